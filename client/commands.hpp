@@ -1,0 +1,10 @@
+#pragma once
+// Each `demcal` subcommand registers itself on the CLI11 app in its own cmd_*.cpp file.
+#include <CLI/CLI.hpp>
+
+namespace demcal::cli {
+
+void add_contact_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
+
+}  // namespace demcal::cli

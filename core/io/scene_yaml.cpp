@@ -1,0 +1,140 @@
+#include "core/io/scene_yaml.hpp"
+
+#include "core/common/rng.hpp"
+#include "core/io/contact_law_yaml.hpp"
+#include "core/particles/insertion.hpp"
+#include "core/sim/time_step.hpp"
+
+namespace demcal::io {
+namespace {
+
+walls::Wall read_wall(const YamlNode& n) {
+  n.expect_only({"name", "plane", "cylinder", "disk", "velocity", "angular_velocity", "pivot"});
+  walls::Wall w;
+  w.name = n["name"].as_string();
+  if (auto p = n.child("plane")) {
+    p->expect_only({"point", "normal"});
+    w.shape = walls::Plane{(*p)["point"].as_vec3(), normalized((*p)["normal"].as_vec3())};
+    w.pivot = (*p)["point"].as_vec3();
+  } else if (auto c = n.child("cylinder")) {
+    c->expect_only({"point", "axis", "radius", "lo", "hi"});
+    walls::Cylinder cyl{(*c)["point"].as_vec3(), normalized((*c)["axis"].as_vec3()), (*c)["radius"].as_number()};
+    cyl.lo = c->number("lo", -walls::kInfinity);
+    cyl.hi = c->number("hi", walls::kInfinity);
+    w.shape = cyl;
+    w.pivot = cyl.point;
+  } else if (auto d = n.child("disk")) {
+    d->expect_only({"centre", "normal", "radius"});
+    w.shape = walls::Disk{(*d)["centre"].as_vec3(), normalized((*d)["normal"].as_vec3()), (*d)["radius"].as_number()};
+    w.pivot = (*d)["centre"].as_vec3();
+  } else {
+    n.fail("a wall needs one of: plane, cylinder, disk");
+  }
+  if (auto v = n.child("velocity")) w.velocity = v->as_vec3();
+  if (auto o = n.child("angular_velocity")) w.omega = o->as_vec3();
+  if (auto p = n.child("pivot")) w.pivot = p->as_vec3();
+  return w;
+}
+
+particles::Region read_region(const YamlNode& n) {
+  if (auto b = n.child("box")) {
+    b->expect_only({"lo", "hi"});
+    return particles::BoxRegion{(*b)["lo"].as_vec3(), (*b)["hi"].as_vec3()};
+  }
+  if (auto c = n.child("cylinder")) {
+    c->expect_only({"centre", "radius", "z_lo", "z_hi"});
+    return particles::CylinderRegion{(*c)["centre"].as_vec3(), (*c)["radius"].as_number(),
+                                     (*c)["z_lo"].as_number(), (*c)["z_hi"].as_number()};
+  }
+  n.fail("a region needs one of: box, cylinder");
+}
+
+void read_particles(const YamlNode& n, sim::World& world, double density, Rng& rng) {
+  n.expect_only({"lattice", "random"});
+  if (auto l = n.child("lattice")) {
+    l->expect_only({"origin", "spacing", "counts", "radius", "jitter"});
+    const auto counts = (*l)["counts"].as_numbers();
+    if (counts.size() != 3) (*l)["counts"].fail("expected 3 counts");
+    particles::insert_lattice(world.particles, (*l)["origin"].as_vec3(), (*l)["spacing"].as_number(),
+                              static_cast<int>(counts[0]), static_cast<int>(counts[1]),
+                              static_cast<int>(counts[2]), (*l)["radius"].as_number(), density, 0,
+                              l->number("jitter", 0.0), rng);
+  } else if (auto r = n.child("random")) {
+    r->expect_only({"region", "count", "sizes", "gap"});
+    particles::InsertRequest req;
+    req.region = read_region((*r)["region"]);
+    req.count = static_cast<std::size_t>((*r)["count"].as_number());
+    req.sizes = read_size_distribution((*r)["sizes"]);
+    req.density = density;
+    req.gap = r->number("gap", 0.0);
+    particles::insert_random(world.particles, req, rng);
+  } else {
+    n.fail("particles need one of: lattice, random");
+  }
+}
+
+}  // namespace
+
+particles::SizeDistribution read_size_distribution(const YamlNode& n) {
+  particles::SizeDistribution d;
+  if (auto m = n.child("monodisperse")) {
+    m->expect_only({"radius"});
+    d = particles::Monodisperse{(*m)["radius"].as_number()};
+  } else if (auto c = n.child("discrete")) {
+    c->expect_only({"radii", "mass_fractions"});
+    d = particles::DiscreteClasses{(*c)["radii"].as_numbers(), (*c)["mass_fractions"].as_numbers()};
+  } else if (auto l = n.child("lognormal")) {
+    l->expect_only({"median_radius", "sigma_g", "truncate_k"});
+    d = particles::LogNormal{(*l)["median_radius"].as_number(), (*l)["sigma_g"].as_number(),
+                             l->number("truncate_k", 2.5)};
+  } else {
+    n.fail("sizes need one of: monodisperse, discrete, lognormal");
+  }
+  particles::validate(d, n.where());
+  return d;
+}
+
+Scene read_scene(const YamlNode& root) {
+  root.expect_only({"threads", "seed", "time_step", "time_step_safety", "skin", "gravity", "domain", "density",
+                    "contact_law", "wall_contact_law", "walls", "particles", "phases"});
+  Scene scene;
+  sim::World& w = scene.world;
+  w.threads = static_cast<int>(root.number("threads", 1));
+  if (w.threads < 1) root["threads"].fail("must be >= 1");
+  Rng rng(static_cast<std::uint64_t>(root.number("seed", 1)));
+  w.skin = root.number("skin", 0.0);
+  if (auto g = root.child("gravity")) w.gravity = g->as_vec3();
+  if (auto d = root.child("domain")) {
+    d->expect_only({"lo", "hi", "periodic"});
+    w.domain.lo = (*d)["lo"].as_vec3();
+    w.domain.hi = (*d)["hi"].as_vec3();
+    if (auto p = d->child("periodic")) {
+      const auto items = p->items();
+      if (items.size() != 3) p->fail("expected 3 booleans");
+      for (int k = 0; k < 3; ++k) w.domain.periodic[k] = items[k].as_bool();
+    }
+  }
+  const double density = root["density"].as_number();
+  if (!(density > 0.0)) root["density"].fail("must be > 0");
+  const auto law = read_contact_law(root["contact_law"]);
+  w.set_pair_law(0, 0, law);
+  const auto wall_law = root.has("wall_contact_law") ? read_contact_law(root["wall_contact_law"]) : law;
+  if (auto walls = root.child("walls"))
+    for (const auto& item : walls->items()) {
+      w.walls.push_back(read_wall(item));
+      w.set_wall_law(0, 0, wall_law);
+    }
+  read_particles(root["particles"], w, density, rng);
+  if (root.has("time_step")) {
+    w.dt = root["time_step"].as_number();
+  } else {
+    w.dt = sim::recommended_time_step(w, root.number("time_step_safety", 0.2));
+  }
+  for (const auto& item : root["phases"].items()) {
+    item.expect_only({"name", "steps"});
+    scene.phases.push_back({item["name"].as_string(), static_cast<long>(item["steps"].as_number())});
+  }
+  return scene;
+}
+
+}  // namespace demcal::io

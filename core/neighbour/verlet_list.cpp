@@ -1,0 +1,165 @@
+#include "core/neighbour/verlet_list.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/common/error.hpp"
+
+namespace demcal::neighbour {
+namespace {
+
+/// Uniform cell grid over the particles (periodic axes: over the box).
+struct Grid {
+  std::array<int, 3> n{1, 1, 1};
+  Vec3 lo;
+  Vec3 inv_cell;
+  std::array<bool, 3> periodic{};
+
+  int coord(const Vec3& x, int k) const {
+    int c = static_cast<int>(std::floor((x[k] - lo[k]) * inv_cell[k]));
+    return std::clamp(c, 0, n[k] - 1);
+  }
+  int index(int cx, int cy, int cz) const { return (cz * n[1] + cy) * n[0] + cx; }
+  int cells() const { return n[0] * n[1] * n[2]; }
+
+  /// The distinct cells around (cx, cy, cz); fewer than 27 where a periodic axis has < 3 cells.
+  int stencil(int cx, int cy, int cz, std::array<int, 27>& out) const {
+    int count = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          std::array<int, 3> c{cx + dx, cy + dy, cz + dz};
+          bool inside = true;
+          for (int k = 0; k < 3; ++k) {
+            if (c[k] >= 0 && c[k] < n[k]) continue;
+            if (periodic[k]) c[k] = (c[k] + n[k]) % n[k];
+            else inside = false;
+          }
+          if (!inside) continue;
+          const int id = index(c[0], c[1], c[2]);
+          if (std::find(out.begin(), out.begin() + count, id) == out.begin() + count) out[count++] = id;
+        }
+    return count;
+  }
+};
+
+Grid make_grid(const std::vector<Vec3>& x, const Domain& domain, double cell, std::size_t n_particles) {
+  Grid g;
+  g.periodic = domain.periodic;
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const Vec3& p : x)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  // Cap the grid at a few cells per particle: a far-flung particle must not allocate a huge grid.
+  const double max_cells = 4.0 * static_cast<double>(n_particles) + 64.0;
+  for (;;) {
+    double total = 1.0;
+    for (int k = 0; k < 3; ++k) {
+      if (domain.periodic[k]) {
+        g.lo[k] = domain.lo[k];
+        const double len = domain.hi[k] - domain.lo[k];
+        g.n[k] = std::max(1, static_cast<int>(std::floor(len / cell)));
+        g.inv_cell[k] = g.n[k] / len;
+      } else {
+        g.lo[k] = lo[k];
+        g.n[k] = std::max(1, static_cast<int>(std::floor((hi[k] - lo[k]) / cell)) + 1);
+        g.inv_cell[k] = 1.0 / cell;
+      }
+      total *= g.n[k];
+    }
+    if (total <= max_cells) return g;
+    cell *= std::cbrt(total / max_cells) * 1.01;
+  }
+}
+
+}  // namespace
+
+void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& radius,
+                       const Domain& domain, double reach, int threads,
+                       std::vector<double>& history, int stride) {
+  const int n = static_cast<int>(x.size());
+  double r_max = 0.0;
+  for (double r : radius) r_max = std::max(r_max, r);
+  const Grid grid = make_grid(x, domain, 2.0 * r_max + reach, x.size());
+
+  // Counting sort of the particles into cells.
+  std::vector<int> cell_of(n);
+  cell_start_.assign(grid.cells() + 1, 0);
+  for (int i = 0; i < n; ++i) {
+    cell_of[i] = grid.index(grid.coord(x[i], 0), grid.coord(x[i], 1), grid.coord(x[i], 2));
+    ++cell_start_[cell_of[i] + 1];
+  }
+  for (int c = 0; c < grid.cells(); ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_items_.resize(n);
+  {
+    std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+    for (int i = 0; i < n; ++i) cell_items_[fill[cell_of[i]]++] = i;
+  }
+
+  std::vector<int> old_start, old_nbr;
+  old_start.swap(row_start);
+  old_nbr.swap(nbr);
+  row_start.assign(n + 1, 0);
+
+  auto for_each_partner = [&](int i, auto&& visit) {
+    std::array<int, 27> cells;
+    const int nc = grid.stencil(grid.coord(x[i], 0), grid.coord(x[i], 1), grid.coord(x[i], 2), cells);
+    for (int s = 0; s < nc; ++s)
+      for (int k = cell_start_[cells[s]]; k < cell_start_[cells[s] + 1]; ++k) {
+        const int j = cell_items_[k];
+        if (j <= i) continue;
+        const double cut = radius[i] + radius[j] + reach;
+        if (norm2(domain.separation(x[i], x[j])) < cut * cut) visit(j);
+      }
+  };
+
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int i = 0; i < n; ++i) {
+    int count = 0;
+    for_each_partner(i, [&](int) { ++count; });
+    row_start[i + 1] = count;
+  }
+  for (int i = 0; i < n; ++i) row_start[i + 1] += row_start[i];
+  nbr.resize(row_start[n]);
+
+  std::vector<double> new_history(static_cast<std::size_t>(nbr.size()) * stride, 0.0);
+  const bool carry = stride > 0 && old_start.size() == static_cast<std::size_t>(n + 1);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int i = 0; i < n; ++i) {
+    int pos = row_start[i];
+    for_each_partner(i, [&](int j) { nbr[pos++] = j; });
+    std::sort(nbr.begin() + row_start[i], nbr.begin() + row_start[i + 1]);
+    if (!carry) continue;
+    // Merge the sorted old and new rows of i: a pair found in both keeps its history.
+    int a = old_start[i], b = row_start[i];
+    while (a < old_start[i + 1] && b < row_start[i + 1]) {
+      if (old_nbr[a] < nbr[b]) {
+        ++a;
+      } else if (nbr[b] < old_nbr[a]) {
+        ++b;
+      } else {
+        std::copy_n(history.begin() + static_cast<std::ptrdiff_t>(a) * stride, stride,
+                    new_history.begin() + static_cast<std::ptrdiff_t>(b) * stride);
+        ++a;
+        ++b;
+      }
+    }
+  }
+  history.swap(new_history);
+  x_at_build_ = x;
+  ++builds_;
+}
+
+bool VerletList::needs_rebuild(const std::vector<Vec3>& x, double skin) const {
+  if (x.size() != x_at_build_.size()) return true;
+  const double limit = 0.25 * skin * skin;
+  const int n = static_cast<int>(x.size());
+  for (int i = 0; i < n; ++i)
+    if (norm2(x[i] - x_at_build_[i]) > limit) return true;
+  return false;
+}
+
+}  // namespace demcal::neighbour

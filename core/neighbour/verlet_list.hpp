@@ -1,0 +1,36 @@
+#pragma once
+// Half Verlet list (each pair once, j > i) built on a cell grid, with a skin. Rows are sorted by j
+// so the per-contact history of the old list can be carried to the new one by merging rows
+// (the explicit history-mapping step of DEM-Engine, keyed by the ordered pair (i, j)).
+#include <vector>
+
+#include "core/common/vec3.hpp"
+#include "core/common/domain.hpp"
+
+namespace demcal::neighbour {
+
+class VerletList {
+ public:
+  std::vector<int> row_start;  ///< size N+1: pairs of i are nbr[row_start[i] .. row_start[i+1])
+  std::vector<int> nbr;        ///< partner j of each pair, sorted within a row
+
+  /// Rebuilds the list for pairs with |x_j - x_i| < r_i + r_j + reach, where reach = interaction
+  /// range beyond contact + skin. Carries `history` (stride doubles per pair) from the old list.
+  /// Positions must already be wrapped into the periodic box.
+  void build(const std::vector<Vec3>& x, const std::vector<double>& radius, const Domain& domain,
+             double reach, int threads, std::vector<double>& history, int stride);
+
+  /// True when some particle has moved more than half the skin since the last build, the
+  /// displacement after which a pair outside the list could have come into range.
+  bool needs_rebuild(const std::vector<Vec3>& x, double skin) const;
+
+  std::size_t pairs() const { return nbr.size(); }
+  std::size_t builds() const { return builds_; }
+
+ private:
+  std::vector<Vec3> x_at_build_;
+  std::vector<int> cell_start_, cell_items_;
+  std::size_t builds_ = 0;
+};
+
+}  // namespace demcal::neighbour

@@ -1,0 +1,116 @@
+#include "core/particles/insertion.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <unordered_map>
+#include <vector>
+
+#include "core/common/error.hpp"
+
+namespace demcal::particles {
+namespace {
+
+/// Hash grid of the spheres already placed, for the overlap check of a candidate.
+class PlacementGrid {
+ public:
+  explicit PlacementGrid(double cell) : cell_(cell) {}
+  void add(std::size_t i, const Vec3& x) { cells_[key(x)].push_back(i); }
+  bool overlaps(const ParticleStore& s, const Vec3& x, double r, double gap) const {
+    const auto c = coords(x);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cells_.find(pack(c[0] + dx, c[1] + dy, c[2] + dz));
+          if (it == cells_.end()) continue;
+          for (std::size_t j : it->second) {
+            const double min_d = r + s.radius[j] + gap;
+            if (norm2(s.x[j] - x) < min_d * min_d) return true;
+          }
+        }
+    return false;
+  }
+
+ private:
+  std::array<std::int64_t, 3> coords(const Vec3& x) const {
+    return {static_cast<std::int64_t>(std::floor(x.x / cell_)),
+            static_cast<std::int64_t>(std::floor(x.y / cell_)),
+            static_cast<std::int64_t>(std::floor(x.z / cell_))};
+  }
+  static std::int64_t pack(std::int64_t a, std::int64_t b, std::int64_t c) {
+    return ((a & 0x1FFFFF) << 42) | ((b & 0x1FFFFF) << 21) | (c & 0x1FFFFF);
+  }
+  std::int64_t key(const Vec3& x) const {
+    const auto c = coords(x);
+    return pack(c[0], c[1], c[2]);
+  }
+  double cell_;
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> cells_;
+};
+
+/// A uniformly random centre for a sphere of radius r that lies wholly inside the region.
+bool random_centre(const Region& region, double r, Rng& rng, Vec3& out) {
+  return std::visit(
+      [&](const auto& g) {
+        using G = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<G, BoxRegion>) {
+          const Vec3 lo = g.lo + Vec3{r, r, r}, hi = g.hi - Vec3{r, r, r};
+          if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z) return false;
+          out = {rng.uniform(lo.x, hi.x), rng.uniform(lo.y, hi.y), rng.uniform(lo.z, hi.z)};
+          return true;
+        } else {
+          const double rr = g.radius - r;
+          if (rr <= 0.0 || g.z_lo + r > g.z_hi - r) return false;
+          // Uniform in the disk: radius from sqrt of a uniform number.
+          const double rho = rr * std::sqrt(rng.uniform());
+          const double phi = 2.0 * M_PI * rng.uniform();
+          out = {g.centre.x + rho * std::cos(phi), g.centre.y + rho * std::sin(phi),
+                 rng.uniform(g.z_lo + r, g.z_hi - r)};
+          return true;
+        }
+      },
+      region);
+}
+
+}  // namespace
+
+void insert_random(ParticleStore& store, const InsertRequest& req, Rng& rng) {
+  validate(req.sizes, "sizes");
+  const double r_max = max_radius(req.sizes);
+  PlacementGrid grid(2.0 * r_max + req.gap);
+  for (std::size_t i = 0; i < store.size(); ++i) grid.add(i, store.x[i]);
+  store.reserve(store.size() + req.count);
+  for (std::size_t placed = 0; placed < req.count; ++placed) {
+    const double r = sample_radius(req.sizes, rng);
+    bool ok = false;
+    for (std::size_t attempt = 0; attempt < req.max_attempts_per_particle && !ok; ++attempt) {
+      Vec3 c;
+      if (!random_centre(req.region, r + req.gap, rng, c))
+        throw InputError("insertion.region", "region too small for a particle of radius " + std::to_string(r));
+      if (grid.overlaps(store, c, r, req.gap)) continue;
+      grid.add(store.add_sphere(c, r, req.density, req.material), c);
+      ok = true;
+    }
+    if (!ok)
+      throw InputError("insertion.count", "could place only " + std::to_string(placed) + " of " +
+                                              std::to_string(req.count) +
+                                              " particles without overlap; enlarge the region or "
+                                              "insert fewer");
+  }
+}
+
+void insert_lattice(ParticleStore& store, const Vec3& origin, double spacing, int nx, int ny, int nz,
+                    double radius, double density, std::uint16_t material, double jitter, Rng& rng) {
+  if (spacing < 2.0 * radius + 2.0 * jitter)
+    throw InputError("lattice.spacing", "spacing must exceed the diameter plus twice the jitter");
+  store.reserve(store.size() + static_cast<std::size_t>(nx) * ny * nz);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const Vec3 c = origin + Vec3{i * spacing + rng.uniform(-jitter, jitter),
+                                     j * spacing + rng.uniform(-jitter, jitter), k * spacing};
+        store.add_sphere(c, radius, density, material);
+      }
+}
+
+}  // namespace demcal::particles

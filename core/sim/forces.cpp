@@ -1,0 +1,191 @@
+#include "core/sim/forces.hpp"
+
+#include <omp.h>
+
+#include <vector>
+
+namespace demcal::sim {
+namespace {
+
+template <class N, class C, class T, class R>
+struct TypedLaw {
+  N n;
+  C c;
+  T t;
+  R r;
+  contact::PairOutput evaluate(const contact::PairInput& in, double* history) const {
+    return contact::evaluate(n, c, t, r, in, history);
+  }
+};
+
+template <class N, class C, class T, class R>
+TypedLaw<N, C, T, R> typed(const contact::ContactLaw& law) {
+  return {std::get<N>(law.normal), std::get<C>(law.cohesion), std::get<T>(law.tangential),
+          std::get<R>(law.rolling)};
+}
+
+template <class N, class C, class T, class R>
+void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
+  using Law = TypedLaw<N, C, T, R>;
+  constexpr int kStride = contact::History<N, C, T, R>::kSize;
+  const int n_mat = w.materials();
+  std::vector<Law> laws;
+  laws.reserve(n_mat * n_mat);
+  for (int a = 0; a < n_mat; ++a)
+    for (int b = 0; b < n_mat; ++b) laws.push_back(typed<N, C, T, R>(w.pair_law(a, b)));
+  const double range = w.interaction_range();
+
+  auto& p = w.particles;
+  const int n = static_cast<int>(p.size());
+  const auto& start = w.list.row_start;
+  const auto& nbr = w.list.nbr;
+  double* hist = w.pair_history.data();
+  const Domain& dom = w.domain;
+  const bool periodic = dom.any_periodic();
+  const double dt = w.dt;
+  const int threads = w.threads;
+
+#pragma omp parallel num_threads(threads)
+  {
+    const int tid = omp_get_thread_num();
+    Vec3* force = threads > 1 ? w.thread_force[tid].data() : p.f.data();
+    Vec3* torque = threads > 1 ? w.thread_torque[tid].data() : p.torque.data();
+    if (threads == 1) {
+      for (int i = 0; i < n; ++i) {
+        force[i] = w.gravity * p.mass[i];
+        torque[i] = {};
+      }
+    }
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      const Vec3 xi = p.x[i], vi = p.v[i], wi = p.omega[i];
+      const double ri = p.radius[i], mi = p.mass[i];
+      const Law* law_row = &laws[p.material[i] * n_mat];
+      Vec3 fi{}, ti{};
+      for (int k = start[i]; k < start[i + 1]; ++k) {
+        const int j = nbr[k];
+        double* h = hist + static_cast<std::ptrdiff_t>(k) * kStride;
+        const Vec3 d = periodic ? dom.separation(xi, p.x[j]) : p.x[j] - xi;
+        const double rj = p.radius[j];
+        const double reach = ri + rj + range;
+        const double dist2 = norm2(d);
+        if (dist2 >= reach * reach) {
+          for (int s = 0; s < kStride; ++s) h[s] = 0.0;
+          continue;
+        }
+        const double dist = std::sqrt(dist2);
+        contact::PairInput in;
+        in.n = d / dist;
+        in.delta = ri + rj - dist;
+        in.r_i = ri;
+        in.r_j = rj;
+        in.r_star = ri * rj / (ri + rj);
+        in.m_star = mi * p.mass[j] / (mi + p.mass[j]);
+        const Vec3 v_rel = vi - p.v[j];
+        in.vn = dot(v_rel, in.n);
+        in.vt = v_rel - in.n * in.vn + cross(wi * ri + p.omega[j] * rj, in.n);
+        in.w_rel = wi - p.omega[j];
+        in.dt = dt;
+        const contact::PairOutput out = law_row[p.material[j]].evaluate(in, h);
+        fi += out.force;
+        ti += out.torque_i;
+        force[j] -= out.force;
+        torque[j] += out.torque_j;
+      }
+      force[i] += fi;
+      torque[i] += ti;
+    }
+    if (threads > 1) {
+      // Sum the thread buffers in thread order (fixed), then clear them for the next step.
+#pragma omp for schedule(static)
+      for (int i = 0; i < n; ++i) {
+        Vec3 f = w.gravity * p.mass[i], t{};
+        for (int b = 0; b < threads; ++b) {
+          f += w.thread_force[b][i];
+          t += w.thread_torque[b][i];
+          w.thread_force[b][i] = {};
+          w.thread_torque[b][i] = {};
+        }
+        p.f[i] = f;
+        p.torque[i] = t;
+      }
+    }
+  }
+}
+
+template <class N, class C, class T, class R>
+void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&, const R&) {
+  using Law = TypedLaw<N, C, T, R>;
+  constexpr int kStride = contact::History<N, C, T, R>::kSize;
+  walls::Wall& wall = w.walls[wall_index];
+  std::vector<Law> laws;
+  for (int m = 0; m < w.materials(); ++m) laws.push_back(typed<N, C, T, R>(w.wall_law(wall.material, m)));
+  double range = 0.0;
+  for (const auto& l : laws) range = std::max(range, l.c.range());
+
+  auto& p = w.particles;
+  const int n = static_cast<int>(p.size());
+  double* hist = w.wall_history[wall_index].data();
+  const int threads = w.threads;
+  std::vector<Vec3> part_force(threads), part_torque(threads);
+
+#pragma omp parallel num_threads(threads)
+  {
+    const int tid = omp_get_thread_num();
+    Vec3 wf{}, wt{};
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
+      walls::WallGeometry g;
+      if (!walls::wall_geometry(wall.shape, p.x[i], p.radius[i], range, g)) {
+        for (int s = 0; s < kStride; ++s) h[s] = 0.0;
+        continue;
+      }
+      contact::PairInput in;
+      in.n = g.n;
+      in.delta = g.delta;
+      in.r_i = p.radius[i];
+      in.r_j = 0.0;
+      in.r_star = p.radius[i];
+      in.m_star = p.mass[i];
+      const Vec3 v_rel = p.v[i] - wall.velocity_at(g.point);
+      in.vn = dot(v_rel, in.n);
+      in.vt = v_rel - in.n * in.vn + cross(p.omega[i] * p.radius[i], in.n);
+      in.w_rel = p.omega[i] - wall.omega;
+      in.dt = w.dt;
+      const contact::PairOutput out = laws[p.material[i]].evaluate(in, h);
+      p.f[i] += out.force;
+      p.torque[i] += out.torque_i;
+      wf -= out.force;
+      wt += cross(g.point - wall.pivot, -out.force) + out.torque_j;
+    }
+    part_force[tid] = wf;
+    part_torque[tid] = wt;
+  }
+  wall.force = {};
+  wall.torque = {};
+  for (int t = 0; t < threads; ++t) {
+    wall.force += part_force[t];
+    wall.torque += part_torque[t];
+  }
+}
+
+}  // namespace
+
+void compute_pair_forces(World& world) {
+  if (world.particles.size() == 0) return;
+  contact::visit(world.pair_law(0, 0), [&](const auto& n, const auto& c, const auto& t, const auto& r) {
+    pair_kernel(world, n, c, t, r);
+  });
+}
+
+void compute_wall_forces(World& world) {
+  const int m0 = world.particles.size() ? world.particles.material[0] : 0;
+  for (std::size_t k = 0; k < world.walls.size(); ++k)
+    contact::visit(world.wall_law(world.walls[k].material, m0),
+                   [&](const auto& n, const auto& c, const auto& t, const auto& r) {
+                     wall_kernel(world, k, n, c, t, r);
+                   });
+}
+
+}  // namespace demcal::sim

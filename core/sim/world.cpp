@@ -1,0 +1,118 @@
+#include "core/sim/world.hpp"
+
+#include <algorithm>
+
+#include "core/common/error.hpp"
+#include "core/sim/time_step.hpp"
+
+namespace demcal::sim {
+namespace {
+
+/// The variant indices of the four slots: laws that share them share one compiled kernel.
+std::array<std::size_t, 4> composition(const contact::ContactLaw& law) {
+  return {law.normal.index(), law.cohesion.index(), law.tangential.index(), law.rolling.index()};
+}
+
+}  // namespace
+
+void World::grow_law_tables(int n) {
+  if (n <= n_materials_) return;
+  std::vector<contact::ContactLaw> laws(static_cast<std::size_t>(n) * n);
+  std::vector<bool> set(static_cast<std::size_t>(n) * n, false);
+  for (int a = 0; a < n_materials_; ++a)
+    for (int b = 0; b < n_materials_; ++b) {
+      laws[a * n + b] = pair_laws_[a * n_materials_ + b];
+      set[a * n + b] = pair_set_[a * n_materials_ + b];
+    }
+  pair_laws_.swap(laws);
+  pair_set_.swap(set);
+  for (auto& row : wall_laws_) row.resize(n);
+  for (auto& row : wall_set_) row.resize(n, false);
+  n_materials_ = n;
+}
+
+void World::set_pair_law(int a, int b, const contact::ContactLaw& law) {
+  grow_law_tables(std::max(a, b) + 1);
+  pair_laws_[a * n_materials_ + b] = law;
+  pair_laws_[b * n_materials_ + a] = law;
+  pair_set_[a * n_materials_ + b] = pair_set_[b * n_materials_ + a] = true;
+  prepared_ = false;
+}
+
+void World::set_wall_law(int wall_material, int particle_material, const contact::ContactLaw& law) {
+  grow_law_tables(particle_material + 1);
+  if (wall_material >= static_cast<int>(wall_laws_.size())) {
+    wall_laws_.resize(wall_material + 1, std::vector<contact::ContactLaw>(n_materials_));
+    wall_set_.resize(wall_material + 1, std::vector<bool>(n_materials_, false));
+  }
+  wall_laws_[wall_material][particle_material] = law;
+  wall_set_[wall_material][particle_material] = true;
+  prepared_ = false;
+}
+
+const contact::ContactLaw& World::pair_law(int a, int b) const { return pair_laws_[a * n_materials_ + b]; }
+
+const contact::ContactLaw& World::wall_law(int wall_material, int particle_material) const {
+  return wall_laws_[wall_material][particle_material];
+}
+
+double World::interaction_range() const {
+  double range = 0.0;
+  for (const auto& law : pair_laws_) range = std::max(range, law.range());
+  for (const auto& row : wall_laws_)
+    for (const auto& law : row) range = std::max(range, law.range());
+  return range;
+}
+
+void World::prepare() {
+  // Every material present needs its laws, and one compiled kernel must serve each table.
+  for (auto m : particles.material) {
+    if (m >= n_materials_ || !pair_set_[m * n_materials_ + m])
+      throw InputError("contact_laws", "no particle-particle contact law for material " + std::to_string(m));
+  }
+  for (int a = 0; a < n_materials_ * n_materials_; ++a)
+    if (pair_set_[a] && composition(pair_laws_[a]) != composition(pair_laws_[0]))
+      throw InputError("contact_laws",
+                       "all particle-particle laws must use the same models (parameters may differ)");
+  wall_strides_.clear();
+  for (const auto& w : walls) {
+    if (w.material >= wall_laws_.size())
+      throw InputError("walls." + w.name, "no contact law for wall material " + std::to_string(w.material));
+    for (auto m : particles.material)
+      if (!wall_set_[w.material][m])
+        throw InputError("walls." + w.name, "no contact law between wall material " +
+                                                std::to_string(w.material) + " and particle material " +
+                                                std::to_string(m));
+    const auto& row = wall_laws_[w.material];
+    for (int m = 0; m < n_materials_; ++m)
+      if (wall_set_[w.material][m] && composition(row[m]) != composition(row[particles.material.empty() ? 0 : particles.material[0]]))
+        throw InputError("walls." + w.name, "all laws of one wall material must use the same models");
+    wall_strides_.push_back(row[particles.material.empty() ? 0 : particles.material[0]].history_size());
+  }
+  check_time_step(*this);
+
+  double r_min = 1e300;
+  for (double r : particles.radius) r_min = std::min(r_min, r);
+  skin_ = skin > 0.0 ? skin : (particles.size() ? 0.1 * r_min : 0.0);
+  pair_stride_ = n_materials_ ? pair_laws_[0].history_size() : 0;
+
+  for (std::size_t i = 0; i < particles.size(); ++i) domain.wrap(particles.x[i]);
+  list = neighbour::VerletList{};
+  pair_history.clear();
+  list.build(particles.x, particles.radius, domain, interaction_range() + skin_, threads, pair_history,
+             pair_stride_);
+  wall_history.assign(walls.size(), {});
+  for (std::size_t w = 0; w < walls.size(); ++w)
+    wall_history[w].assign(particles.size() * wall_strides_[w], 0.0);
+  const int buffers = threads > 1 ? threads : 0;
+  thread_force.assign(buffers, std::vector<Vec3>(particles.size()));
+  thread_torque.assign(buffers, std::vector<Vec3>(particles.size()));
+  prepared_ = true;
+}
+
+void World::remove_particles(const std::vector<char>& flags) {
+  particles.remove_if(flags);
+  prepared_ = false;
+}
+
+}  // namespace demcal::sim

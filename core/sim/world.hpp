@@ -1,0 +1,68 @@
+#pragma once
+// The simulated system: particles, walls, the contact laws per pair type, and the state the
+// step function carries from one step to the next (neighbour list, per-contact history).
+#include <cstdint>
+#include <vector>
+
+#include "core/contact/contact_law.hpp"
+#include "core/neighbour/verlet_list.hpp"
+#include "core/particles/particle_store.hpp"
+#include "core/common/domain.hpp"
+#include "core/walls/wall.hpp"
+
+namespace demcal::sim {
+
+class World {
+ public:
+  particles::ParticleStore particles;
+  std::vector<walls::Wall> walls;
+  Domain domain;
+  Vec3 gravity{0.0, 0.0, -9.81};
+  double dt = 0.0;     ///< time step (s)
+  double skin = 0.0;   ///< Verlet skin (m); 0 = 10 % of the smallest particle radius
+  int threads = 1;     ///< OpenMP threads; results are bitwise identical for a given count
+  double time = 0.0;
+  std::int64_t step_count = 0;
+
+  /// Contact laws. Particle-particle laws by (material i, material j), symmetric; particle-wall
+  /// laws by (wall material, particle material). All particle-particle laws share one composition
+  /// of models (their parameters differ), and so do all laws of one wall material.
+  void set_pair_law(int material_i, int material_j, const contact::ContactLaw& law);
+  void set_wall_law(int wall_material, int particle_material, const contact::ContactLaw& law);
+  const contact::ContactLaw& pair_law(int material_i, int material_j) const;
+  const contact::ContactLaw& wall_law(int wall_material, int particle_material) const;
+  int materials() const { return n_materials_; }
+
+  /// Checks the laws, the time step against the stability limit, and builds the neighbour list.
+  /// Called by step() when needed; call it again after adding or removing particles or walls.
+  void prepare();
+  bool prepared() const { return prepared_; }
+  /// Removes flagged particles (e.g. a bed cut to height); contact history is dropped.
+  void remove_particles(const std::vector<char>& flags);
+
+  /// The largest interaction reach beyond contact over all laws (cohesion range), m.
+  double interaction_range() const;
+
+  // State carried between steps, used by the step function and by metrics.
+  neighbour::VerletList list;
+  std::vector<double> pair_history;               ///< history_stride() doubles per listed pair
+  std::vector<std::vector<double>> wall_history;  ///< per wall: particles * wall_stride
+  std::vector<std::vector<Vec3>> thread_force, thread_torque;
+  int pair_stride() const { return pair_stride_; }
+  int wall_stride(std::size_t wall) const { return wall_strides_[wall]; }
+  double effective_skin() const { return skin_; }
+
+ private:
+  void grow_law_tables(int n);
+  std::vector<contact::ContactLaw> pair_laws_;        // n_materials_^2
+  std::vector<std::vector<contact::ContactLaw>> wall_laws_;  // [wall material][particle material]
+  std::vector<bool> pair_set_;
+  std::vector<std::vector<bool>> wall_set_;
+  int n_materials_ = 0;
+  int pair_stride_ = 0;
+  std::vector<int> wall_strides_;
+  double skin_ = 0.0;
+  bool prepared_ = false;
+};
+
+}  // namespace demcal::sim

@@ -1,0 +1,66 @@
+#pragma once
+// Walls: infinite planes, cylinders (inner surface) and disks, moved rigidly by a prescribed
+// or controlled velocity and angular velocity. Each wall reports the force and torque the
+// particles exert on it in the last step.
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <variant>
+
+#include "core/common/vec3.hpp"
+
+namespace demcal::walls {
+
+inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+/// Infinite plane through `point`; particles live on the side `normal` points to.
+struct Plane {
+  Vec3 point;
+  Vec3 normal;  ///< unit
+};
+/// Inner surface of a cylinder: axis through `point` along the unit `axis`, particles inside.
+/// The surface spans axial coordinates [lo, hi] measured from `point`.
+struct Cylinder {
+  Vec3 point;
+  Vec3 axis;
+  double radius = 0.0;
+  double lo = -kInfinity, hi = kInfinity;
+};
+/// Flat disk (a piston face or a lid): both faces and the rim touch particles.
+struct Disk {
+  Vec3 centre;
+  Vec3 normal;  ///< unit
+  double radius = 0.0;
+};
+using Shape = std::variant<Plane, Cylinder, Disk>;
+
+/// Where a sphere meets a wall. n points from the particle centre into the wall.
+struct WallGeometry {
+  Vec3 n;
+  double delta = 0.0;  ///< overlap (m), < 0 a gap
+  Vec3 point;          ///< the nearest point on the wall surface
+};
+
+struct Wall {
+  std::string name;
+  Shape shape;
+  std::uint16_t material = 0;
+  Vec3 velocity;          ///< translation (m/s)
+  Vec3 omega;             ///< rotation about `pivot` (rad/s)
+  Vec3 pivot;             ///< centre of rotation and reference point of `torque`; moves with the wall
+  Vec3 force;             ///< force of the particles on the wall in the last step (N)
+  Vec3 torque;            ///< their torque about `pivot` (N m)
+  Vec3 displacement;      ///< total translation since the start (m)
+
+  /// Velocity of the wall's material point at p.
+  Vec3 velocity_at(const Vec3& p) const { return velocity + cross(omega, p - pivot); }
+};
+
+/// Nearest-point geometry of a sphere (centre x, radius r) against a shape; false when the gap
+/// exceeds `range` (or the sphere is beside a finite wall's extent).
+bool wall_geometry(const Shape& shape, const Vec3& x, double r, double range, WallGeometry& out);
+
+/// Moves a wall rigidly over dt: translation, then rotation about its pivot.
+void advance(Wall& wall, double dt);
+
+}  // namespace demcal::walls
