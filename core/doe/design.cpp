@@ -1,6 +1,7 @@
 #include "core/doe/design.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <numeric>
 #include <sstream>
@@ -221,6 +222,30 @@ Design fold_over(const Design& design, Word fold) {
   d.description = design.description + ", folded over on " +
                   (fold == all ? std::string("all factors") : word_name(fold));
   return d;
+}
+
+Word choose_fold_to_split(const std::vector<SignedWord>& chain, int factor_count) {
+  Word best = 0;
+  std::size_t best_score = chain.size();
+  const auto consider = [&](Word s) {
+    std::size_t odd = 0;
+    for (const auto& m : chain) odd += std::popcount(m.word & s) % 2;
+    if (odd == 0 || odd == chain.size()) return;
+    const std::size_t score =
+        odd > chain.size() - odd ? 2 * odd - chain.size() : chain.size() - 2 * odd;
+    if (score < best_score) {
+      best_score = score;
+      best = s;
+    }
+  };
+  for (int i = 0; i < factor_count; ++i) consider(Word{1} << i);
+  for (int i = 0; i < factor_count; ++i) {
+    for (int j = i + 1; j < factor_count; ++j) consider((Word{1} << i) | (Word{1} << j));
+  }
+  if (best == 0) {
+    throw InputError("chain", "no fold on one or two factors splits " + chain_name(chain));
+  }
+  return best;
 }
 
 Design central_composite(int factor_count, CompositeKind kind, int centre_points) {

@@ -61,6 +61,13 @@ void randomise_run_order(Design& design, std::uint64_t seed);
 /// as block 2 (Montgomery 2017, sec. 8.6). fold = all factors is the full fold-over.
 Design fold_over(const Design& design, Word fold);
 
+/// Factors to fold on so that the members of an alias chain fall into two groups of sizes as
+/// equal as possible: after folding on S, members P and Q stay aliased only when
+/// P xor Q has an even number of letters in S. Repeating the choice on the group that holds
+/// the effect names the interaction in about log2(chain size) fold-overs. Throws InputError
+/// when no fold on one or two factors splits the chain.
+Word choose_fold_to_split(const std::vector<SignedWord>& chain, int factor_count);
+
 enum class CompositeKind { kFaceCentred, kRotatable };
 /// Central composite design on a full 2^k factorial: 2k axial points at alpha = 1
 /// (face-centred) or alpha = (2^k)^(1/4) (rotatable, Box and Hunter 1957), plus centres.
