@@ -27,7 +27,8 @@ struct ParamInfo {
 };
 
 /// Reads `values` into a parameter struct through its table. Every key must be known and every
-/// value inside its range; `where` is the field path used in error messages.
+/// value inside its range; `where` is the field path used in error messages. The model's
+/// finalize() then checks the combination and derives its constants.
 template <class P>
 P params_from_map(const std::map<std::string, double>& values, const std::string& where) {
   P p{};
@@ -49,7 +50,7 @@ P params_from_map(const std::map<std::string, double>& values, const std::string
                                               "] " + std::string(found->unit));
     p.*found->field = value;
   }
-  p.validate(where);
+  p.finalize(where);
   return p;
 }
 

@@ -21,6 +21,7 @@ Variant scale_slot(const Variant& slot, const ScaleFactors& f) {
           double& v = m.*info.field;
           if (is_set(v)) v *= factor_for_unit(info.unit, f);
         }
+        m.finalize("scaled law");
         return m;
       },
       slot);

@@ -50,8 +50,17 @@ particles::Region read_region(const YamlNode& n) {
 }
 
 void read_particles(const YamlNode& n, sim::World& world, double density, Rng& rng) {
-  n.expect_only({"lattice", "random"});
-  if (auto l = n.child("lattice")) {
+  n.expect_only({"lattice", "random", "list"});
+  if (auto list = n.child("list")) {
+    for (const auto& item : list->items()) {
+      item.expect_only({"radius", "position", "velocity", "angular_velocity", "density"});
+      const double r = item["radius"].as_number();
+      if (!(r > 0.0)) item["radius"].fail("must be > 0");
+      const auto i = world.particles.add_sphere(item["position"].as_vec3(), r, item.number("density", density), 0);
+      if (auto v = item.child("velocity")) world.particles.v[i] = v->as_vec3();
+      if (auto w = item.child("angular_velocity")) world.particles.omega[i] = w->as_vec3();
+    }
+  } else if (auto l = n.child("lattice")) {
     l->expect_only({"origin", "spacing", "counts", "radius", "jitter"});
     const auto counts = (*l)["counts"].as_numbers();
     if (counts.size() != 3) (*l)["counts"].fail("expected 3 counts");
@@ -69,7 +78,7 @@ void read_particles(const YamlNode& n, sim::World& world, double density, Rng& r
     req.gap = r->number("gap", 0.0);
     particles::insert_random(world.particles, req, rng);
   } else {
-    n.fail("particles need one of: lattice, random");
+    n.fail("particles need one of: lattice, random, list");
   }
 }
 

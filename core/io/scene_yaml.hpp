@@ -8,6 +8,7 @@
 //   particles: {lattice: {origin, spacing, counts, radius, jitter}}
 //            | {random: {region: {box: {lo, hi}} | {cylinder: {centre, radius, z_lo, z_hi}},
 //                        count, sizes}}
+//            | {list: [{radius, position, velocity, angular_velocity, density}]}
 //   phases: [{name, steps}]
 #include <string>
 #include <vector>

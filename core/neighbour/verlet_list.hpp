@@ -22,7 +22,7 @@ class VerletList {
 
   /// True when some particle has moved more than half the skin since the last build, the
   /// displacement after which a pair outside the list could have come into range.
-  bool needs_rebuild(const std::vector<Vec3>& x, double skin) const;
+  bool needs_rebuild(const std::vector<Vec3>& x, double skin, int threads) const;
 
   std::size_t pairs() const { return nbr.size(); }
   std::size_t builds() const { return builds_; }

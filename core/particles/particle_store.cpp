@@ -15,14 +15,23 @@ std::size_t ParticleStore::add_sphere(const Vec3& position, double r, double den
   radius.push_back(r);
   mass.push_back(mass_i);
   inertia.push_back(0.4 * mass_i * r * r);
+  inv_mass.push_back(0.0);
+  inv_inertia.push_back(0.0);
   material.push_back(material_id);
   motion.push_back(m);
+  set_motion(x.size() - 1, m);
   return x.size() - 1;
+}
+
+void ParticleStore::set_motion(std::size_t i, Motion m) {
+  motion[i] = m;
+  inv_mass[i] = m == Motion::kFree ? 1.0 / mass[i] : 0.0;
+  inv_inertia[i] = m == Motion::kFree ? 1.0 / inertia[i] : 0.0;
 }
 
 void ParticleStore::reserve(std::size_t n) {
   x.reserve(n); v.reserve(n); omega.reserve(n); f.reserve(n); torque.reserve(n);
-  radius.reserve(n); mass.reserve(n); inertia.reserve(n); material.reserve(n); motion.reserve(n);
+  radius.reserve(n); mass.reserve(n); inertia.reserve(n); inv_mass.reserve(n); inv_inertia.reserve(n); material.reserve(n); motion.reserve(n);
 }
 
 namespace {
@@ -37,7 +46,7 @@ void compact(std::vector<T>& a, const std::vector<char>& flags) {
 
 void ParticleStore::remove_if(const std::vector<char>& flags) {
   compact(x, flags); compact(v, flags); compact(omega, flags); compact(f, flags);
-  compact(torque, flags); compact(radius, flags); compact(mass, flags); compact(inertia, flags);
+  compact(torque, flags); compact(radius, flags); compact(mass, flags); compact(inertia, flags); compact(inv_mass, flags); compact(inv_inertia, flags);
   compact(material, flags); compact(motion, flags);
 }
 

@@ -22,6 +22,8 @@ class ParticleStore {
   std::vector<double> radius;       ///< (m)
   std::vector<double> mass;         ///< (kg)
   std::vector<double> inertia;      ///< moment of inertia of a solid sphere, 2/5 m r^2 (kg m^2)
+  std::vector<double> inv_mass;     ///< 1/m, or 0 for a kinematic particle (forces do not move it)
+  std::vector<double> inv_inertia;  ///< 1/I, or 0 for a kinematic particle
   std::vector<std::uint16_t> material;
   std::vector<Motion> motion;
 
@@ -31,6 +33,8 @@ class ParticleStore {
   std::size_t add_sphere(const Vec3& position, double radius, double density, std::uint16_t material_id,
                          Motion motion = Motion::kFree);
   void reserve(std::size_t n);
+  /// Makes a particle kinematic or free again (updates its inverse mass and inertia).
+  void set_motion(std::size_t i, Motion m);
   /// Removes the particles whose flag is set (e.g. those above a cut height), keeping order.
   void remove_if(const std::vector<char>& flags);
 

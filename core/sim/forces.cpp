@@ -40,8 +40,8 @@ void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
   const auto& start = w.list.row_start;
   const auto& nbr = w.list.nbr;
   double* hist = w.pair_history.data();
-  const Domain& dom = w.domain;
-  const bool periodic = dom.any_periodic();
+  const MinimumImage image(w.domain);
+  const bool periodic = w.domain.any_periodic();
   const double dt = w.dt;
   const int threads = w.threads;
 
@@ -65,7 +65,7 @@ void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
       for (int k = start[i]; k < start[i + 1]; ++k) {
         const int j = nbr[k];
         double* h = hist + static_cast<std::ptrdiff_t>(k) * kStride;
-        const Vec3 d = periodic ? dom.separation(xi, p.x[j]) : p.x[j] - xi;
+        const Vec3 d = periodic ? image(p.x[j] - xi) : p.x[j] - xi;
         const double rj = p.radius[j];
         const double reach = ri + rj + range;
         const double dist2 = norm2(d);

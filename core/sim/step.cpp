@@ -16,15 +16,14 @@ void step(World& w) {
   const double half = 0.5 * w.dt;
 
   // 1. First half kick with the forces of the last step, then drift (velocity Verlet).
-  integrate::kick(w.particles, half, w.threads);
-  integrate::drift(w.particles, w.dt, w.threads);
+  integrate::kick_drift(w.particles, w.dt, w.threads);
 
   // 2. Walls move with their prescribed or controlled velocities.
   for (auto& wall : w.walls) walls::advance(wall, w.dt);
 
   // 3. Neighbour list: rebuilt only once some particle moved more than half the skin; the
   //    history of pairs still in range is carried to the new list.
-  if (w.list.needs_rebuild(w.particles.x, w.effective_skin())) {
+  if (w.list.needs_rebuild(w.particles.x, w.effective_skin(), w.threads)) {
     for (auto& x : w.particles.x) w.domain.wrap(x);
     w.list.build(w.particles.x, w.particles.radius, w.domain, w.interaction_range() + w.effective_skin(),
                  w.threads, w.pair_history, w.pair_stride());

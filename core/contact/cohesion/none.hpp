@@ -10,7 +10,7 @@ namespace demcal::contact::cohesion {
 struct None {
   static constexpr const char* kName = "none";
   static std::array<ParamInfo<None>, 0> table() { return {}; }
-  void validate(const std::string&) const {}
+  void finalize(const std::string&) {}
   double range() const { return 0.0; }
   double force(const PairInput&) const { return 0.0; }
 };

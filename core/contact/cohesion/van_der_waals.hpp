@@ -26,7 +26,7 @@ struct VanDerWaals {
              {"d_min", "m", 1e-12, 1.0, 4e-10, "minimum surface distance D_min", &VanDerWaals::d_min},
              {"d_max", "m", 1e-12, 1.0, kUnset, "cut-off surface distance D_max", &VanDerWaals::d_max}}};
   }
-  void validate(const std::string& where) const {
+  void finalize(const std::string& where) {
     if (!is_set(hamaker)) throw InputError(where + ".hamaker", "required");
     if (!is_set(d_max)) throw InputError(where + ".d_max", "required");
     if (d_max <= d_min) throw InputError(where + ".d_max", "must exceed d_min");

@@ -30,29 +30,28 @@ struct Hertz {
              {"clip_attraction", "0/1", 0, 1, 0, "set a net attractive force to zero",
               &Hertz::clip_attraction}}};
   }
-  void validate(const std::string& where) const {
+  void finalize(const std::string& where) {
     if (!is_set(youngs_modulus)) throw InputError(where + ".youngs_modulus", "required");
-  }
-  double y_star() const { return youngs_modulus / (2.0 * (1.0 - poisson_ratio * poisson_ratio)); }
-  double g_star() const {
-    return youngs_modulus / (4.0 * (2.0 - poisson_ratio) * (1.0 + poisson_ratio));
-  }
-  double beta() const {
+    y_star = youngs_modulus / (2.0 * (1.0 - poisson_ratio * poisson_ratio));
+    g_star = youngs_modulus / (4.0 * (2.0 - poisson_ratio) * (1.0 + poisson_ratio));
     const double l = std::log(restitution);
-    return l / std::sqrt(l * l + M_PI * M_PI);
+    const double beta = l / std::sqrt(l * l + M_PI * M_PI);
+    constexpr double kSqrtFiveSixths = 0.91287092917527685576;
+    damping_factor = -2.0 * kSqrtFiveSixths * beta * std::sqrt(2.0 * y_star);
   }
   /// Stiffness at an overlap of 1 % of the radius, used only for the sqrt(m/k) time-step check.
-  double max_stiffness(double r_eff) const { return 2.0 * y_star() * std::sqrt(0.5 * r_eff * 0.01 * r_eff); }
+  double max_stiffness(double r_eff) const { return 2.0 * y_star * std::sqrt(0.5 * r_eff * 0.01 * r_eff); }
+
+  // Derived by finalize(): Y*, G*, and -2 sqrt(5/6) beta sqrt(2 Y*) so that
+  // gamma_n = damping_factor sqrt(sqrt(R* delta) m*).
+  double y_star = 0.0, g_star = 0.0, damping_factor = 0.0;
 
   NormalResult force(const PairInput& in, double* /*history*/) const {
-    constexpr double kSqrtFiveSixths = 0.91287092917527685576;
     const double root = std::sqrt(in.r_star * in.delta);
-    const double ys = y_star();
-    const double s_n = 2.0 * ys * root;
     NormalResult r;
-    r.k_ref = 8.0 * g_star() * root;
-    r.gamma_n = -2.0 * kSqrtFiveSixths * beta() * std::sqrt(s_n * in.m_star);
-    r.fn = (4.0 / 3.0) * ys * root * in.delta + r.gamma_n * in.vn;
+    r.k_ref = 8.0 * g_star * root;
+    r.gamma_n = damping_factor * std::sqrt(root * in.m_star);
+    r.fn = (4.0 / 3.0) * y_star * root * in.delta + r.gamma_n * in.vn;
     if (clip_attraction != 0.0 && r.fn < 0.0) r.fn = 0.0;
     return r;
   }

@@ -31,7 +31,7 @@ struct Linear {
              {"clip_attraction", "0/1", 0, 1, 1, "set a net attractive force to zero",
               &Linear::clip_attraction}}};
   }
-  void validate(const std::string& where) const {
+  void finalize(const std::string& where) {
     if (!is_set(kn)) throw InputError(where + ".kn", "required");
   }
   double max_stiffness(double /*r_eff*/) const { return kn; }

@@ -48,7 +48,7 @@ struct Luding {
              {"restitution", "-", 1e-6, 1.0, 0.5, "coefficient of restitution e (eq. 7)",
               &Luding::restitution}}};
   }
-  void validate(const std::string& where) const {
+  void finalize(const std::string& where) {
     if (is_set(k1) == is_set(youngs_modulus))
       throw InputError(where, "give exactly one of 'k1' and 'youngs_modulus' (eq. 3)");
   }

@@ -20,7 +20,7 @@ struct Cdt {
   static std::array<ParamInfo<Cdt>, 1> table() {
     return {{{"mu_r", "-", 0.0, 10.0, kUnset, "rolling friction coefficient", &Cdt::mu_r}}};
   }
-  void validate(const std::string& where) const {
+  void finalize(const std::string& where) {
     if (!is_set(mu_r)) throw InputError(where + ".mu_r", "required");
   }
 

@@ -24,7 +24,7 @@ struct Epsd {
     return {{{"mu_r", "-", 0.0, 10.0, kUnset, "rolling friction coefficient", &Epsd::mu_r},
              {"kr_ratio", "-", 0.0, 10.0, 1.0, "rolling stiffness k_r / k_ref", &Epsd::kr_ratio}}};
   }
-  void validate(const std::string& where) const {
+  void finalize(const std::string& where) {
     if (!is_set(mu_r)) throw InputError(where + ".mu_r", "required");
   }
 

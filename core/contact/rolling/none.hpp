@@ -11,7 +11,7 @@ struct None {
   static constexpr const char* kName = "none";
   static constexpr int kHistory = 0;
   static std::array<ParamInfo<None>, 0> table() { return {}; }
-  void validate(const std::string&) const {}
+  void finalize(const std::string&) {}
   Vec3 torque(const PairInput&, const NormalResult&, double, double*) const { return {}; }
 };
 

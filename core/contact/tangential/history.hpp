@@ -31,7 +31,7 @@ struct History {
              {"mu_d_ratio", "-", 0.0, 1.0, 1.0, "f4 = mu_d / mu_s", &History::mu_d_ratio},
              {"gamma_t_ratio", "-", 0.0, 10.0, 0.0, "f5 = gamma_t / gamma_n", &History::gamma_t_ratio}}};
   }
-  void validate(const std::string& where) const {
+  void finalize(const std::string& where) {
     if (!is_set(mu_s)) throw InputError(where + ".mu_s", "required");
   }
 
