@@ -1,0 +1,259 @@
+#include "core/calib/calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/common/error.hpp"
+#include "core/doe/design.hpp"
+
+namespace demcal::calib {
+
+namespace {
+
+using Objective = std::function<double(const Eigen::VectorXd&)>;
+
+Eigen::VectorXd clamp_box(const Eigen::VectorXd& x) {
+  return x.cwiseMax(-1.0).cwiseMin(1.0);
+}
+
+/// Nelder-Mead with standard coefficients (reflection 1, expansion 2, contraction 0.5,
+/// shrink 0.5) on f(clamp(x)); returns the clamped best point.
+Eigen::VectorXd nelder_mead(const Objective& f, const Eigen::VectorXd& start, int max_iterations) {
+  const auto n = start.size();
+  std::vector<Eigen::VectorXd> simplex{clamp_box(start)};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Eigen::VectorXd v = simplex.front();
+    v(i) += v(i) > 0.0 ? -0.25 : 0.25;
+    simplex.push_back(v);
+  }
+  std::vector<double> values;
+  const auto g = [&](const Eigen::VectorXd& x) { return f(clamp_box(x)); };
+  for (const auto& v : simplex) values.push_back(g(v));
+  std::vector<std::size_t> idx(simplex.size());
+  for (int it = 0; it < max_iterations; ++it) {
+    for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+    std::sort(idx.begin(), idx.end(), [&](auto a, auto b) { return values[a] < values[b]; });
+    const std::size_t best = idx.front(), worst = idx.back(), second = idx[idx.size() - 2];
+    double spread = 0.0;
+    for (const auto& v : simplex)
+      spread = std::max(spread, (v - simplex[best]).cwiseAbs().maxCoeff());
+    if (spread < 1e-10 && values[worst] - values[best] <= 1e-15 * (1.0 + std::abs(values[best]))) {
+      break;
+    }
+    Eigen::VectorXd centroid = Eigen::VectorXd::Zero(n);
+    for (std::size_t i = 0; i < simplex.size(); ++i) {
+      if (i != worst) centroid += simplex[i];
+    }
+    centroid /= static_cast<double>(n);
+    const Eigen::VectorXd reflected = centroid + (centroid - simplex[worst]);
+    const double fr = g(reflected);
+    if (fr < values[best]) {
+      const Eigen::VectorXd expanded = centroid + 2.0 * (centroid - simplex[worst]);
+      const double fe = g(expanded);
+      simplex[worst] = fe < fr ? expanded : reflected;
+      values[worst] = std::min(fe, fr);
+    } else if (fr < values[second]) {
+      simplex[worst] = reflected;
+      values[worst] = fr;
+    } else {
+      const Eigen::VectorXd contracted = centroid + 0.5 * (simplex[worst] - centroid);
+      const double fc = g(contracted);
+      if (fc < values[worst]) {
+        simplex[worst] = contracted;
+        values[worst] = fc;
+      } else {
+        for (std::size_t i = 0; i < simplex.size(); ++i) {
+          if (i == best) continue;
+          simplex[i] = simplex[best] + 0.5 * (simplex[i] - simplex[best]);
+          values[i] = g(simplex[i]);
+        }
+      }
+    }
+    // Keep the simplex inside the box so it cannot drift along a flat projected direction.
+    for (std::size_t i = 0; i < simplex.size(); ++i) simplex[i] = clamp_box(simplex[i]);
+  }
+  const auto best = std::min_element(values.begin(), values.end()) - values.begin();
+  return clamp_box(simplex[std::size_t(best)]);
+}
+
+/// Minimises f over the box from the centre and a seeded Latin hypercube of starts.
+Eigen::VectorXd minimise(const Objective& f, int k, const CalibrationOptions& options) {
+  std::vector<Eigen::VectorXd> starts{Eigen::VectorXd::Zero(k)};
+  if (options.starts > 1) {
+    const doe::Design lhs = doe::latin_hypercube(k, std::max(2, options.starts - 1), options.seed);
+    for (int r = 0; r < lhs.runs(); ++r) starts.push_back(lhs.coded.row(r).transpose());
+  }
+  Eigen::VectorXd best;
+  double best_value = std::numeric_limits<double>::infinity();
+  for (const auto& s : starts) {
+    const Eigen::VectorXd x = nelder_mead(f, s, options.max_iterations);
+    if (const double v = f(x); v < best_value) {
+      best_value = v;
+      best = x;
+    }
+  }
+  return best;
+}
+
+bool has_squares(const doe::ModelFit& model) {
+  return std::any_of(model.terms.begin(), model.terms.end(),
+                     [](const doe::ModelTerm& t) { return t.squared; });
+}
+
+std::string number(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+double effective_weight(const MetricTarget& m) {
+  return m.uncertainty ? std::pow(m.target / *m.uncertainty, 2) : m.weight;
+}
+
+void validate(const CalibrationProblem& problem) {
+  if (problem.factors.empty()) throw InputError("factors", "no factors to calibrate");
+  if (problem.metrics.empty()) throw InputError("metrics", "no metrics to calibrate against");
+  for (const auto& f : problem.factors) f.validate();
+  for (const auto& m : problem.metrics) {
+    const std::string where = "metrics." + m.name;
+    if (m.model.factor_count != static_cast<int>(problem.factors.size())) {
+      throw InputError(where, "model has " + std::to_string(m.model.factor_count) +
+                                  " factors, the problem " +
+                                  std::to_string(problem.factors.size()));
+    }
+    if (!std::isfinite(m.target)) throw InputError(where + ".target", "must be finite");
+    if (m.uncertainty && !(*m.uncertainty > 0.0)) {
+      throw InputError(where + ".uncertainty", "must be positive");
+    }
+    if (!m.uncertainty && !(m.weight >= 0.0)) throw InputError(where + ".weight", "must be >= 0");
+    if (m.target == 0.0 && !m.uncertainty) {
+      throw InputError(where + ".target",
+                       "is 0: a relative error is undefined; give an "
+                       "uncertainty instead of a weight");
+    }
+  }
+}
+
+}  // namespace
+
+Envelope reachable_envelope(const doe::ModelFit& model, const CalibrationOptions& options) {
+  const int k = model.factor_count;
+  Envelope env;
+  env.min = std::numeric_limits<double>::infinity();
+  env.max = -env.min;
+  if (!has_squares(model) && k <= 16) {
+    // Without squares the model is multilinear: its extremes over a box sit on vertices.
+    env.exact = true;
+    for (std::uint32_t v = 0; v < (std::uint32_t{1} << k); ++v) {
+      Eigen::VectorXd x(k);
+      for (int i = 0; i < k; ++i) x(i) = (v >> i) & 1 ? 1.0 : -1.0;
+      const double y = model.predict(x);
+      if (y < env.min) {
+        env.min = y;
+        env.argmin = x;
+      }
+      if (y > env.max) {
+        env.max = y;
+        env.argmax = x;
+      }
+    }
+    return env;
+  }
+  env.argmin = minimise([&](const Eigen::VectorXd& x) { return model.predict(x); }, k, options);
+  env.argmax = minimise([&](const Eigen::VectorXd& x) { return -model.predict(x); }, k, options);
+  env.min = model.predict(env.argmin);
+  env.max = model.predict(env.argmax);
+  return env;
+}
+
+CalibrationResult calibrate(const CalibrationProblem& problem, const CalibrationOptions& options) {
+  validate(problem);
+  if (options.starts < 1) throw InputError("starts", "need at least one start");
+  const int k = static_cast<int>(problem.factors.size());
+  double total_weight = 0.0;
+  for (const auto& m : problem.metrics) total_weight += effective_weight(m);
+  if (!(total_weight > 0.0)) throw InputError("metrics", "all weights are zero");
+  const Objective objective = [&](const Eigen::VectorXd& x) {
+    double j = 0.0;
+    for (const auto& m : problem.metrics) {
+      const double scale = m.uncertainty ? *m.uncertainty : std::abs(m.target);
+      const double r = (m.model.predict(x) - m.target) / scale;
+      j += (m.uncertainty ? 1.0 : m.weight) * r * r;
+    }
+    return j / total_weight;
+  };
+  CalibrationResult out;
+  out.coded = minimise(objective, k, options);
+  out.objective = objective(out.coded);
+  out.natural.resize(k);
+  for (int i = 0; i < k; ++i)
+    out.natural(i) = problem.factors[std::size_t(i)].to_natural(out.coded(i));
+  for (const auto& m : problem.metrics) {
+    MetricOutcome o;
+    o.name = m.name;
+    o.target = m.target;
+    o.predicted = m.model.predict(out.coded);
+    o.relative_error =
+        m.target != 0.0 ? (o.predicted - m.target) / std::abs(m.target) : std::nan("");
+    o.envelope = reachable_envelope(m.model, options);
+    const std::string range = "[" + number(o.envelope.min) + ", " + number(o.envelope.max) + "]";
+    if (m.target > o.envelope.max) {
+      o.reachable = false;
+      o.statement = "target " + number(m.target) + " of " + m.name +
+                    " lies above the largest value reachable in the box, " +
+                    number(o.envelope.max) + ": unreachable with these factor ranges";
+    } else if (m.target < o.envelope.min) {
+      o.reachable = false;
+      o.statement = "target " + number(m.target) + " of " + m.name +
+                    " lies below the smallest value reachable in the box, " +
+                    number(o.envelope.min) + ": unreachable with these factor ranges";
+    } else {
+      o.statement = "target " + number(m.target) + " of " + m.name + " is within reach " + range;
+    }
+    out.metrics.push_back(o);
+  }
+  return out;
+}
+
+std::vector<doe::Factor> narrow_box(const std::vector<doe::Factor>& factors,
+                                    const Eigen::VectorXd& natural_optimum, double percent) {
+  if (!(percent > 0.0 && percent < 100.0)) {
+    throw InputError("percent", "range narrowing needs 0 < percent < 100, got " + number(percent));
+  }
+  if (natural_optimum.size() != static_cast<Eigen::Index>(factors.size())) {
+    throw InputError("optimum", "one value per factor needed");
+  }
+  std::vector<doe::Factor> out = factors;
+  for (std::size_t i = 0; i < factors.size(); ++i) {
+    const double v = natural_optimum(Eigen::Index(i));
+    if (v == 0.0) {
+      throw InputError("factor " + factors[i].name,
+                       "optimum is 0: a box of +-" + number(percent) + " % around it is empty");
+    }
+    const double a = v * (1.0 - percent / 100.0), b = v * (1.0 + percent / 100.0);
+    out[i].low = std::min(a, b);
+    out[i].high = std::max(a, b);
+    out[i].validate();
+  }
+  return out;
+}
+
+std::vector<NarrowingRound> calibrate_iteratively(
+    std::vector<doe::Factor> box,
+    const std::function<std::vector<MetricTarget>(const std::vector<doe::Factor>&)>& fit_in_box,
+    int rounds, double percent, double shrink, const CalibrationOptions& options) {
+  if (rounds < 1) throw InputError("rounds", "need at least one round");
+  if (!(shrink > 0.0 && shrink <= 1.0)) throw InputError("shrink", "must lie in (0, 1]");
+  std::vector<NarrowingRound> out;
+  for (int r = 0; r < rounds; ++r) {
+    CalibrationProblem problem{box, fit_in_box(box)};
+    NarrowingRound round{box, calibrate(problem, options)};
+    box = narrow_box(box, round.result.natural, percent * std::pow(shrink, r));
+    out.push_back(std::move(round));
+  }
+  return out;
+}
+
+}  // namespace demcal::calib

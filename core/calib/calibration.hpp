@@ -1,0 +1,89 @@
+#pragma once
+// Calibration against measured metrics with fitted response models (seed 000 §2.5.2 "with
+// these equations an optimisation of input parameters shall be done"; §3.3 for the range
+// narrowing). The objective is the weighted mean squared relative error
+//   J(x) = sum_m w_m ((yhat_m(x) - t_m) / |t_m|)^2 / sum_m w_m ,
+// where a metric given with an uncertainty s_m uses w_m = (t_m / s_m)^2, so that its term is
+// ((yhat_m - t_m) / s_m)^2. J is minimised over the factor box in coded units by Nelder-Mead
+// (Nelder and Mead 1965) on the box-projected point, from the centre and from the points of
+// a seeded maximin Latin hypercube: the result is deterministic for a seed.
+#include <Eigen/Dense>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/doe/factor.hpp"
+#include "core/doe/model_fit.hpp"
+
+namespace demcal::calib {
+
+struct MetricTarget {
+  std::string name;
+  doe::ModelFit model;  ///< fitted in the coded units of the problem's factor box
+  double target = 0.0;
+  double weight = 1.0;
+  std::optional<double> uncertainty;
+};
+
+struct CalibrationProblem {
+  std::vector<doe::Factor> factors;
+  std::vector<MetricTarget> metrics;
+};
+
+struct CalibrationOptions {
+  int starts = 16;
+  std::uint64_t seed = 1;
+  int max_iterations = 4000;
+};
+
+/// The smallest and largest value a model reaches over the box [-1, 1]^k.
+struct Envelope {
+  double min = 0.0, max = 0.0;
+  Eigen::VectorXd argmin, argmax;  ///< coded
+  bool exact = false;  ///< vertex enumeration of a multilinear model (else multi-start search)
+};
+
+struct MetricOutcome {
+  std::string name;
+  double target = 0.0;
+  double predicted = 0.0;
+  double relative_error = 0.0;  ///< (predicted - target) / |target|
+  Envelope envelope;
+  bool reachable = true;
+  std::string statement;  ///< plain words: within reach, or above/below what the box reaches
+};
+
+struct CalibrationResult {
+  Eigen::VectorXd coded;
+  Eigen::VectorXd natural;
+  double objective = 0.0;
+  std::vector<MetricOutcome> metrics;
+};
+
+/// Checks the problem (names the offending metric or factor) and solves it.
+CalibrationResult calibrate(const CalibrationProblem& problem, const CalibrationOptions& options);
+
+/// Envelope of one model over the box; `options` seeds the search for models with squares.
+Envelope reachable_envelope(const doe::ModelFit& model, const CalibrationOptions& options);
+
+/// Seed 000 §3.3: a new box of +-percent around the optimum (natural units), per factor.
+std::vector<doe::Factor> narrow_box(const std::vector<doe::Factor>& factors,
+                                    const Eigen::VectorXd& natural_optimum, double percent);
+
+/// One round of iterative narrowing: the box it used and the calibration found in it.
+struct NarrowingRound {
+  std::vector<doe::Factor> box;
+  CalibrationResult result;
+};
+
+/// Fits new models in each box (the callback runs the designed simulations and fits them),
+/// calibrates, and narrows the box around the optimum, `rounds` times. A box of a fixed
+/// +-x % never gets smaller than x % of the optimum, so round r uses percent * shrink^r.
+std::vector<NarrowingRound> calibrate_iteratively(
+    std::vector<doe::Factor> box,
+    const std::function<std::vector<MetricTarget>(const std::vector<doe::Factor>&)>& fit_in_box,
+    int rounds, double percent, double shrink, const CalibrationOptions& options);
+
+}  // namespace demcal::calib
