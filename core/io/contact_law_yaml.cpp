@@ -1,5 +1,9 @@
 #include "core/io/contact_law_yaml.hpp"
 
+#include <algorithm>
+
+#include "core/common/error.hpp"
+
 namespace demcal::io {
 namespace {
 
@@ -24,7 +28,28 @@ contact::ContactLawSpec read_contact_law_spec(const YamlNode& node) {
 }
 
 contact::ContactLaw read_contact_law(const YamlNode& node) {
-  return contact::ContactLaw::from_spec(read_contact_law_spec(node), node.where());
+  const contact::ContactLawSpec spec = read_contact_law_spec(node);
+  const std::string base = node.path().empty() ? "contact_law" : node.path();
+  try {
+    return contact::ContactLaw::from_spec(spec, base);
+  } catch (const InputError& e) {
+    // from_spec names the bad field by its path below `base` ("contact_law.normal.k2_ratio");
+    // report the line of that field (or of its deepest existing parent), not of the section.
+    if (e.where().rfind(base, 0) != 0) throw;
+    const std::string rest = e.where().substr(base.size());
+    YamlNode at = node;
+    std::size_t pos = 0;
+    while (pos < rest.size() && rest[pos] == '.') {
+      const std::size_t next = std::min(rest.find('.', pos + 1), rest.size());
+      const auto child = at.child(rest.substr(pos + 1, next - pos - 1));
+      if (!child) break;
+      at = *child;
+      pos = next;
+    }
+    std::string what = e.what();
+    if (what.rfind(e.where() + ": ", 0) == 0) what = what.substr(e.where().size() + 2);
+    throw InputError(at.where() + rest.substr(pos), what);
+  }
 }
 
 }  // namespace demcal::io

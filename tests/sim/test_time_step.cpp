@@ -1,0 +1,101 @@
+// The time-step bound of a world (issue 2 §3): the Rayleigh time for Hertz laws (seed 000 eq. 1),
+// sqrt(m/k) for linear and Luding laws (seed 001 eq. 14), and a step above it is an error that
+// names both numbers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "core/common/error.hpp"
+#include "core/sim/step.hpp"
+#include "core/sim/time_step.hpp"
+
+namespace demcal {
+namespace {
+
+contact::ContactLaw law(contact::SlotSpec normal) {
+  contact::ContactLawSpec s;
+  s.normal = std::move(normal);
+  s.tangential = {"history", {{"mu_s", 0.5}}};
+  return contact::ContactLaw::from_spec(s, "law");
+}
+
+/// Two resting spheres (radii 1 mm and 2 mm, density 2500) above a plane floor.
+sim::World two_spheres(const contact::ContactLaw& pair, const contact::ContactLaw& wall) {
+  sim::World w;
+  w.set_pair_law(0, 0, pair);
+  w.set_wall_law(0, 0, wall);
+  w.walls.push_back({.name = "floor", .shape = walls::Plane{{0, 0, 0}, {0, 0, 1}}});
+  w.particles.add_sphere({0, 0, 0.01}, 0.001, 2500, 0);
+  w.particles.add_sphere({0.01, 0, 0.01}, 0.002, 2500, 0);
+  return w;
+}
+
+std::string g4(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+TEST(SimTimeStep, HertzBoundIsTheRayleighTimeOfTheSmallestSphere) {
+  const double y = 1e7, nu = 0.3, rho = 2500, r = 0.001;
+  const auto hertz = law({"hertz", {{"youngs_modulus", y}, {"poisson_ratio", nu}}});
+  const sim::World w = two_spheres(hertz, hertz);
+  // Seed 000 eq. 1: T_R = pi R sqrt(rho / G) / (0.163 nu + 0.8766), G = Y / (2 (1 + nu)).
+  const double g = y / (2.0 * (1.0 + nu));
+  const double expected = M_PI * r * std::sqrt(rho / g) / (0.163 * nu + 0.8766);
+  const auto limit = sim::critical_time_step(w);
+  EXPECT_NEAR(limit.critical, expected, 1e-12 * expected);
+  EXPECT_NEAR(limit.critical, 8.6543e-5, 1e-9);  // the number itself, for this Y, nu, rho, R
+  EXPECT_NE(limit.basis.find("Rayleigh"), std::string::npos) << limit.basis;
+  EXPECT_NEAR(sim::recommended_time_step(w, 0.2), 0.2 * expected, 1e-12 * expected);
+}
+
+TEST(SimTimeStep, LinearBoundIsSqrtOfLightestMassOverStiffestSpring) {
+  const auto pair = law({"linear", {{"kn", 1e4}}});
+  const auto wall = law({"linear", {{"kn", 3e4}}});  // seed 000/001 use stiffer walls
+  const sim::World w = two_spheres(pair, wall);
+  const double m_light = 2500 * 4.0 / 3.0 * M_PI * 1e-9;
+  const double expected = std::sqrt(m_light / 3e4);  // seed 001 eq. 14
+  const auto limit = sim::critical_time_step(w);
+  EXPECT_NEAR(limit.critical, expected, 1e-12 * expected);
+  EXPECT_NE(limit.basis.find("sqrt(m/k)"), std::string::npos) << limit.basis;
+  EXPECT_NE(limit.basis.find("wall"), std::string::npos) << limit.basis;
+}
+
+TEST(SimTimeStep, LudingBoundUsesTheUnloadingStiffness) {
+  const auto luding = law({"luding", {{"k1", 1e4}, {"k2_ratio", 5.0}}});
+  const sim::World w = two_spheres(luding, luding);
+  const double m_light = 2500 * 4.0 / 3.0 * M_PI * 1e-9;
+  EXPECT_NEAR(sim::critical_time_step(w).critical, std::sqrt(m_light / 5e4),
+              1e-12 * std::sqrt(m_light / 5e4));
+}
+
+TEST(SimTimeStep, StepAboveTheLimitThrowsNamingBothNumbers) {
+  const auto pair = law({"linear", {{"kn", 1e4}, {"damping_ratio", 0.3}}});
+  sim::World w = two_spheres(pair, pair);
+  const double critical = sim::critical_time_step(w).critical;
+  w.dt = 1.01 * critical;
+  try {
+    sim::step(w);
+    FAIL() << "a time step above the stability limit was accepted";
+  } catch (const SimulationFailure& e) {
+    EXPECT_EQ(e.reason(), SimulationFailure::Reason::kUnstableTimeStep);
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(g4(w.dt)), std::string::npos) << msg;
+    EXPECT_NE(msg.find(g4(critical)), std::string::npos) << msg;
+  }
+  EXPECT_EQ(w.step_count, 0);
+
+  w.dt = 0.0;
+  EXPECT_THROW(sim::step(w), SimulationFailure);
+
+  // Just below the limit the world runs.
+  w.dt = 0.99 * critical;
+  EXPECT_NO_THROW(sim::run(w, 10));
+  EXPECT_EQ(w.step_count, 10);
+}
+
+}  // namespace
+}  // namespace demcal
