@@ -9,6 +9,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   demcal::cli::add_contact_command(app);
   demcal::cli::add_simulate_command(app);
+  demcal::cli::add_models_command(app);
   demcal::cli::add_design_command(app);
   demcal::cli::add_analyze_command(app);
   try {
