@@ -65,6 +65,7 @@ class Search {
   }
 
   GeneratorChoice run() {
+    seed_with_greedy();
     // Permuting base factors maps any design onto one whose first (longest) generator is the
     // first candidate of its length, so only those open the search.
     for (std::size_t c = 0; c < candidates_.size(); ++c) {
@@ -82,6 +83,51 @@ class Search {
   }
 
  private:
+  /// A first bound from a greedy choice (each added generator the one that keeps the
+  /// pattern smallest): without it a truncated search of a large case can end in the
+  /// first subtree it happens to open.
+  void seed_with_greedy() {
+    std::vector<bool> used(candidates_.size(), false);
+    for (int depth = 0; depth < p_; ++depth) {
+      std::size_t pick = candidates_.size();
+      std::vector<int> pick_counts;
+      for (std::size_t c = 0; c < candidates_.size(); ++c) {
+        if (used[c]) continue;
+        push(c, depth);
+        if (pick == candidates_.size() ||
+            compare_word_length_patterns(pattern(counts_), pattern(pick_counts)) < 0) {
+          pick = c;
+          pick_counts = counts_;
+        }
+        pop();
+      }
+      used[pick] = true;
+      push(pick, depth);
+    }
+    best_ = chosen_;
+    best_counts_ = counts_;
+    best_clear_ = clear_count();
+    for (int depth = 0; depth < p_; ++depth) pop();
+  }
+
+  void push(std::size_t c, int depth) {
+    const Word gen = candidates_[c] | (Word{1} << (m_ + depth));
+    const std::size_t n = group_.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Word w = group_[i] ^ gen;
+      group_.push_back(w);
+      ++counts_[std::size_t(word_length(w))];
+    }
+    chosen_.push_back(candidates_[c]);
+  }
+
+  void pop() {
+    const std::size_t n = group_.size() / 2;
+    for (std::size_t i = n; i < group_.size(); ++i) --counts_[std::size_t(word_length(group_[i]))];
+    group_.resize(n);
+    chosen_.pop_back();
+  }
+
   std::vector<int> pattern(const std::vector<int>& counts) const {
     return {counts.begin() + 3, counts.end()};
   }
@@ -106,14 +152,7 @@ class Search {
       exhausted_ = true;
       return;
     }
-    const Word gen = candidates_[c] | (Word{1} << (m_ + depth));
-    const std::size_t n = group_.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      const Word w = group_[i] ^ gen;
-      group_.push_back(w);
-      ++counts_[std::size_t(word_length(w))];
-    }
-    chosen_.push_back(candidates_[c]);
+    push(c, depth);
     const bool leaf = depth + 1 == p_;
     const int cmp =
         best_.empty() ? -1 : compare_word_length_patterns(pattern(counts_), pattern(best_counts_));
@@ -134,9 +173,7 @@ class Search {
         if (exhausted_) break;
       }
     }
-    chosen_.pop_back();
-    for (std::size_t i = n; i < group_.size(); ++i) --counts_[std::size_t(word_length(group_[i]))];
-    group_.resize(n);
+    pop();
   }
 
   int k_, m_, p_;
