@@ -14,6 +14,14 @@
 namespace demcal {
 namespace {
 
+walls::Wall wall_of(std::string name, walls::Shape shape, std::uint16_t material = 0) {
+  walls::Wall w;
+  w.name = std::move(name);
+  w.shape = shape;
+  w.material = material;
+  return w;
+}
+
 constexpr double kG = 9.81;
 
 contact::ContactLaw linear_law(double kn, double mu_s, double mu_r) {
@@ -31,15 +39,13 @@ TEST(SimWalls, SettledBedFloorCarriesTheWeightAndMovingLidMovesVt) {
   w.set_wall_law(0, 0, linear_law(1e3, 0.5, 0.1));  // floor: frictional
   w.set_wall_law(1, 0, linear_law(1e3, 0.0, 0.0));  // cylinder: frictionless, so no Janssen arching
   const double rc = 0.008;
-  w.walls.push_back({.name = "floor", .shape = walls::Plane{{0, 0, 0}, {0, 0, 1}}});
-  w.walls.push_back(
-      {.name = "cylinder", .shape = walls::Cylinder{{0, 0, 0}, {0, 0, 1}, rc}, .material = 1});
+  w.walls.push_back(wall_of("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}));
+  w.walls.push_back(wall_of("cylinder", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, rc}, 1));
   // A lid far above the bed, moving up: it never touches a sphere.
   const Vec3 lid_velocity{0.003, -0.002, 0.1};
-  w.walls.push_back({.name = "lid",
-                     .shape = walls::Plane{{0, 0, 0.06}, {0, 0, -1}},
-                     .velocity = lid_velocity,
-                     .pivot = {0, 0, 0.06}});
+  w.walls.push_back(wall_of("lid", walls::Plane{{0, 0, 0.06}, {0, 0, -1}}));
+  w.walls.back().velocity = lid_velocity;
+  w.walls.back().pivot = {0, 0, 0.06};
   Rng rng(99);
   particles::InsertRequest req;
   req.region = particles::CylinderRegion{{0, 0, 0}, rc, 0.0, 0.04};
@@ -107,10 +113,8 @@ TEST(SimWalls, RotatingFloorReportsTorqueAboutItsPivot) {
   const auto i = w.particles.add_sphere({d, 0, 0}, r, 2500, 0);
   const double m = w.particles.mass[i];
   w.particles.x[i].z = r - m * kG / kn;  // at its equilibrium overlap
-  w.walls.push_back({.name = "turntable",
-                     .shape = walls::Plane{{0, 0, 0}, {0, 0, 1}},
-                     .omega = {0, 0, 2.0},
-                     .pivot = {0, 0, 0}});
+  w.walls.push_back(wall_of("turntable", walls::Plane{{0, 0, 0}, {0, 0, 1}}));
+  w.walls.back().omega = {0, 0, 2.0};  // pivot: the origin
   w.dt = sim::recommended_time_step(w, 0.2);
   sim::run(w, 20);
   const auto& wall = w.walls[0];
