@@ -91,7 +91,9 @@ TEST(Analysis, AliasedInteractionsCarryTheirWholeChain) {
   EXPECT_EQ(res.fit.terms.size(), 27u);  // 12 mains + 15 chains
   bool found = false;
   for (const auto& t : res.fit.terms) {
-    if (t.order() == 2) EXPECT_GE(t.chain.size(), 4u) << t.name();
+    if (t.order() == 2) {
+      EXPECT_GE(t.chain.size(), 4u) << t.name();
+    }
     if (t.name() == "AB=CF=DG=EK=HJ") {
       found = true;
       EXPECT_NEAR(res.fit.coefficients(&t - &res.fit.terms[0]), 0.5, 1e-12);
@@ -121,10 +123,12 @@ TEST(Analysis, FailedRunIsReportedAndTheFitUsesTheRest) {
   EXPECT_EQ(res.balance.level_counts[0][2], 15);
   EXPECT_EQ(res.fit.rows_used.size(), 32u);
   for (std::size_t t = 0; t < res.fit.terms.size(); ++t) {
-    if (res.fit.terms[t].name() == "B")
+    if (res.fit.terms[t].name() == "B") {
       EXPECT_NEAR(res.fit.coefficients(Eigen::Index(t)), 1.2, 0.1);
-    if (res.fit.terms[t].name() == "EH")
+    }
+    if (res.fit.terms[t].name() == "EH") {
       EXPECT_NEAR(res.fit.coefficients(Eigen::Index(t)), -0.7, 0.1);
+    }
   }
 }
 
@@ -153,8 +157,12 @@ TEST(Analysis, CurvatureAnovaAndPureErrorOnAReplicatedDesign) {
       has_pure = true;
       EXPECT_DOUBLE_EQ(row.df, 11.0);
     }
-    if (row.source == "A") EXPECT_LT(*row.p, 1e-6);
-    if (row.source == "C") EXPECT_GT(*row.p, 1e-3);
+    if (row.source == "A") {
+      EXPECT_LT(*row.p, 1e-6);
+    }
+    if (row.source == "C") {
+      EXPECT_GT(*row.p, 1e-3);
+    }
   }
   EXPECT_TRUE(has_curvature);
   EXPECT_TRUE(has_pure);
@@ -201,8 +209,9 @@ TEST(Designs, LatinHypercubeIsLatinSeededAndSpread) {
   for (int c = 0; c < 3; ++c) {
     std::vector<double> col(a.coded.col(c).data(), a.coded.col(c).data() + 10);
     std::sort(col.begin(), col.end());
-    for (int i = 0; i < 10; ++i)
+    for (int i = 0; i < 10; ++i) {
       EXPECT_NEAR(col[std::size_t(i)], -1.0 + (2.0 * i + 1.0) / 10.0, 1e-12);
+    }
   }
   EXPECT_GT(min_pairwise_distance(a.coded), 0.5);
 }
@@ -217,7 +226,9 @@ TEST(Designs, RunOrderIsSeededAndStandardOrderKept) {
   EXPECT_TRUE(d.coded.isApprox(before));
   std::vector<int> sorted = d.run_order;
   std::sort(sorted.begin(), sorted.end());
-  for (int i = 0; i < 16; ++i) EXPECT_EQ(sorted[std::size_t(i)], i + 1);
+  for (int i = 0; i < 16; ++i) {
+    EXPECT_EQ(sorted[std::size_t(i)], i + 1);
+  }
   EXPECT_NE(d.run_order[0] + d.run_order[1] * 100, 1 + 200);
 }
 
