@@ -6,12 +6,11 @@
 namespace demcal::sim {
 
 void step(World& w) {
-  if (!w.prepared() || w.list.row_start.size() != w.particles.size() + 1) {
-    // A new or changed world: build its state and its forces, so the first kick below uses the
-    // forces of the initial configuration (as LIGGGHTS' setup does).
+  if (!w.prepared() || w.list.row_start.size() != w.particles.size() + 1 ||
+      w.wall_history.size() != w.walls.size()) {
+    // A new or changed world: build its state and its forces (prepare() computes them), so the
+    // first kick below uses the forces of the initial configuration (as LIGGGHTS' setup does).
     w.prepare();
-    compute_pair_forces(w);
-    compute_wall_forces(w);
   }
   const double half = 0.5 * w.dt;
 

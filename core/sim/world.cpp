@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/common/error.hpp"
+#include "core/sim/forces.hpp"
 #include "core/sim/time_step.hpp"
 
 namespace demcal::sim {
@@ -108,6 +109,10 @@ void World::prepare() {
   thread_force.assign(buffers, std::vector<Vec3>(particles.size()));
   thread_torque.assign(buffers, std::vector<Vec3>(particles.size()));
   prepared_ = true;
+  // The forces of this configuration, for the first half kick of the next step: step() relies on
+  // them whether it called prepare() itself or the caller did.
+  compute_pair_forces(*this);
+  compute_wall_forces(*this);
 }
 
 void World::remove_particles(const std::vector<char>& flags) {
