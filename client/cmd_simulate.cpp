@@ -39,7 +39,7 @@ void run_simulate(const SimulateOptions& opt) {
         {{"name", phase.name},
          {"steps", phase.steps},
          {"wall_seconds", seconds},
-         {"particle_steps_per_second", static_cast<double>(w.particles.size()) * phase.steps / seconds}});
+         {"particle_steps_per_second", static_cast<double>(w.particles.size()) * static_cast<double>(phase.steps) / seconds}});
   }
   report["metrics"] = {{"kinetic_energy", w.particles.kinetic_energy()},
                        {"coordination_number", metrics::coordination_number(w)},

@@ -4,7 +4,9 @@ add_library(demcal_warnings INTERFACE)
 target_compile_options(demcal_warnings INTERFACE -Wall -Wextra -Wpedantic -Wshadow -Wconversion
   -Wno-sign-conversion)
 if(DEMCAL_NATIVE AND NOT DEMCAL_SANITIZE)
-  target_compile_options(demcal_warnings INTERFACE -march=native)
+  # GCC 12 reports false -Wmaybe-uninitialized positives inside Eigen's AVX-512 kernels, which
+  # -march=native enables on this hardware.
+  target_compile_options(demcal_warnings INTERFACE -march=native -Wno-maybe-uninitialized)
 endif()
 if(DEMCAL_SANITIZE)
   target_compile_options(demcal_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer)
