@@ -45,19 +45,24 @@ void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
   const double dt = w.dt;
   const int threads = w.threads;
 
+  if (static_cast<int>(w.deferred.size()) != threads) w.deferred.assign(threads, {});
+
+  // Each thread owns a contiguous range of particles and evaluates the pairs of its rows. A pair
+  // force on a partner j inside the own range is added directly; one on a partner owned by a
+  // later thread is deferred and added after the loop, in thread order. No two threads write the
+  // same particle, and the order of every sum is fixed for a given thread count.
 #pragma omp parallel num_threads(threads)
   {
     const int tid = omp_get_thread_num();
-    Vec3* force = threads > 1 ? w.thread_force[tid].data() : p.f.data();
-    Vec3* torque = threads > 1 ? w.thread_torque[tid].data() : p.torque.data();
-    if (threads == 1) {
-      for (int i = 0; i < n; ++i) {
-        force[i] = w.gravity * p.mass[i];
-        torque[i] = {};
-      }
+    const int lo = static_cast<int>(static_cast<long>(n) * tid / threads);
+    const int hi = static_cast<int>(static_cast<long>(n) * (tid + 1) / threads);
+    auto& deferred = w.deferred[tid];
+    deferred.clear();
+    for (int i = lo; i < hi; ++i) {
+      p.f[i] = w.gravity * p.mass[i];
+      p.torque[i] = {};
     }
-#pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
+    for (int i = lo; i < hi; ++i) {
       const Vec3 xi = p.x[i], vi = p.v[i], wi = p.omega[i];
       const double ri = p.radius[i], mi = p.mass[i];
       const Law* law_row = &laws[p.material[i] * n_mat];
@@ -75,7 +80,7 @@ void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
         }
         const double dist = std::sqrt(dist2);
         contact::PairInput in;
-        in.n = d / dist;
+        in.n = d * (1.0 / dist);
         in.delta = ri + rj - dist;
         in.r_i = ri;
         in.r_j = rj;
@@ -89,27 +94,23 @@ void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
         const contact::PairOutput out = law_row[p.material[j]].evaluate(in, h);
         fi += out.force;
         ti += out.torque_i;
-        force[j] -= out.force;
-        torque[j] += out.torque_j;
-      }
-      force[i] += fi;
-      torque[i] += ti;
-    }
-    if (threads > 1) {
-      // Sum the thread buffers in thread order (fixed), then clear them for the next step.
-#pragma omp for schedule(static)
-      for (int i = 0; i < n; ++i) {
-        Vec3 f = w.gravity * p.mass[i], t{};
-        for (int b = 0; b < threads; ++b) {
-          f += w.thread_force[b][i];
-          t += w.thread_torque[b][i];
-          w.thread_force[b][i] = {};
-          w.thread_torque[b][i] = {};
+        if (j < hi) {
+          p.f[j] -= out.force;
+          p.torque[j] += out.torque_j;
+        } else {
+          deferred.push_back({j, -out.force, out.torque_j});
         }
-        p.f[i] = f;
-        p.torque[i] = t;
       }
+      p.f[i] += fi;
+      p.torque[i] += ti;
     }
+#pragma omp barrier
+    for (int b = 0; b < tid; ++b)
+      for (const auto& c : w.deferred[b])
+        if (c.particle >= lo && c.particle < hi) {
+          p.f[c.particle] += c.force;
+          p.torque[c.particle] += c.torque;
+        }
   }
 }
 

@@ -5,8 +5,7 @@
 namespace demcal::sim {
 
 /// Sets every particle's force to m g plus its pair contact forces, and its torque to the pair
-/// torques. Deterministic for a given thread count: each thread sums into its own buffer and the
-/// buffers are added in thread order.
+/// torques. Deterministic for a given thread count (see the owner ranges in forces.cpp).
 void compute_pair_forces(World& world);
 
 /// Adds particle-wall contact forces to the particles and stores each wall's force and torque.

@@ -105,9 +105,6 @@ void World::prepare() {
   wall_history.assign(walls.size(), {});
   for (std::size_t w = 0; w < walls.size(); ++w)
     wall_history[w].assign(particles.size() * wall_strides_[w], 0.0);
-  const int buffers = threads > 1 ? threads : 0;
-  thread_force.assign(buffers, std::vector<Vec3>(particles.size()));
-  thread_torque.assign(buffers, std::vector<Vec3>(particles.size()));
   prepared_ = true;
   // The forces of this configuration, for the first half kick of the next step: step() relies on
   // them whether it called prepare() itself or the caller did.

@@ -48,7 +48,12 @@ class World {
   neighbour::VerletList list;
   std::vector<double> pair_history;               ///< history_stride() doubles per listed pair
   std::vector<std::vector<double>> wall_history;  ///< per wall: particles * wall_stride
-  std::vector<std::vector<Vec3>> thread_force, thread_torque;
+  /// A pair force on a particle owned by another thread, added after the pair loop.
+  struct DeferredForce {
+    int particle;
+    Vec3 force, torque;
+  };
+  std::vector<std::vector<DeferredForce>> deferred;  ///< per thread
   int pair_stride() const { return pair_stride_; }
   int wall_stride(std::size_t wall) const { return wall_strides_[wall]; }
   double effective_skin() const { return skin_; }
