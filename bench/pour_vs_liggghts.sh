@@ -22,8 +22,10 @@ demcal_rate=$("$demcal" simulate "$work/pour.yaml" --threads 2 |
 
 cp "$peers/in.bench_pour" "$work/"
 (cd "$work" && script -qc "mpirun --allow-run-as-root --oversubscribe -np 2 liggghts -in in.bench_pour -var cdt 1 -var nbench $nbench" /dev/null > liggghts.log 2>&1)
-loop=$(grep "Loop time of" "$work/liggghts.log" | tail -n 1 | awk '{print $4}')
-natoms=$(grep "Loop time of" "$work/liggghts.log" | tail -n 1 | awk '{print $(NF-1)}')
+# "Loop time of T on P procs for S steps with N atoms[, finish time ...]" of the timed run
+last=$(grep "Loop time of" "$work/liggghts.log" | tail -n 1)
+loop=$(sed -E 's/.*Loop time of ([0-9.eE+-]+) on .*/\1/' <<<"$last")
+natoms=$(sed -E 's/.* with ([0-9]+) atoms.*/\1/' <<<"$last")
 [ -n "$loop" ] || { echo "LIGGGHTS run failed:"; tail -20 "$work/liggghts.log"; exit 1; }
 liggghts_rate=$(python3 -c "print($natoms * $nbench / $loop)")
 
