@@ -8,28 +8,28 @@
 namespace demcal::io {
 namespace {
 
-walls::Wall read_wall(const YamlNode& n) {
-  n.expect_only({"name", "plane", "cylinder", "disk", "velocity", "angular_velocity", "pivot"});
-  walls::Wall w;
-  w.name = n["name"].as_string();
+walls::Shape read_shape(const YamlNode& n) {
   if (auto p = n.child("plane")) {
     p->expect_only({"point", "normal"});
-    w.shape = walls::Plane{(*p)["point"].as_vec3(), normalized((*p)["normal"].as_vec3())};
-    w.pivot = (*p)["point"].as_vec3();
-  } else if (auto c = n.child("cylinder")) {
+    return walls::Plane{(*p)["point"].as_vec3(), normalized((*p)["normal"].as_vec3())};
+  }
+  if (auto c = n.child("cylinder")) {
     c->expect_only({"point", "axis", "radius", "lo", "hi"});
     walls::Cylinder cyl{(*c)["point"].as_vec3(), normalized((*c)["axis"].as_vec3()), (*c)["radius"].as_number()};
     cyl.lo = c->number("lo", -walls::kInfinity);
     cyl.hi = c->number("hi", walls::kInfinity);
-    w.shape = cyl;
-    w.pivot = cyl.point;
-  } else if (auto d = n.child("disk")) {
-    d->expect_only({"centre", "normal", "radius"});
-    w.shape = walls::Disk{(*d)["centre"].as_vec3(), normalized((*d)["normal"].as_vec3()), (*d)["radius"].as_number()};
-    w.pivot = (*d)["centre"].as_vec3();
-  } else {
-    n.fail("a wall needs one of: plane, cylinder, disk");
+    return cyl;
   }
+  if (auto d = n.child("disk")) {
+    d->expect_only({"centre", "normal", "radius"});
+    return walls::Disk{(*d)["centre"].as_vec3(), normalized((*d)["normal"].as_vec3()), (*d)["radius"].as_number()};
+  }
+  n.fail("a wall needs one of: plane, cylinder, disk");
+}
+
+walls::Wall read_wall(const YamlNode& n) {
+  n.expect_only({"name", "plane", "cylinder", "disk", "velocity", "angular_velocity", "pivot"});
+  walls::Wall w = walls::make_wall(n["name"].as_string(), read_shape(n));
   if (auto v = n.child("velocity")) w.velocity = v->as_vec3();
   if (auto o = n.child("angular_velocity")) w.omega = o->as_vec3();
   if (auto p = n.child("pivot")) w.pivot = p->as_vec3();

@@ -125,10 +125,7 @@ SingleContactSummary run_single_contact(const SingleContactSpec& spec,
   if (spec.second) {
     add_body(w, *spec.second, spec.second->fixed || spec.path_mode);
   } else {
-    walls::Wall wall;
-    wall.name = "wall";
-    wall.shape = walls::Plane{*spec.wall_point, spec.wall_normal};
-    w.walls.push_back(wall);
+    w.walls.push_back(walls::make_wall("wall", walls::Plane{*spec.wall_point, spec.wall_normal}));
     w.set_wall_law(0, 0, spec.law);
   }
 

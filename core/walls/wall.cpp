@@ -64,6 +64,21 @@ bool wall_geometry(const Shape& shape, const Vec3& x, double r, double range, Wa
       shape);
 }
 
+Wall make_wall(std::string name, Shape shape, std::uint16_t material) {
+  Wall w;
+  w.name = std::move(name);
+  w.pivot = std::visit(
+      [](const auto& s) {
+        using S = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<S, Disk>) return s.centre;
+        else return s.point;
+      },
+      shape);
+  w.shape = std::move(shape);
+  w.material = material;
+  return w;
+}
+
 void advance(Wall& wall, double dt) {
   const Vec3 shift = wall.velocity * dt;
   wall.displacement += shift;

@@ -56,6 +56,10 @@ struct Wall {
   Vec3 velocity_at(const Vec3& p) const { return velocity + cross(omega, p - pivot); }
 };
 
+/// A wall at rest whose pivot is the shape's own reference point (plane point, cylinder axis
+/// point, disk centre).
+Wall make_wall(std::string name, Shape shape, std::uint16_t material = 0);
+
 /// Nearest-point geometry of a sphere (centre x, radius r) against a shape; false when the gap
 /// exceeds `range` (or the sphere is beside a finite wall's extent).
 bool wall_geometry(const Shape& shape, const Vec3& x, double r, double range, WallGeometry& out);

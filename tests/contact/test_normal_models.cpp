@@ -109,19 +109,8 @@ class LudingReference {
 };
 
 TEST(Luding, DrivenOverlapPathFollowsTheEquationsAtEveryStep) {
-  const std::string yaml = R"(
-contact_law:
-  normal: {model: luding, k1: 1.0e4, k2_ratio: 5.0, kc_ratio: 0.5, phi_f: 0.05, restitution: 1.0}
-  tangential: {model: history, mu_s: 0.5}
-bodies:
-  - {radius: 0.001, density: 2500, position: [0, 0, 0], fixed: true}
-  - {radius: 0.001, density: 2500, position: [0.002, 0, 0]}
-time_step: 1.0e-6
-mode: path
-path: {waypoints: [20e-6, 10e-6, 40e-6, 10e-6, 30e-6, -5e-6, 100e-6, 30e-6, 60e-6, -5e-6], speed: 0.01}
-)";
   std::vector<lab::SingleContactSample> samples;
-  test::run_contact(yaml, &samples);
+  test::run_contact(test::luding_path_example(), &samples);
   ASSERT_GT(samples.size(), 40000u);
   LudingReference ref(1e4, 5e4, 0.5e4, 0.05, 1e-3);
   int adhesive = 0, beyond_limit = 0;

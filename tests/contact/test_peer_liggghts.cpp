@@ -117,18 +117,7 @@ TEST_F(PeerLiggghts, LudingOverlapPathForcesAgree) {
   }
   ASSERT_GT(peer.size(), 4000u);
   std::vector<lab::SingleContactSample> samples;
-  test::run_contact(R"(
-contact_law:
-  normal: {model: luding, k1: 1.0e4, k2_ratio: 5.0, kc_ratio: 0.5, phi_f: 0.05, restitution: 1.0}
-  tangential: {model: history, mu_s: 0.5}
-bodies:
-  - {radius: 0.001, density: 2500, position: [0, 0, 0], fixed: true}
-  - {radius: 0.001, density: 2500, position: [0.002, 0, 0]}
-time_step: 1.0e-6
-mode: path
-path: {waypoints: [20e-6, 10e-6, 40e-6, 10e-6, 30e-6, -5e-6, 100e-6, 30e-6, 60e-6, -5e-6], speed: 0.01}
-)",
-                    &samples);
+  test::run_contact(test::luding_path_example(), &samples);
   // LIGGGHTS moves the driven sphere as x0 + v t, demcal adds v dt each step: the overlaps differ
   // by rounding (~1e-15 m), which shifts a force crossing zero by up to k2 times that. The
   // tolerance is 1e-6 relative plus k2 * 1e-14 m for this rounding.

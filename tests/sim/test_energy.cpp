@@ -15,14 +15,6 @@
 namespace demcal {
 namespace {
 
-walls::Wall wall_of(std::string name, walls::Shape shape, std::uint16_t material = 0) {
-  walls::Wall w;
-  w.name = std::move(name);
-  w.shape = shape;
-  w.material = material;
-  return w;
-}
-
 constexpr double kRadius = 0.01;    // m
 constexpr double kDensity = 1000;   // kg/m^3
 constexpr double kStiffness = 1e4;  // N/m
@@ -70,8 +62,8 @@ sim::World elastic_gas(int count, std::uint64_t seed) {
     lo_normal[k] = 1.0;
     hi_normal[k] = -1.0;
     hi_point[k] = kBox;
-    w.walls.push_back(wall_of("lo" + std::to_string(k), walls::Plane{Vec3{}, lo_normal}));
-    w.walls.push_back(wall_of("hi" + std::to_string(k), walls::Plane{hi_point, hi_normal}));
+    w.walls.push_back(walls::make_wall("lo" + std::to_string(k), walls::Plane{Vec3{}, lo_normal}));
+    w.walls.push_back(walls::make_wall("hi" + std::to_string(k), walls::Plane{hi_point, hi_normal}));
   }
   Rng rng(seed);
   particles::InsertRequest req;

@@ -14,14 +14,6 @@
 namespace demcal {
 namespace {
 
-walls::Wall wall_of(std::string name, walls::Shape shape, std::uint16_t material = 0) {
-  walls::Wall w;
-  w.name = std::move(name);
-  w.shape = shape;
-  w.material = material;
-  return w;
-}
-
 contact::ContactLaw law(contact::SlotSpec normal) {
   contact::ContactLawSpec s;
   s.normal = std::move(normal);
@@ -34,7 +26,7 @@ sim::World two_spheres(const contact::ContactLaw& pair, const contact::ContactLa
   sim::World w;
   w.set_pair_law(0, 0, pair);
   w.set_wall_law(0, 0, wall);
-  w.walls.push_back(wall_of("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}));
+  w.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}));
   w.particles.add_sphere({0, 0, 0.01}, 0.001, 2500, 0);
   w.particles.add_sphere({0.01, 0, 0.01}, 0.002, 2500, 0);
   return w;

@@ -14,14 +14,6 @@
 namespace demcal {
 namespace {
 
-walls::Wall wall_of(std::string name, walls::Shape shape, std::uint16_t material = 0) {
-  walls::Wall w;
-  w.name = std::move(name);
-  w.shape = shape;
-  w.material = material;
-  return w;
-}
-
 constexpr double kG = 9.81;
 
 contact::ContactLaw linear_law(double kn, double mu_s, double mu_r) {
@@ -39,11 +31,11 @@ TEST(SimWalls, SettledBedFloorCarriesTheWeightAndMovingLidMovesVt) {
   w.set_wall_law(0, 0, linear_law(1e3, 0.5, 0.1));  // floor: frictional
   w.set_wall_law(1, 0, linear_law(1e3, 0.0, 0.0));  // cylinder: frictionless, so no Janssen arching
   const double rc = 0.008;
-  w.walls.push_back(wall_of("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}));
-  w.walls.push_back(wall_of("cylinder", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, rc}, 1));
+  w.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}));
+  w.walls.push_back(walls::make_wall("cylinder", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, rc}, 1));
   // A lid far above the bed, moving up: it never touches a sphere.
   const Vec3 lid_velocity{0.003, -0.002, 0.1};
-  w.walls.push_back(wall_of("lid", walls::Plane{{0, 0, 0.06}, {0, 0, -1}}));
+  w.walls.push_back(walls::make_wall("lid", walls::Plane{{0, 0, 0.06}, {0, 0, -1}}));
   w.walls.back().velocity = lid_velocity;
   w.walls.back().pivot = {0, 0, 0.06};
   Rng rng(99);
@@ -113,7 +105,7 @@ TEST(SimWalls, RotatingFloorReportsTorqueAboutItsPivot) {
   const auto i = w.particles.add_sphere({d, 0, 0}, r, 2500, 0);
   const double m = w.particles.mass[i];
   w.particles.x[i].z = r - m * kG / kn;  // at its equilibrium overlap
-  w.walls.push_back(wall_of("turntable", walls::Plane{{0, 0, 0}, {0, 0, 1}}));
+  w.walls.push_back(walls::make_wall("turntable", walls::Plane{{0, 0, 0}, {0, 0, 1}}));
   w.walls.back().omega = {0, 0, 2.0};  // pivot: the origin
   w.dt = sim::recommended_time_step(w, 0.2);
   sim::run(w, 20);
