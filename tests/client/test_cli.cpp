@@ -1,0 +1,149 @@
+// The `demcal` command line, run as a user runs it: real processes, real files, JSON parsed back.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "core/common/rng.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int exit_code;
+  std::string out;
+};
+
+Result demcal(const std::string& args) {
+  const std::string cmd = std::string(DEMCAL_BINARY_DIR) + "/client/demcal " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string source(const std::string& rel) { return std::string(DEMCAL_SOURCE_DIR) + "/" + rel; }
+
+fs::path scratch_dir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("demcal_cli_" + name + "_" + std::to_string(::getpid()));
+  fs::create_directories(p);
+  return p;
+}
+
+TEST(Cli, DesignReportsTheAliasStructureOfTheSeedScreening) {
+  const Result r = demcal("design --factors 12 --runs 32 --center 1 --format json");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["resolution"], 4);
+  EXPECT_EQ(j["runs"].size(), 33u);
+  EXPECT_EQ(j["clear_two_factor_interactions"].size(), 0u) << "no 2FI is clear in the 2^(12-7)";
+  EXPECT_EQ(j["two_factor_alias_chains"].size(), 15u);
+}
+
+TEST(Cli, BadArgumentsAreRejectedWithAMessage) {
+  const Result r = demcal("design --factors 12 --runs 7");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.out.find("runs"), std::string::npos) << r.out;
+}
+
+TEST(Cli, AnalyzeFindsTheActiveEffectsOfACsv) {
+  const fs::path dir = scratch_dir("analyze");
+  const Result d = demcal("design --factors 5 --runs 16 --format json");
+  ASSERT_EQ(d.exit_code, 0) << d.out;
+  const auto design = nlohmann::json::parse(d.out);
+  std::ofstream csv(dir / "runs.csv");
+  csv << "A,B,C,D,E,y\n";
+  demcal::Rng rng(11);
+  for (const auto& run : design["runs"]) {
+    std::array<double, 5> x{};
+    for (int k = 0; k < 5; ++k) x[k] = run["coded"][k];
+    const double y = 10 + 3 * x[0] - 2 * x[1] + 1.5 * x[0] * x[2] + 0.1 * rng.normal();
+    csv << x[0] << "," << x[1] << "," << x[2] << "," << x[3] << "," << x[4] << "," << y << "\n";
+  }
+  csv.close();
+  const Result r = demcal("analyze --design " + (dir / "runs.csv").string() + " --response y --model 2fi --format json");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  std::set<std::string> active;
+  for (const auto& e : j["effects"])
+    if (e["active_me"]) active.insert(e["chain"]);
+  EXPECT_TRUE(active.count("A") && active.count("B")) << r.out;
+  bool interaction_found = false;
+  for (const auto& name : active) interaction_found |= name.find("AC") != std::string::npos;
+  EXPECT_TRUE(interaction_found) << "the chain holding AC must be flagged";
+  EXPECT_FALSE(active.count("D") || active.count("E")) << "inactive factors stay unflagged";
+  fs::remove_all(dir);
+}
+
+TEST(Cli, ContactPrintsTheSummaryAndWritesTheSeries) {
+  const fs::path dir = scratch_dir("contact");
+  const Result r = demcal("contact " + source("examples/contact_hertz_collision.yaml") + " --csv " +
+                          (dir / "series.csv").string());
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  // LIGGGHTS 3.8 measures 0.499965884831271 for this collision (../shared/peers).
+  EXPECT_NEAR(j["restitution"].get<double>(), 0.499965884831271, 1e-9);
+  std::ifstream series(dir / "series.csv");
+  std::string header;
+  std::getline(series, header);
+  EXPECT_EQ(header.rfind("time,x1_x", 0), 0u);
+  int rows = 0;
+  for (std::string line; std::getline(series, line);) ++rows;
+  EXPECT_EQ(rows, 800);  // 8000 steps, every 10th
+  fs::remove_all(dir);
+}
+
+TEST(Cli, ContactSpecErrorsNameFileLineAndField) {
+  const fs::path dir = scratch_dir("bad");
+  std::ofstream(dir / "bad.yaml") << "contact_law:\n  normal: {model: linear, kn: -5}\n"
+                                     "  tangential: {model: history, mu_s: 0.5}\n"
+                                     "bodies: []\ntime_step: 1.0e-6\n";
+  const Result r = demcal("contact " + (dir / "bad.yaml").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("bad.yaml:2"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("contact_law.normal.kn"), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
+TEST(Cli, SimulateRunsAScenePrintsMetricsAndWritesVtk) {
+  const fs::path dir = scratch_dir("simulate");
+  std::ofstream(dir / "scene.yaml") << R"(
+threads: 2
+time_step_safety: 0.2
+density: 2500
+contact_law:
+  normal: {model: hertz, youngs_modulus: 1.0e7, poisson_ratio: 0.3, restitution: 0.5}
+  tangential: {model: history, mu_s: 0.5}
+walls:
+  - {name: floor, plane: {point: [0, 0, 0], normal: [0, 0, 1]}}
+  - {name: die, cylinder: {point: [0, 0, 0], axis: [0, 0, 1], radius: 0.01}}
+particles:
+  random: {region: {cylinder: {centre: [0, 0, 0], radius: 0.0099, z_lo: 0, z_hi: 0.02}}, count: 150,
+           sizes: {monodisperse: {radius: 0.001}}}
+phases:
+  - {name: fall, steps: 2000}
+)";
+  const Result r = demcal("simulate " + (dir / "scene.yaml").string() + " --out " + (dir / "vtk").string());
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["particles"], 150);
+  EXPECT_LT(j["time_step"].get<double>(), j["critical_time_step"].get<double>());
+  EXPECT_GT(j["phases"][0]["particle_steps_per_second"].get<double>(), 0.0);
+  std::ifstream vtk(dir / "vtk" / "particles.vtk");
+  std::string first;
+  std::getline(vtk, first);
+  EXPECT_EQ(first, "# vtk DataFile Version 3.0");
+  EXPECT_TRUE(fs::exists(dir / "vtk" / "walls.vtk"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
