@@ -7,6 +7,7 @@ namespace demcal::cli {
 void add_contact_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_models_command(CLI::App& app);
+void add_lab_command(CLI::App& app);
 void add_design_command(CLI::App& app);
 void add_analyze_command(CLI::App& app);
 

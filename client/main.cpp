@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   demcal::cli::add_contact_command(app);
   demcal::cli::add_simulate_command(app);
   demcal::cli::add_models_command(app);
+  demcal::cli::add_lab_command(app);
   demcal::cli::add_design_command(app);
   demcal::cli::add_analyze_command(app);
   try {

@@ -9,12 +9,17 @@ namespace demcal {
 /// `where` names the place: a field path ("contact_law.normal.k1"), or "file.yaml:12".
 class InputError : public std::runtime_error {
  public:
-  InputError(std::string where, const std::string& what)
-      : std::runtime_error(where.empty() ? what : where + ": " + what), where_(std::move(where)) {}
+  InputError(std::string where, std::string what)
+      : std::runtime_error(where.empty() ? what : where + ": " + what),
+        where_(std::move(where)),
+        message_(std::move(what)) {}
   const std::string& where() const { return where_; }
+  /// What is wrong, without the place.
+  const std::string& message() const { return message_; }
 
  private:
   std::string where_;
+  std::string message_;
 };
 
 /// A simulation that cannot go on: NaN, kinetic-energy explosion, escaped particles,

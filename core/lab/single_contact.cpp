@@ -48,8 +48,9 @@ double approach_speed(const sim::World& w, const Vec3& n) {
 }
 
 void add_body(sim::World& w, const Body& b, bool kinematic) {
-  const auto i = w.particles.add_sphere(b.position, b.radius, b.density, 0,
-                                        kinematic ? particles::Motion::kKinematic : particles::Motion::kFree);
+  const auto i =
+      w.particles.add_sphere(b.position, b.radius, b.density, 0,
+                             kinematic ? particles::Motion::kKinematic : particles::Motion::kFree);
   w.particles.v[i] = b.velocity;
   w.particles.omega[i] = b.angular_velocity;
 }
@@ -76,12 +77,13 @@ SingleContactSample sample(const sim::World& w) {
 }  // namespace
 
 SingleContactSpec read_single_contact(const io::YamlNode& root) {
-  root.expect_only({"contact_law", "bodies", "wall", "gravity", "time_step", "steps", "end_time", "mode",
-                    "path", "output_every"});
+  root.expect_only({"contact_law", "bodies", "wall", "gravity", "time_step", "steps", "end_time",
+                    "mode", "path", "output_every"});
   SingleContactSpec spec;
   spec.law = io::read_contact_law(root["contact_law"]);
   const auto bodies = root["bodies"].items();
-  if (bodies.empty() || bodies.size() > 2) root["bodies"].fail("give one sphere (with a wall) or two spheres");
+  if (bodies.empty() || bodies.size() > 2)
+    root["bodies"].fail("give one sphere (with a wall) or two spheres");
   spec.first = read_body(bodies[0]);
   if (bodies.size() == 2) spec.second = read_body(bodies[1]);
   if (auto wall = root.child("wall")) {
@@ -115,8 +117,8 @@ SingleContactSpec read_single_contact(const io::YamlNode& root) {
   return spec;
 }
 
-SingleContactSummary run_single_contact(const SingleContactSpec& spec,
-                                        const std::function<void(const SingleContactSample&)>& sink) {
+SingleContactSummary run_single_contact(
+    const SingleContactSpec& spec, const std::function<void(const SingleContactSample&)>& sink) {
   sim::World w;
   w.gravity = spec.gravity;
   w.dt = spec.time_step;
@@ -165,8 +167,10 @@ SingleContactSummary run_single_contact(const SingleContactSpec& spec,
       const Vec3 n = geometry(w).n;
       const double direction = target > current ? 1.0 : -1.0;
       // Increasing the overlap means moving body 1 against n (or the sphere along n to the wall).
-      w.particles.v[driven] = n * (spec.second ? -direction * spec.drive_speed : direction * spec.drive_speed);
-      const long n_steps = std::lround(std::abs(target - current) / (spec.drive_speed * spec.time_step));
+      w.particles.v[driven] =
+          n * (spec.second ? -direction * spec.drive_speed : direction * spec.drive_speed);
+      const long n_steps =
+          std::lround(std::abs(target - current) / (spec.drive_speed * spec.time_step));
       for (long k = 0; k < n_steps; ++k) advance();
       current = target;
     }
@@ -186,7 +190,8 @@ std::vector<std::string> single_contact_columns() {
   std::vector<std::string> c{"time"};
   for (const char* q : {"x", "v", "w"})
     for (int b = 1; b <= 2; ++b)
-      for (const char* a : {"x", "y", "z"}) c.push_back(std::string(q) + std::to_string(b) + "_" + a);
+      for (const char* a : {"x", "y", "z"})
+        c.push_back(std::string(q) + std::to_string(b) + "_" + a);
   for (const char* q : {"overlap", "fn", "ft_x", "ft_y", "ft_z", "troll_x", "troll_y", "troll_z"})
     c.emplace_back(q);
   return c;

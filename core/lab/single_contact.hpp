@@ -52,8 +52,8 @@ struct SingleContactSample {
 
 SingleContactSpec read_single_contact(const io::YamlNode& root);
 /// Runs the experiment; `sink` receives every `output_every`-th sample (may be empty).
-SingleContactSummary run_single_contact(const SingleContactSpec& spec,
-                                        const std::function<void(const SingleContactSample&)>& sink);
+SingleContactSummary run_single_contact(
+    const SingleContactSpec& spec, const std::function<void(const SingleContactSample&)>& sink);
 
 /// The CSV column names matching write order of a sample.
 std::vector<std::string> single_contact_columns();

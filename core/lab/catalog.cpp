@@ -1,0 +1,48 @@
+#include "core/lab/catalog.hpp"
+
+#include "core/common/error.hpp"
+#include "core/lab/packing.hpp"
+
+namespace demcal::lab {
+
+// packing: seed 000 §2.7.1, §3.1 (runner in packing.cpp).
+LabTestInfo packing_info() {
+  return {
+      "packing",
+      "bed poured into a cylindrical die and settled; solid fraction and coordination number in a "
+      "sampling volume away from the walls",
+      "seed 000 §2.7.1, §3.1",
+      {{"solid_fraction", "-", "solid volume over sampling volume"},
+       {"coordination_number", "-", "mean particle contacts per particle in the sampling volume"}},
+      settings_docs<PackingSettings>()};
+}
+
+const std::vector<LabTestInfo>& lab_catalog() {
+  static const std::vector<LabTestInfo> tests = {packing_info()};
+  return tests;
+}
+
+const LabTestInfo& find_lab_info(const std::string& name) {
+  std::string known;
+  for (const auto& t : lab_catalog()) {
+    if (t.name == name) return t;
+    known += (known.empty() ? "" : ", ") + t.name;
+  }
+  throw InputError("test", "unknown lab test '" + name + "' (known: " + known + ")");
+}
+
+void validate_settings(const LabTestInfo& info, const Settings& settings,
+                       const std::string& where) {
+  for (const auto& [key, value] : settings) {
+    const contact::ParamDoc* doc = nullptr;
+    for (const auto& d : info.settings)
+      if (d.name == key) doc = &d;
+    if (!doc) throw InputError(where + "." + key, "not a setting of lab test '" + info.name + "'");
+    if (!(value >= doc->lo && value <= doc->hi))
+      throw InputError(where + "." + key,
+                       "value " + std::to_string(value) + " outside the valid range [" +
+                           std::to_string(doc->lo) + ", " + std::to_string(doc->hi) + "]");
+  }
+}
+
+}  // namespace demcal::lab

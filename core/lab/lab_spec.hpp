@@ -1,0 +1,31 @@
+#pragma once
+// YAML form of a material model and of one lab-test run (`demcal lab run`):
+//   test: packing
+//   settings: {particles: 300}            # the test's settings table (demcal lab list)
+//   seed: 1
+//   threads: 2
+//   material:
+//     particle_law: {normal: ..., cohesion: ..., tangential: ..., rolling: ...}
+//     wall_law: {...}                      # default: particle_law
+//     sizes: {monodisperse: {radius}} | {discrete: {radii, mass_fractions}} | {lognormal: {...}}
+//     size_scale: 1.0
+//     density: 1545
+//     scaling: {law: none | kottlan2018 | tiscar2019, factor: 1}
+#include <string>
+
+#include "core/io/yaml_node.hpp"
+#include "core/lab/lab_test.hpp"
+
+namespace demcal::lab {
+
+struct LabRunSpec {
+  std::string test;
+  Settings settings;
+  MaterialModel material;
+  RunOptions options;
+};
+
+MaterialModel read_material(const io::YamlNode& node);
+LabRunSpec read_lab_run(const io::YamlNode& root);
+
+}  // namespace demcal::lab

@@ -1,0 +1,25 @@
+#include "core/lab/lab_test.hpp"
+
+#include "core/common/error.hpp"
+#include "core/lab/packing.hpp"
+
+namespace demcal::lab {
+
+LabRunner find_lab_runner(const std::string& name) {
+  if (name == "packing") return run_packing;
+  find_lab_info(name);  // throws with the known names
+  throw InputError("test", "lab test '" + name + "' is catalogued but has no runner");
+}
+
+LabOutput run_lab_test(const std::string& name, const MaterialModel& material,
+                       const Settings& settings, const RunOptions& options) {
+  const LabTestInfo& info = find_lab_info(name);
+  validate_settings(info, settings, "settings");
+  LabOutput out = find_lab_runner(name)(material, settings, options);
+  for (const auto& m : info.metrics)
+    if (!out.metrics.count(m.name))
+      throw std::logic_error("lab test '" + name + "' did not produce its metric '" + m.name + "'");
+  return out;
+}
+
+}  // namespace demcal::lab

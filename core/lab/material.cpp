@@ -1,0 +1,165 @@
+#include "core/lab/material.hpp"
+
+#include <cmath>
+
+#include "core/common/error.hpp"
+
+namespace demcal::lab {
+namespace {
+
+contact::SlotSpec& slot_of(contact::ContactLawSpec& law, const std::string& slot,
+                           const std::string& path) {
+  if (slot == "normal") return law.normal;
+  if (slot == "cohesion") return law.cohesion;
+  if (slot == "tangential") return law.tangential;
+  if (slot == "rolling") return law.rolling;
+  throw InputError(path, "unknown contact-law slot '" + slot + "'");
+}
+
+struct Path {
+  std::string law, slot, param;
+};
+
+/// Splits "particle_law.normal.k2_ratio"; returns false for paths outside the laws.
+bool split_law_path(const std::string& path, Path& out) {
+  const auto a = path.find('.');
+  if (a == std::string::npos) return false;
+  out.law = path.substr(0, a);
+  if (out.law != "particle_law" && out.law != "wall_law") return false;
+  const auto b = path.find('.', a + 1);
+  if (b == std::string::npos) throw InputError(path, "expected <law>.<slot>.<parameter>");
+  out.slot = path.substr(a + 1, b - a - 1);
+  out.param = path.substr(b + 1);
+  return true;
+}
+
+void append_law(std::vector<ParameterInfo>& out, const contact::ContactLawSpec& law,
+                const std::string& name) {
+  for (const auto& slot : contact::slot_names()) {
+    const contact::SlotSpec& s = slot == "normal"       ? law.normal
+                                 : slot == "cohesion"   ? law.cohesion
+                                 : slot == "tangential" ? law.tangential
+                                                        : law.rolling;
+    if (s.model.empty()) continue;
+    for (const auto& p : contact::model_params(slot, s.model))
+      out.push_back({name + "." + slot + "." + p.name, p.unit, p.lo, p.hi});
+  }
+}
+
+void radius_params(std::vector<ParameterInfo>& out, const particles::SizeDistribution& sizes) {
+  out.push_back({"sizes.scale", "-", 1e-6, 1e6});
+  if (std::holds_alternative<particles::Monodisperse>(sizes))
+    out.push_back({"sizes.radius", "m", 1e-9, 10.0});
+  if (std::holds_alternative<particles::LogNormal>(sizes)) {
+    out.push_back({"sizes.median_radius", "m", 1e-9, 10.0});
+    out.push_back({"sizes.sigma_g", "-", 1.0 + 1e-9, 10.0});
+  }
+}
+
+double* size_field(MaterialModel& m, const std::string& path) {
+  if (path == "sizes.scale") return &m.size_scale;
+  if (auto* mono = std::get_if<particles::Monodisperse>(&m.sizes); mono && path == "sizes.radius")
+    return &mono->radius;
+  if (auto* ln = std::get_if<particles::LogNormal>(&m.sizes)) {
+    if (path == "sizes.median_radius") return &ln->median_radius;
+    if (path == "sizes.sigma_g") return &ln->sigma_g;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+contact::ScaleFactors MaterialModel::factors() const {
+  return contact::scale_factors(scaling, scale_factor);
+}
+
+contact::ContactLaw MaterialModel::simulated_particle_law() const {
+  return contact::scale(contact::ContactLaw::from_spec(particle_law, "particle_law"), factors());
+}
+
+contact::ContactLaw MaterialModel::simulated_wall_law() const {
+  return contact::scale(contact::ContactLaw::from_spec(wall_law, "wall_law"), factors());
+}
+
+particles::SizeDistribution MaterialModel::simulated_sizes() const {
+  const double k = size_scale * factors().length;
+  return std::visit(
+      [&](auto d) -> particles::SizeDistribution {
+        using D = std::decay_t<decltype(d)>;
+        if constexpr (std::is_same_v<D, particles::Monodisperse>)
+          d.radius *= k;
+        else if constexpr (std::is_same_v<D, particles::DiscreteClasses>)
+          for (double& r : d.radii) r *= k;
+        else
+          d.median_radius *= k;
+        return d;
+      },
+      sizes);
+}
+
+double MaterialModel::simulated_density() const {
+  return density * factors().density;
+}
+
+void MaterialModel::validate() const {
+  contact::ContactLaw::from_spec(particle_law, "particle_law");
+  contact::ContactLaw::from_spec(wall_law, "wall_law");
+  particles::validate(sizes, "sizes");
+  if (!(density > 0.0)) throw InputError("density", "must be > 0");
+  if (!(size_scale > 0.0)) throw InputError("sizes.scale", "must be > 0");
+  factors();
+}
+
+std::vector<ParameterInfo> parameters(const MaterialModel& model) {
+  std::vector<ParameterInfo> out;
+  append_law(out, model.particle_law, "particle_law");
+  append_law(out, model.wall_law, "wall_law");
+  out.push_back({"density", "kg/m^3", 1e-3, 1e6});
+  radius_params(out, model.sizes);
+  out.push_back({"scaling.factor", "-", 1e-6, 1e6});
+  return out;
+}
+
+void set_parameter(MaterialModel& model, const std::string& path, double value) {
+  for (const auto& info : parameters(model))
+    if (info.path == path) {
+      if (!(value >= info.lo && value <= info.hi))
+        throw InputError(path, "value " + std::to_string(value) + " outside the valid range [" +
+                                   std::to_string(info.lo) + ", " + std::to_string(info.hi) + "] " +
+                                   info.unit);
+      Path p;
+      if (split_law_path(path, p)) {
+        auto& law = p.law == "particle_law" ? model.particle_law : model.wall_law;
+        slot_of(law, p.slot, path).params[p.param] = value;
+      } else if (path == "density") {
+        model.density = value;
+      } else if (path == "scaling.factor") {
+        model.scale_factor = value;
+      } else {
+        *size_field(model, path) = value;
+      }
+      return;
+    }
+  throw InputError(
+      path,
+      "not a parameter of this material model (see `demcal models` for the models' parameters)");
+}
+
+double get_parameter(const MaterialModel& model, const std::string& path) {
+  Path p;
+  if (split_law_path(path, p)) {
+    auto law = p.law == "particle_law" ? model.particle_law : model.wall_law;
+    const auto& params = slot_of(law, p.slot, path).params;
+    if (auto it = params.find(p.param); it != params.end()) return it->second;
+    for (const auto& info : contact::model_params(p.slot, slot_of(law, p.slot, path).model))
+      if (info.name == p.param) return info.fallback;
+    throw InputError(path, "unknown parameter");
+  }
+  if (path == "density") return model.density;
+  if (path == "scaling.factor") return model.scale_factor;
+  MaterialModel copy = model;
+  if (double* f = size_field(copy, path)) return *f;
+  throw InputError(path, "not a parameter of this material model");
+}
+
+}  // namespace demcal::lab

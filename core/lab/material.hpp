@@ -1,0 +1,54 @@
+#pragma once
+// The material model a campaign calibrates: the contact laws (in spec form, so any parameter can
+// be addressed by a path), the size distribution, the density and the coarse-graining. Lab tests
+// build their worlds from it; factor paths of a campaign name its parameters.
+//
+// Parameter paths:
+//   particle_law.<slot>.<param>   e.g. particle_law.normal.k2_ratio, particle_law.rolling.mu_r
+//   wall_law.<slot>.<param>       e.g. wall_law.tangential.mu_s
+//   density
+//   sizes.radius | sizes.median_radius | sizes.sigma_g | sizes.scale   (scale multiplies every
+//   radius) scaling.factor
+#include <string>
+#include <vector>
+
+#include "core/contact/contact_law.hpp"
+#include "core/contact/scaling.hpp"
+#include "core/particles/size_distribution.hpp"
+
+namespace demcal::lab {
+
+struct MaterialModel {
+  contact::ContactLawSpec particle_law;
+  contact::ContactLawSpec wall_law;
+  particles::SizeDistribution sizes = particles::Monodisperse{1e-3};
+  double size_scale =
+      1.0;  ///< multiplies every radius of `sizes` (real radii), a factor like any other
+  double density = 1500.0;  ///< real particle density (kg/m^3)
+  contact::ScalingLaw scaling = contact::ScalingLaw::kNone;
+  double scale_factor = 1.0;
+
+  /// The simulated laws, radii and density after coarse-graining (seed 000 eq. 24-30 or
+  /// seed 001 eq. 15-18).
+  contact::ContactLaw simulated_particle_law() const;
+  contact::ContactLaw simulated_wall_law() const;
+  particles::SizeDistribution simulated_sizes() const;
+  double simulated_density() const;
+  contact::ScaleFactors factors() const;
+  /// Checks both laws and the distribution; errors name the path.
+  void validate() const;
+};
+
+struct ParameterInfo {
+  std::string path, unit;
+  double lo, hi;  ///< valid range
+};
+
+/// Every addressable parameter of the model as it stands (its models' tables, plus density,
+/// sizes and scaling), for validating factor paths and bounds.
+std::vector<ParameterInfo> parameters(const MaterialModel& model);
+/// Sets one parameter by path; throws InputError naming the path if unknown or out of range.
+void set_parameter(MaterialModel& model, const std::string& path, double value);
+double get_parameter(const MaterialModel& model, const std::string& path);
+
+}  // namespace demcal::lab

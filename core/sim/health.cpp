@@ -1,0 +1,38 @@
+#include "core/sim/health.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/common/error.hpp"
+
+namespace demcal::sim {
+
+void check_health(const World& w, const HealthLimits& limits) {
+  const auto& p = w.particles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!is_finite(p.x[i]) || !is_finite(p.v[i]) || !is_finite(p.omega[i])) {
+      char msg[160];
+      std::snprintf(msg, sizeof msg,
+                    "particle %zu has a non-finite position or velocity at t = %.6g s", i, w.time);
+      throw SimulationFailure(SimulationFailure::Reason::kNotFinite, msg);
+    }
+    for (int k = 0; k < 3; ++k)
+      if (!w.domain.periodic[k] && (p.x[i][k] < limits.lo[k] || p.x[i][k] > limits.hi[k])) {
+        char msg[200];
+        std::snprintf(msg, sizeof msg,
+                      "particle %zu left the test volume at t = %.6g s (position %.4g %.4g %.4g m)",
+                      i, w.time, p.x[i].x, p.x[i].y, p.x[i].z);
+        throw SimulationFailure(SimulationFailure::Reason::kEscaped, msg);
+      }
+  }
+  const double ke = p.kinetic_energy();
+  if (ke > limits.max_kinetic_energy) {
+    char msg[200];
+    std::snprintf(msg, sizeof msg,
+                  "kinetic energy %.4g J exceeds the plausible maximum %.4g J at t = %.6g s", ke,
+                  limits.max_kinetic_energy, w.time);
+    throw SimulationFailure(SimulationFailure::Reason::kEnergyExplosion, msg);
+  }
+}
+
+}  // namespace demcal::sim
