@@ -20,14 +20,16 @@ struct ContactOptions {
 void run_contact(const ContactOptions& opt) {
   const auto spec = lab::read_single_contact(io::YamlNode::load_file(opt.spec));
   std::unique_ptr<io::CsvWriter> csv;
-  if (!opt.csv.empty()) csv = std::make_unique<io::CsvWriter>(opt.csv, lab::single_contact_columns());
+  if (!opt.csv.empty())
+    csv = std::make_unique<io::CsvWriter>(opt.csv, lab::single_contact_columns());
   const auto sum = lab::run_single_contact(spec, [&](const lab::SingleContactSample& s) {
     if (csv) csv->row(lab::single_contact_row(s));
   });
   nlohmann::json j;
   j["steps"] = sum.steps;
   j["restitution"] = sum.contact_ended ? nlohmann::json(sum.restitution) : nlohmann::json(nullptr);
-  j["contact_duration"] = sum.contact_ended ? nlohmann::json(sum.contact_duration) : nlohmann::json(nullptr);
+  j["contact_duration"] =
+      sum.contact_ended ? nlohmann::json(sum.contact_duration) : nlohmann::json(nullptr);
   j["max_overlap"] = sum.max_overlap;
   j["max_force"] = sum.max_force;
   for (int b = 0; b < (spec.second ? 2 : 1); ++b) {

@@ -26,10 +26,11 @@ void print_models() {
         std::cout << "No parameters.\n\n";
         continue;
       }
-      std::cout << "| parameter | unit | valid range | default | meaning |\n|---|---|---|---|---|\n";
+      std::cout
+          << "| parameter | unit | valid range | default | meaning |\n|---|---|---|---|---|\n";
       for (const auto& p : params)
-        std::cout << "| `" << p.name << "` | " << p.unit << " | [" << number(p.lo) << ", " << number(p.hi)
-                  << "] | " << number(p.fallback) << " | " << p.doc << " |\n";
+        std::cout << "| `" << p.name << "` | " << p.unit << " | [" << number(p.lo) << ", "
+                  << number(p.hi) << "] | " << number(p.fallback) << " | " << p.doc << " |\n";
       std::cout << "\n";
     }
   }
@@ -38,7 +39,8 @@ void print_models() {
 }  // namespace
 
 void add_models_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("models", "List the contact-law models and their parameters (Markdown)");
+  auto* cmd =
+      app.add_subcommand("models", "List the contact-law models and their parameters (Markdown)");
   cmd->callback(print_models);
 }
 

@@ -34,12 +34,14 @@ void run_simulate(const SimulateOptions& opt) {
   for (const auto& phase : scene.phases) {
     const auto t0 = std::chrono::steady_clock::now();
     sim::run(w, phase.steps);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     report["phases"].push_back(
         {{"name", phase.name},
          {"steps", phase.steps},
          {"wall_seconds", seconds},
-         {"particle_steps_per_second", static_cast<double>(w.particles.size()) * static_cast<double>(phase.steps) / seconds}});
+         {"particle_steps_per_second",
+          static_cast<double>(w.particles.size()) * static_cast<double>(phase.steps) / seconds}});
   }
   report["metrics"] = {{"kinetic_energy", w.particles.kinetic_energy()},
                        {"coordination_number", metrics::coordination_number(w)},
@@ -59,7 +61,8 @@ void run_simulate(const SimulateOptions& opt) {
 
 void add_simulate_command(CLI::App& app) {
   auto opt = std::make_shared<SimulateOptions>();
-  auto* cmd = app.add_subcommand("simulate", "Run a simulation scene from YAML and print its metrics");
+  auto* cmd =
+      app.add_subcommand("simulate", "Run a simulation scene from YAML and print its metrics");
   cmd->add_option("spec", opt->spec, "scene YAML")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", opt->out_dir, "directory for VTK snapshots of the final state");
   cmd->add_option("--threads", opt->threads, "override the scene's thread count");

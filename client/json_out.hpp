@@ -6,6 +6,8 @@
 
 namespace demcal::cli {
 
-inline nlohmann::json to_json(const Vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+inline nlohmann::json to_json(const Vec3& v) {
+  return nlohmann::json::array({v.x, v.y, v.z});
+}
 
 }  // namespace demcal::cli

@@ -10,8 +10,10 @@ Variant make_model(const SlotSpec& spec, const std::string& where) {
   if constexpr (I == std::variant_size_v<Variant>) {
     std::string known;
     [&]<std::size_t... Is>(std::index_sequence<Is...>) {
-      ((known += (Is ? ", " : "") + std::string(std::variant_alternative_t<Is, Variant>::kName)), ...);
-    }(std::make_index_sequence<std::variant_size_v<Variant>>{});
+      ((known += (Is ? ", " : "") + std::string(std::variant_alternative_t<Is, Variant>::kName)),
+       ...);
+    }
+    (std::make_index_sequence<std::variant_size_v<Variant>>{});
     throw InputError(where + ".model", "unknown model '" + spec.model + "' (known: " + known + ")");
   } else {
     using M = std::variant_alternative_t<I, Variant>;
@@ -25,7 +27,8 @@ std::vector<std::string> names_of() {
   std::vector<std::string> out;
   [&]<std::size_t... Is>(std::index_sequence<Is...>) {
     (out.emplace_back(std::variant_alternative_t<Is, Variant>::kName), ...);
-  }(std::make_index_sequence<std::variant_size_v<Variant>>{});
+  }
+  (std::make_index_sequence<std::variant_size_v<Variant>>{});
   return out;
 }
 
@@ -44,7 +47,8 @@ std::vector<ParamDoc> params_of(const std::string& model) {
                            p.fallback});
         }(),
         ...);
-  }(std::make_index_sequence<std::variant_size_v<Variant>>{});
+  }
+  (std::make_index_sequence<std::variant_size_v<Variant>>{});
   if (!found) throw InputError("model", "unknown model '" + model + "'");
   return out;
 }
@@ -61,9 +65,10 @@ decltype(auto) with_slot(const std::string& slot, F&& f) {
 }  // namespace
 
 int ContactLaw::history_size() const {
-  return visit(*this, []<class N, class C, class T, class R>(const N&, const C&, const T&, const R&) {
-    return History<N, C, T, R>::kSize;
-  });
+  return visit(*this,
+               []<class N, class C, class T, class R>(const N&, const C&, const T&, const R&) {
+                 return History<N, C, T, R>::kSize;
+               });
 }
 
 double ContactLaw::range() const {
@@ -81,7 +86,9 @@ ContactLaw ContactLaw::from_spec(const ContactLawSpec& spec, const std::string& 
           make_model<RollingModel>(spec.rolling, where + ".rolling")};
 }
 
-std::vector<std::string> slot_names() { return {"normal", "cohesion", "tangential", "rolling"}; }
+std::vector<std::string> slot_names() {
+  return {"normal", "cohesion", "tangential", "rolling"};
+}
 
 std::vector<std::string> model_names(const std::string& slot) {
   return with_slot(slot, []<class V>(const V&) { return names_of<V>(); });

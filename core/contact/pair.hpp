@@ -25,19 +25,19 @@ struct PairInput {
 /// Output of the normal slot, read by the tangential and rolling slots.
 struct NormalResult {
   double fn = 0.0;        ///< normal force incl. damping, without the cohesion slot (N)
-  double f_adhesive = 0;  ///< attraction built into the normal law (Luding k_c delta), added back for
-                          ///< the Coulomb criterion as seed 000 eq. 18 does (N)
-  double k_ref = 0.0;     ///< the stiffness tangential and rolling stiffness ratios refer to (N/m)
-  double gamma_n = 0.0;   ///< normal damping coefficient (kg/s)
+  double f_adhesive = 0;  ///< attraction built into the normal law (Luding k_c delta), added back
+                          ///< for the Coulomb criterion as seed 000 eq. 18 does (N)
+  double k_ref = 0.0;    ///< the stiffness tangential and rolling stiffness ratios refer to (N/m)
+  double gamma_n = 0.0;  ///< normal damping coefficient (kg/s)
 };
 
 struct PairOutput {
-  double fn = 0.0;          ///< total normal force, > 0 repulsive (N)
-  Vec3 force;               ///< force on i (N); j receives -force
-  Vec3 ft;                  ///< tangential part of `force` (N)
-  Vec3 torque_i;            ///< (N m)
-  Vec3 torque_j;            ///< (N m)
-  Vec3 rolling_torque;      ///< rolling-resistance part of torque_i (N m)
+  double fn = 0.0;      ///< total normal force, > 0 repulsive (N)
+  Vec3 force;           ///< force on i (N); j receives -force
+  Vec3 ft;              ///< tangential part of `force` (N)
+  Vec3 torque_i;        ///< (N m)
+  Vec3 torque_j;        ///< (N m)
+  Vec3 rolling_torque;  ///< rolling-resistance part of torque_i (N m)
 };
 
 /// Removes the normal component of a history vector and restores its length: the history is
@@ -50,7 +50,13 @@ inline void rotate_into_plane(Vec3& h, const Vec3& n) {
   if (after > 0.0) h *= std::sqrt(before / after);
 }
 
-inline Vec3 load_vec(const double* p) { return {p[0], p[1], p[2]}; }
-inline void store_vec(double* p, const Vec3& v) { p[0] = v.x; p[1] = v.y; p[2] = v.z; }
+inline Vec3 load_vec(const double* p) {
+  return {p[0], p[1], p[2]};
+}
+inline void store_vec(double* p, const Vec3& v) {
+  p[0] = v.x;
+  p[1] = v.y;
+  p[2] = v.z;
+}
 
 }  // namespace demcal::contact

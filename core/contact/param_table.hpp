@@ -13,15 +13,17 @@
 namespace demcal::contact {
 
 inline constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
-inline bool is_set(double v) { return !std::isnan(v); }
+inline bool is_set(double v) {
+  return !std::isnan(v);
+}
 
 template <class P>
 struct ParamInfo {
   std::string_view name;
   std::string_view unit;
-  double lo;           ///< smallest valid value (inclusive)
-  double hi;           ///< largest valid value (inclusive)
-  double fallback;     ///< default; kUnset = must be given (unless the model says otherwise)
+  double lo;        ///< smallest valid value (inclusive)
+  double hi;        ///< largest valid value (inclusive)
+  double fallback;  ///< default; kUnset = must be given (unless the model says otherwise)
   std::string_view doc;
   double P::*field;
 };
@@ -41,13 +43,14 @@ P params_from_map(const std::map<std::string, double>& values, const std::string
     if (!found) {
       std::string known;
       for (const auto& info : table) known += (known.empty() ? "" : ", ") + std::string(info.name);
-      throw InputError(where + "." + key,
-                       "unknown parameter of model '" + std::string(P::kName) + "' (known: " + known + ")");
+      throw InputError(where + "." + key, "unknown parameter of model '" + std::string(P::kName) +
+                                              "' (known: " + known + ")");
     }
     if (!(value >= found->lo && value <= found->hi))
-      throw InputError(where + "." + key, "value " + std::to_string(value) + " outside the valid range [" +
-                                              std::to_string(found->lo) + ", " + std::to_string(found->hi) +
-                                              "] " + std::string(found->unit));
+      throw InputError(where + "." + key,
+                       "value " + std::to_string(value) + " outside the valid range [" +
+                           std::to_string(found->lo) + ", " + std::to_string(found->hi) + "] " +
+                           std::string(found->unit));
     p.*found->field = value;
   }
   p.finalize(where);

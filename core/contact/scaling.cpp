@@ -61,7 +61,8 @@ ScalingLaw scaling_law_from_name(const std::string& name, const std::string& whe
   if (name == "none") return ScalingLaw::kNone;
   if (name == "kottlan2018") return ScalingLaw::kKottlan2018;
   if (name == "tiscar2019") return ScalingLaw::kTiscar2019;
-  throw InputError(where, "unknown scaling law '" + name + "' (known: none, kottlan2018, tiscar2019)");
+  throw InputError(where,
+                   "unknown scaling law '" + name + "' (known: none, kottlan2018, tiscar2019)");
 }
 
 ContactLaw scale(const ContactLaw& law, const ScaleFactors& f) {

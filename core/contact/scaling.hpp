@@ -6,9 +6,9 @@
 //     (so k1 = 4/3 Y r sqrt(delta') scales as 1/SF, and a given stiffness does too).
 //   Tiscar 2019 (seed 001 eq. 15-18), scale factor lambda = N_real / N_sim = (R_s / R_r)^3:
 //     R_s = lambda^(1/3) R_r, rho_s = rho_r / lambda (eq. 17, particle mass kept),
-//     k_s = lambda^(-1/3) k_r (eq. 18, relative overlap kept); by the same rule Y_s = lambda^(-2/3) Y_r
-//     (k ~ Y R), stresses lambda^(-2/3) (the same forces on areas lambda^(2/3) larger), lengths of
-//     cohesion lambda^(1/3), A_H lambda^(1/3).
+//     k_s = lambda^(-1/3) k_r (eq. 18, relative overlap kept); by the same rule Y_s = lambda^(-2/3)
+//     Y_r (k ~ Y R), stresses lambda^(-2/3) (the same forces on areas lambda^(2/3) larger), lengths
+//     of cohesion lambda^(1/3), A_H lambda^(1/3).
 // Parameters are scaled by their unit as declared in the model's parameter table.
 #include <string>
 

@@ -14,6 +14,8 @@ inline double rayleigh_time(double radius, double density, double youngs_modulus
 /// Spring time sqrt(m/k) (seed 001 eq. 14) for linear contacts: m the lightest particle, k the
 /// stiffest spring. Velocity Verlet is stable up to 2 sqrt(m*/k) = sqrt(2) sqrt(m/k) for a pair of
 /// equal particles, so sqrt(m/k) itself keeps a margin.
-inline double spring_time(double mass, double stiffness) { return std::sqrt(mass / stiffness); }
+inline double spring_time(double mass, double stiffness) {
+  return std::sqrt(mass / stiffness);
+}
 
 }  // namespace demcal::integrate

@@ -15,14 +15,16 @@ walls::Shape read_shape(const YamlNode& n) {
   }
   if (auto c = n.child("cylinder")) {
     c->expect_only({"point", "axis", "radius", "lo", "hi"});
-    walls::Cylinder cyl{(*c)["point"].as_vec3(), normalized((*c)["axis"].as_vec3()), (*c)["radius"].as_number()};
+    walls::Cylinder cyl{(*c)["point"].as_vec3(), normalized((*c)["axis"].as_vec3()),
+                        (*c)["radius"].as_number()};
     cyl.lo = c->number("lo", -walls::kInfinity);
     cyl.hi = c->number("hi", walls::kInfinity);
     return cyl;
   }
   if (auto d = n.child("disk")) {
     d->expect_only({"centre", "normal", "radius"});
-    return walls::Disk{(*d)["centre"].as_vec3(), normalized((*d)["normal"].as_vec3()), (*d)["radius"].as_number()};
+    return walls::Disk{(*d)["centre"].as_vec3(), normalized((*d)["normal"].as_vec3()),
+                       (*d)["radius"].as_number()};
   }
   n.fail("a wall needs one of: plane, cylinder, disk");
 }
@@ -56,7 +58,8 @@ void read_particles(const YamlNode& n, sim::World& world, double density, Rng& r
       item.expect_only({"radius", "position", "velocity", "angular_velocity", "density"});
       const double r = item["radius"].as_number();
       if (!(r > 0.0)) item["radius"].fail("must be > 0");
-      const auto i = world.particles.add_sphere(item["position"].as_vec3(), r, item.number("density", density), 0);
+      const auto i = world.particles.add_sphere(item["position"].as_vec3(), r,
+                                                item.number("density", density), 0);
       if (auto v = item.child("velocity")) world.particles.v[i] = v->as_vec3();
       if (auto w = item.child("angular_velocity")) world.particles.omega[i] = w->as_vec3();
     }
@@ -64,10 +67,10 @@ void read_particles(const YamlNode& n, sim::World& world, double density, Rng& r
     l->expect_only({"origin", "spacing", "counts", "radius", "jitter"});
     const auto counts = (*l)["counts"].as_numbers();
     if (counts.size() != 3) (*l)["counts"].fail("expected 3 counts");
-    particles::insert_lattice(world.particles, (*l)["origin"].as_vec3(), (*l)["spacing"].as_number(),
-                              static_cast<int>(counts[0]), static_cast<int>(counts[1]),
-                              static_cast<int>(counts[2]), (*l)["radius"].as_number(), density, 0,
-                              l->number("jitter", 0.0), rng);
+    particles::insert_lattice(
+        world.particles, (*l)["origin"].as_vec3(), (*l)["spacing"].as_number(),
+        static_cast<int>(counts[0]), static_cast<int>(counts[1]), static_cast<int>(counts[2]),
+        (*l)["radius"].as_number(), density, 0, l->number("jitter", 0.0), rng);
   } else if (auto r = n.child("random")) {
     r->expect_only({"region", "count", "sizes", "gap"});
     particles::InsertRequest req;
@@ -104,8 +107,8 @@ particles::SizeDistribution read_size_distribution(const YamlNode& n) {
 }
 
 Scene read_scene(const YamlNode& root) {
-  root.expect_only({"threads", "seed", "time_step", "time_step_safety", "skin", "gravity", "domain", "density",
-                    "contact_law", "wall_contact_law", "walls", "particles", "phases"});
+  root.expect_only({"threads", "seed", "time_step", "time_step_safety", "skin", "gravity", "domain",
+                    "density", "contact_law", "wall_contact_law", "walls", "particles", "phases"});
   Scene scene;
   sim::World& w = scene.world;
   w.threads = static_cast<int>(root.number("threads", 1));
@@ -127,7 +130,8 @@ Scene read_scene(const YamlNode& root) {
   if (!(density > 0.0)) root["density"].fail("must be > 0");
   const auto law = read_contact_law(root["contact_law"]);
   w.set_pair_law(0, 0, law);
-  const auto wall_law = root.has("wall_contact_law") ? read_contact_law(root["wall_contact_law"]) : law;
+  const auto wall_law =
+      root.has("wall_contact_law") ? read_contact_law(root["wall_contact_law"]) : law;
   if (auto walls = root.child("walls"))
     for (const auto& item : walls->items()) {
       w.walls.push_back(read_wall(item));
@@ -141,7 +145,8 @@ Scene read_scene(const YamlNode& root) {
   }
   for (const auto& item : root["phases"].items()) {
     item.expect_only({"name", "steps"});
-    scene.phases.push_back({item["name"].as_string(), static_cast<long>(item["steps"].as_number())});
+    scene.phases.push_back(
+        {item["name"].as_string(), static_cast<long>(item["steps"].as_number())});
   }
   return scene;
 }

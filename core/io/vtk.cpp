@@ -69,7 +69,8 @@ void write_walls_vtk(const std::string& path, const sim::World& world, double ex
           } else if constexpr (std::is_same_v<S, walls::Cylinder>) {
             Vec3 u, w;
             basis(s.axis, u, w);
-            const double lo = std::isfinite(s.lo) ? s.lo : -extent, hi = std::isfinite(s.hi) ? s.hi : extent;
+            const double lo = std::isfinite(s.lo) ? s.lo : -extent,
+                         hi = std::isfinite(s.hi) ? s.hi : extent;
             for (int c = 0; c < kSegments; ++c) {
               const double phi = 2.0 * M_PI * c / kSegments;
               const Vec3 radial = (u * std::cos(phi) + w * std::sin(phi)) * s.radius;

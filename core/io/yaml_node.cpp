@@ -32,9 +32,13 @@ std::string YamlNode::where() const {
   return w;
 }
 
-void YamlNode::fail(const std::string& what) const { throw InputError(where(), what); }
+void YamlNode::fail(const std::string& what) const {
+  throw InputError(where(), what);
+}
 
-bool YamlNode::has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined(); }
+bool YamlNode::has(const std::string& key) const {
+  return node_.IsMap() && node_[key].IsDefined();
+}
 
 YamlNode YamlNode::at(const std::string& key) const {
   return YamlNode(node_[key], file_, path_.empty() ? key : path_ + "." + key);

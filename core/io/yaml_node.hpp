@@ -23,8 +23,8 @@ class YamlNode {
   bool has(const std::string& key) const;
   YamlNode operator[](const std::string& key) const;  ///< required child
   std::optional<YamlNode> child(const std::string& key) const;
-  std::vector<YamlNode> items() const;               ///< elements of a sequence
-  std::vector<std::string> keys() const;             ///< keys of a map
+  std::vector<YamlNode> items() const;    ///< elements of a sequence
+  std::vector<std::string> keys() const;  ///< keys of a map
   /// Throws on a key outside `allowed` (a misspelt field must not be silently ignored).
   void expect_only(std::initializer_list<const char*> allowed) const;
 

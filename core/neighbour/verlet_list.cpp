@@ -33,18 +33,22 @@ struct Grid {
           bool inside = true;
           for (int k = 0; k < 3; ++k) {
             if (c[k] >= 0 && c[k] < n[k]) continue;
-            if (periodic[k]) c[k] = (c[k] + n[k]) % n[k];
-            else inside = false;
+            if (periodic[k])
+              c[k] = (c[k] + n[k]) % n[k];
+            else
+              inside = false;
           }
           if (!inside) continue;
           const int id = index(c[0], c[1], c[2]);
-          if (std::find(out.begin(), out.begin() + count, id) == out.begin() + count) out[count++] = id;
+          if (std::find(out.begin(), out.begin() + count, id) == out.begin() + count)
+            out[count++] = id;
         }
     return count;
   }
 };
 
-Grid make_grid(const std::vector<Vec3>& x, const Domain& domain, double cell, std::size_t n_particles) {
+Grid make_grid(const std::vector<Vec3>& x, const Domain& domain, double cell,
+               std::size_t n_particles) {
   Grid g;
   g.periodic = domain.periodic;
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
@@ -106,7 +110,8 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
 
   auto for_each_partner = [&](int i, auto&& visit) {
     std::array<int, 27> cells;
-    const int nc = grid.stencil(grid.coord(x[i], 0), grid.coord(x[i], 1), grid.coord(x[i], 2), cells);
+    const int nc =
+        grid.stencil(grid.coord(x[i], 0), grid.coord(x[i], 1), grid.coord(x[i], 2), cells);
     for (int s = 0; s < nc; ++s)
       for (int k = cell_start_[cells[s]]; k < cell_start_[cells[s] + 1]; ++k) {
         const int j = cell_items_[k];

@@ -4,8 +4,8 @@
 // (the explicit history-mapping step of DEM-Engine, keyed by the ordered pair (i, j)).
 #include <vector>
 
-#include "core/common/vec3.hpp"
 #include "core/common/domain.hpp"
+#include "core/common/vec3.hpp"
 
 namespace demcal::neighbour {
 

@@ -86,7 +86,8 @@ void insert_random(ParticleStore& store, const InsertRequest& req, Rng& rng) {
     for (std::size_t attempt = 0; attempt < req.max_attempts_per_particle && !ok; ++attempt) {
       Vec3 c;
       if (!random_centre(req.region, r + req.gap, rng, c))
-        throw InputError("insertion.region", "region too small for a particle of radius " + std::to_string(r));
+        throw InputError("insertion.region",
+                         "region too small for a particle of radius " + std::to_string(r));
       if (grid.overlaps(store, c, r, req.gap)) continue;
       grid.add(store.add_sphere(c, r, req.density, req.material), c);
       ok = true;
@@ -99,8 +100,9 @@ void insert_random(ParticleStore& store, const InsertRequest& req, Rng& rng) {
   }
 }
 
-void insert_lattice(ParticleStore& store, const Vec3& origin, double spacing, int nx, int ny, int nz,
-                    double radius, double density, std::uint16_t material, double jitter, Rng& rng) {
+void insert_lattice(ParticleStore& store, const Vec3& origin, double spacing, int nx, int ny,
+                    int nz, double radius, double density, std::uint16_t material, double jitter,
+                    Rng& rng) {
   if (spacing < 2.0 * radius + 2.0 * jitter)
     throw InputError("lattice.spacing", "spacing must exceed the diameter plus twice the jitter");
   store.reserve(store.size() + static_cast<std::size_t>(nx) * ny * nz);

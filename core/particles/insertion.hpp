@@ -26,7 +26,7 @@ struct InsertRequest {
   std::size_t count = 0;
   double density = 0.0;  ///< (kg/m^3)
   std::uint16_t material = 0;
-  double gap = 0.0;      ///< extra clearance kept between spheres and to the region border (m)
+  double gap = 0.0;  ///< extra clearance kept between spheres and to the region border (m)
   std::size_t max_attempts_per_particle = 2000;
 };
 
@@ -37,7 +37,8 @@ void insert_random(ParticleStore& store, const InsertRequest& request, Rng& rng)
 
 /// Simple-cubic lattice of n.x * n.y * n.z spheres starting at `origin`, with a uniform random
 /// lateral jitter of +-jitter in x and y (as LIGGGHTS' displace_atoms in the benchmark).
-void insert_lattice(ParticleStore& store, const Vec3& origin, double spacing, int nx, int ny, int nz,
-                    double radius, double density, std::uint16_t material, double jitter, Rng& rng);
+void insert_lattice(ParticleStore& store, const Vec3& origin, double spacing, int nx, int ny,
+                    int nz, double radius, double density, std::uint16_t material, double jitter,
+                    Rng& rng);
 
 }  // namespace demcal::particles

@@ -30,8 +30,18 @@ void ParticleStore::set_motion(std::size_t i, Motion m) {
 }
 
 void ParticleStore::reserve(std::size_t n) {
-  x.reserve(n); v.reserve(n); omega.reserve(n); f.reserve(n); torque.reserve(n);
-  radius.reserve(n); mass.reserve(n); inertia.reserve(n); inv_mass.reserve(n); inv_inertia.reserve(n); material.reserve(n); motion.reserve(n);
+  x.reserve(n);
+  v.reserve(n);
+  omega.reserve(n);
+  f.reserve(n);
+  torque.reserve(n);
+  radius.reserve(n);
+  mass.reserve(n);
+  inertia.reserve(n);
+  inv_mass.reserve(n);
+  inv_inertia.reserve(n);
+  material.reserve(n);
+  motion.reserve(n);
 }
 
 namespace {
@@ -45,9 +55,18 @@ void compact(std::vector<T>& a, const std::vector<char>& flags) {
 }  // namespace
 
 void ParticleStore::remove_if(const std::vector<char>& flags) {
-  compact(x, flags); compact(v, flags); compact(omega, flags); compact(f, flags);
-  compact(torque, flags); compact(radius, flags); compact(mass, flags); compact(inertia, flags); compact(inv_mass, flags); compact(inv_inertia, flags);
-  compact(material, flags); compact(motion, flags);
+  compact(x, flags);
+  compact(v, flags);
+  compact(omega, flags);
+  compact(f, flags);
+  compact(torque, flags);
+  compact(radius, flags);
+  compact(mass, flags);
+  compact(inertia, flags);
+  compact(inv_mass, flags);
+  compact(inv_inertia, flags);
+  compact(material, flags);
+  compact(motion, flags);
 }
 
 double ParticleStore::total_mass() const {

@@ -14,11 +14,11 @@ enum class Motion : std::uint8_t { kFree = 0, kKinematic = 1 };
 
 class ParticleStore {
  public:
-  std::vector<Vec3> x;       ///< position (m)
-  std::vector<Vec3> v;       ///< velocity (m/s)
-  std::vector<Vec3> omega;   ///< angular velocity (rad/s)
-  std::vector<Vec3> f;       ///< force (N)
-  std::vector<Vec3> torque;  ///< torque (N m)
+  std::vector<Vec3> x;              ///< position (m)
+  std::vector<Vec3> v;              ///< velocity (m/s)
+  std::vector<Vec3> omega;          ///< angular velocity (rad/s)
+  std::vector<Vec3> f;              ///< force (N)
+  std::vector<Vec3> torque;         ///< torque (N m)
   std::vector<double> radius;       ///< (m)
   std::vector<double> mass;         ///< (kg)
   std::vector<double> inertia;      ///< moment of inertia of a solid sphere, 2/5 m r^2 (kg m^2)
@@ -30,8 +30,8 @@ class ParticleStore {
   std::size_t size() const { return x.size(); }
 
   /// Adds a solid sphere of the given radius and density; returns its index.
-  std::size_t add_sphere(const Vec3& position, double radius, double density, std::uint16_t material_id,
-                         Motion motion = Motion::kFree);
+  std::size_t add_sphere(const Vec3& position, double radius, double density,
+                         std::uint16_t material_id, Motion motion = Motion::kFree);
   void reserve(std::size_t n);
   /// Makes a particle kinematic or free again (updates its inverse mass and inertia).
   void set_motion(std::size_t i, Motion m);

@@ -1,8 +1,8 @@
 #include "core/particles/size_distribution.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <algorithm>
 
 #include "core/common/error.hpp"
 
@@ -26,12 +26,14 @@ void validate(const SizeDistribution& dist, const std::string& where) {
           if (!(d.radius > 0.0)) throw InputError(where + ".radius", "must be > 0");
         } else if constexpr (std::is_same_v<D, DiscreteClasses>) {
           if (d.radii.empty() || d.radii.size() != d.mass_fractions.size())
-            throw InputError(where, "radii and mass_fractions must be non-empty and of equal length");
+            throw InputError(where,
+                             "radii and mass_fractions must be non-empty and of equal length");
           for (std::size_t k = 0; k < d.radii.size(); ++k) {
             if (!(d.radii[k] > 0.0))
               throw InputError(where + ".radii[" + std::to_string(k) + "]", "must be > 0");
             if (!(d.mass_fractions[k] >= 0.0))
-              throw InputError(where + ".mass_fractions[" + std::to_string(k) + "]", "must be >= 0");
+              throw InputError(where + ".mass_fractions[" + std::to_string(k) + "]",
+                               "must be >= 0");
           }
           if (!(std::accumulate(d.mass_fractions.begin(), d.mass_fractions.end(), 0.0) > 0.0))
             throw InputError(where + ".mass_fractions", "must not all be zero");
@@ -73,10 +75,12 @@ double max_radius(const SizeDistribution& dist) {
   return std::visit(
       [](const auto& d) -> double {
         using D = std::decay_t<decltype(d)>;
-        if constexpr (std::is_same_v<D, Monodisperse>) return d.radius;
+        if constexpr (std::is_same_v<D, Monodisperse>)
+          return d.radius;
         else if constexpr (std::is_same_v<D, DiscreteClasses>)
           return *std::max_element(d.radii.begin(), d.radii.end());
-        else return d.median_radius * std::pow(d.sigma_g, d.truncate_k);
+        else
+          return d.median_radius * std::pow(d.sigma_g, d.truncate_k);
       },
       dist);
 }
@@ -85,10 +89,12 @@ double min_radius(const SizeDistribution& dist) {
   return std::visit(
       [](const auto& d) -> double {
         using D = std::decay_t<decltype(d)>;
-        if constexpr (std::is_same_v<D, Monodisperse>) return d.radius;
+        if constexpr (std::is_same_v<D, Monodisperse>)
+          return d.radius;
         else if constexpr (std::is_same_v<D, DiscreteClasses>)
           return *std::min_element(d.radii.begin(), d.radii.end());
-        else return d.median_radius / std::pow(d.sigma_g, d.truncate_k);
+        else
+          return d.median_radius / std::pow(d.sigma_g, d.truncate_k);
       },
       dist);
 }

@@ -47,10 +47,10 @@ void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
 
   if (static_cast<int>(w.deferred.size()) != threads) w.deferred.assign(threads, {});
 
-  // Each thread owns a contiguous range of particles and evaluates the pairs of its rows. A pair
-  // force on a partner j inside the own range is added directly; one on a partner owned by a
-  // later thread is deferred and added after the loop, in thread order. No two threads write the
-  // same particle, and the order of every sum is fixed for a given thread count.
+    // Each thread owns a contiguous range of particles and evaluates the pairs of its rows. A pair
+    // force on a partner j inside the own range is added directly; one on a partner owned by a
+    // later thread is deferred and added after the loop, in thread order. No two threads write the
+    // same particle, and the order of every sum is fixed for a given thread count.
 #pragma omp parallel num_threads(threads)
   {
     const int tid = omp_get_thread_num();
@@ -120,7 +120,8 @@ void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&,
   constexpr int kStride = contact::History<N, C, T, R>::kSize;
   walls::Wall& wall = w.walls[wall_index];
   std::vector<Law> laws;
-  for (int m = 0; m < w.materials(); ++m) laws.push_back(typed<N, C, T, R>(w.wall_law(wall.material, m)));
+  for (int m = 0; m < w.materials(); ++m)
+    laws.push_back(typed<N, C, T, R>(w.wall_law(wall.material, m)));
   double range = 0.0;
   for (const auto& l : laws) range = std::max(range, l.c.range());
 
@@ -175,9 +176,8 @@ void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&,
 
 void compute_pair_forces(World& world) {
   if (world.particles.size() == 0) return;
-  contact::visit(world.pair_law(0, 0), [&](const auto& n, const auto& c, const auto& t, const auto& r) {
-    pair_kernel(world, n, c, t, r);
-  });
+  contact::visit(world.pair_law(0, 0), [&](const auto& n, const auto& c, const auto& t,
+                                           const auto& r) { pair_kernel(world, n, c, t, r); });
 }
 
 void compute_wall_forces(World& world) {

@@ -24,8 +24,9 @@ void step(World& w) {
   //    history of pairs still in range is carried to the new list.
   if (w.list.needs_rebuild(w.particles.x, w.effective_skin(), w.threads)) {
     for (auto& x : w.particles.x) w.domain.wrap(x);
-    w.list.build(w.particles.x, w.particles.radius, w.domain, w.interaction_range() + w.effective_skin(),
-                 w.threads, w.pair_history, w.pair_stride());
+    w.list.build(w.particles.x, w.particles.radius, w.domain,
+                 w.interaction_range() + w.effective_skin(), w.threads, w.pair_history,
+                 w.pair_stride());
   }
 
   // 4. Forces: gravity and particle-particle contacts, then particle-wall contacts (which also

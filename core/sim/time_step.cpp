@@ -25,9 +25,10 @@ void tighten(TimeStepLimit& limit, const contact::ContactLaw& law, const std::st
     }
     if (t < limit.critical) {
       limit.critical = t;
-      limit.basis = (std::holds_alternative<contact::normal::Hertz>(law.normal) ? "Rayleigh time of "
-                                                                                 : "sqrt(m/k) of ") +
-                    which;
+      limit.basis =
+          (std::holds_alternative<contact::normal::Hertz>(law.normal) ? "Rayleigh time of "
+                                                                      : "sqrt(m/k) of ") +
+          which;
     }
   }
 }
@@ -38,8 +39,8 @@ TimeStepLimit critical_time_step(const World& world) {
   TimeStepLimit limit{std::numeric_limits<double>::infinity(), "no contacts"};
   for (int a = 0; a < world.materials(); ++a)
     for (int b = a; b < world.materials(); ++b)
-      tighten(limit, world.pair_law(a, b), "particle-particle law " + std::to_string(a) + "-" + std::to_string(b),
-              world);
+      tighten(limit, world.pair_law(a, b),
+              "particle-particle law " + std::to_string(a) + "-" + std::to_string(b), world);
   for (const auto& w : world.walls)
     for (int a = 0; a < world.materials(); ++a)
       tighten(limit, world.wall_law(w.material, a), "wall '" + w.name + "' law", world);

@@ -51,7 +51,9 @@ void World::set_wall_law(int wall_material, int particle_material, const contact
   prepared_ = false;
 }
 
-const contact::ContactLaw& World::pair_law(int a, int b) const { return pair_laws_[a * n_materials_ + b]; }
+const contact::ContactLaw& World::pair_law(int a, int b) const {
+  return pair_laws_[a * n_materials_ + b];
+}
 
 const contact::ContactLaw& World::wall_law(int wall_material, int particle_material) const {
   return wall_laws_[wall_material][particle_material];
@@ -69,26 +71,33 @@ void World::prepare() {
   // Every material present needs its laws, and one compiled kernel must serve each table.
   for (auto m : particles.material) {
     if (m >= n_materials_ || !pair_set_[m * n_materials_ + m])
-      throw InputError("contact_laws", "no particle-particle contact law for material " + std::to_string(m));
+      throw InputError("contact_laws",
+                       "no particle-particle contact law for material " + std::to_string(m));
   }
   for (int a = 0; a < n_materials_ * n_materials_; ++a)
     if (pair_set_[a] && composition(pair_laws_[a]) != composition(pair_laws_[0]))
-      throw InputError("contact_laws",
-                       "all particle-particle laws must use the same models (parameters may differ)");
+      throw InputError(
+          "contact_laws",
+          "all particle-particle laws must use the same models (parameters may differ)");
   wall_strides_.clear();
   for (const auto& w : walls) {
     if (w.material >= wall_laws_.size())
-      throw InputError("walls." + w.name, "no contact law for wall material " + std::to_string(w.material));
+      throw InputError("walls." + w.name,
+                       "no contact law for wall material " + std::to_string(w.material));
     for (auto m : particles.material)
       if (!wall_set_[w.material][m])
         throw InputError("walls." + w.name, "no contact law between wall material " +
-                                                std::to_string(w.material) + " and particle material " +
-                                                std::to_string(m));
+                                                std::to_string(w.material) +
+                                                " and particle material " + std::to_string(m));
     const auto& row = wall_laws_[w.material];
     for (int m = 0; m < n_materials_; ++m)
-      if (wall_set_[w.material][m] && composition(row[m]) != composition(row[particles.material.empty() ? 0 : particles.material[0]]))
-        throw InputError("walls." + w.name, "all laws of one wall material must use the same models");
-    wall_strides_.push_back(row[particles.material.empty() ? 0 : particles.material[0]].history_size());
+      if (wall_set_[w.material][m] &&
+          composition(row[m]) !=
+              composition(row[particles.material.empty() ? 0 : particles.material[0]]))
+        throw InputError("walls." + w.name,
+                         "all laws of one wall material must use the same models");
+    wall_strides_.push_back(
+        row[particles.material.empty() ? 0 : particles.material[0]].history_size());
   }
   check_time_step(*this);
 
@@ -100,8 +109,8 @@ void World::prepare() {
   for (std::size_t i = 0; i < particles.size(); ++i) domain.wrap(particles.x[i]);
   list = neighbour::VerletList{};
   pair_history.clear();
-  list.build(particles.x, particles.radius, domain, interaction_range() + skin_, threads, pair_history,
-             pair_stride_);
+  list.build(particles.x, particles.radius, domain, interaction_range() + skin_, threads,
+             pair_history, pair_stride_);
   wall_history.assign(walls.size(), {});
   for (std::size_t w = 0; w < walls.size(); ++w)
     wall_history[w].assign(particles.size() * wall_strides_[w], 0.0);

@@ -4,10 +4,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/common/domain.hpp"
 #include "core/contact/contact_law.hpp"
 #include "core/neighbour/verlet_list.hpp"
 #include "core/particles/particle_store.hpp"
-#include "core/common/domain.hpp"
 #include "core/walls/wall.hpp"
 
 namespace demcal::sim {
@@ -18,9 +18,9 @@ class World {
   std::vector<walls::Wall> walls;
   Domain domain;
   Vec3 gravity{0.0, 0.0, -9.81};
-  double dt = 0.0;     ///< time step (s)
-  double skin = 0.0;   ///< Verlet skin (m); 0 = 10 % of the smallest particle radius
-  int threads = 1;     ///< OpenMP threads; results are bitwise identical for a given count
+  double dt = 0.0;    ///< time step (s)
+  double skin = 0.0;  ///< Verlet skin (m); 0 = 10 % of the smallest particle radius
+  int threads = 1;    ///< OpenMP threads; results are bitwise identical for a given count
   double time = 0.0;
   std::int64_t step_count = 0;
 
@@ -60,7 +60,7 @@ class World {
 
  private:
   void grow_law_tables(int n);
-  std::vector<contact::ContactLaw> pair_laws_;        // n_materials_^2
+  std::vector<contact::ContactLaw> pair_laws_;               // n_materials_^2
   std::vector<std::vector<contact::ContactLaw>> wall_laws_;  // [wall material][particle material]
   std::vector<bool> pair_set_;
   std::vector<std::vector<bool>> wall_set_;

@@ -10,8 +10,10 @@ void StressServo::update(Wall& wall, double dt) {
   const double unclamped_integral = integral_ + error * dt;
   double v = kp * error + ki * unclamped_integral + kd * derivative;
   // Anti-windup: the integral only grows while the output is not saturated.
-  if (v > max_speed || v < -max_speed) v = std::clamp(v, -max_speed, max_speed);
-  else integral_ = unclamped_integral;
+  if (v > max_speed || v < -max_speed)
+    v = std::clamp(v, -max_speed, max_speed);
+  else
+    integral_ = unclamped_integral;
   last_error_ = error;
   started_ = true;
   wall.velocity = axis * v;

@@ -57,9 +57,12 @@ bool wall_geometry(const Shape& shape, const Vec3& x, double r, double range, Wa
   return std::visit(
       [&](const auto& s) {
         using S = std::decay_t<decltype(s)>;
-        if constexpr (std::is_same_v<S, Plane>) return plane_geometry(s, x, r, range, out);
-        else if constexpr (std::is_same_v<S, Cylinder>) return cylinder_geometry(s, x, r, range, out);
-        else return disk_geometry(s, x, r, range, out);
+        if constexpr (std::is_same_v<S, Plane>)
+          return plane_geometry(s, x, r, range, out);
+        else if constexpr (std::is_same_v<S, Cylinder>)
+          return cylinder_geometry(s, x, r, range, out);
+        else
+          return disk_geometry(s, x, r, range, out);
       },
       shape);
 }
@@ -70,8 +73,10 @@ Wall make_wall(std::string name, Shape shape, std::uint16_t material) {
   w.pivot = std::visit(
       [](const auto& s) {
         using S = std::decay_t<decltype(s)>;
-        if constexpr (std::is_same_v<S, Disk>) return s.centre;
-        else return s.point;
+        if constexpr (std::is_same_v<S, Disk>)
+          return s.centre;
+        else
+          return s.point;
       },
       shape);
   w.shape = std::move(shape);

@@ -45,12 +45,12 @@ struct Wall {
   std::string name;
   Shape shape;
   std::uint16_t material = 0;
-  Vec3 velocity;          ///< translation (m/s)
-  Vec3 omega;             ///< rotation about `pivot` (rad/s)
-  Vec3 pivot;             ///< centre of rotation and reference point of `torque`; moves with the wall
-  Vec3 force;             ///< force of the particles on the wall in the last step (N)
-  Vec3 torque;            ///< their torque about `pivot` (N m)
-  Vec3 displacement;      ///< total translation since the start (m)
+  Vec3 velocity;      ///< translation (m/s)
+  Vec3 omega;         ///< rotation about `pivot` (rad/s)
+  Vec3 pivot;         ///< centre of rotation and reference point of `torque`; moves with the wall
+  Vec3 force;         ///< force of the particles on the wall in the last step (N)
+  Vec3 torque;        ///< their torque about `pivot` (N m)
+  Vec3 displacement;  ///< total translation since the start (m)
 
   /// Velocity of the wall's material point at p.
   Vec3 velocity_at(const Vec3& p) const { return velocity + cross(omega, p - pivot); }

@@ -31,10 +31,13 @@ Result demcal(const std::string& args) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
 }
 
-std::string source(const std::string& rel) { return std::string(DEMCAL_SOURCE_DIR) + "/" + rel; }
+std::string source(const std::string& rel) {
+  return std::string(DEMCAL_SOURCE_DIR) + "/" + rel;
+}
 
 fs::path scratch_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("demcal_cli_" + name + "_" + std::to_string(::getpid()));
+  const fs::path p =
+      fs::temp_directory_path() / ("demcal_cli_" + name + "_" + std::to_string(::getpid()));
   fs::create_directories(p);
   return p;
 }
@@ -70,7 +73,8 @@ TEST(Cli, AnalyzeFindsTheActiveEffectsOfACsv) {
     csv << x[0] << "," << x[1] << "," << x[2] << "," << x[3] << "," << x[4] << "," << y << "\n";
   }
   csv.close();
-  const Result r = demcal("analyze --design " + (dir / "runs.csv").string() + " --response y --model 2fi --format json");
+  const Result r = demcal("analyze --design " + (dir / "runs.csv").string() +
+                          " --response y --model 2fi --format json");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
   std::set<std::string> active;
@@ -132,7 +136,8 @@ particles:
 phases:
   - {name: fall, steps: 2000}
 )";
-  const Result r = demcal("simulate " + (dir / "scene.yaml").string() + " --out " + (dir / "vtk").string());
+  const Result r =
+      demcal("simulate " + (dir / "scene.yaml").string() + " --out " + (dir / "vtk").string());
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["particles"], 150);

@@ -1,4 +1,5 @@
-// Van der Waals (Hamaker) cohesion against seed 000 eq. 12-15, and the Coulomb normal force of eq. 18.
+// Van der Waals (Hamaker) cohesion against seed 000 eq. 12-15, and the Coulomb normal force of
+// eq. 18.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -33,7 +34,8 @@ TEST(VanDerWaals, ForceAgainstSurfaceDistance) {
   double history[8] = {};
   for (double d : {5e-10, 1e-9, 1e-8, 5e-8, 9.9e-8}) {
     const PairOutput out = evaluate(law, pair_at(-d), history);
-    EXPECT_NEAR(-out.fn, a * r_eff / (6.0 * d * d), 1e-12 * a * r_eff / (6.0 * d * d)) << "D = " << d;
+    EXPECT_NEAR(-out.fn, a * r_eff / (6.0 * d * d), 1e-12 * a * r_eff / (6.0 * d * d))
+        << "D = " << d;
     EXPECT_GT(out.force.x, 0.0) << "attraction pulls i towards j";
   }
   // Below D_min the force is capped (eq. 12), beyond D_max it vanishes.
@@ -76,7 +78,8 @@ TEST(ContactLaw, SpecErrorsNameTheField) {
   spec.normal = {"hooke", {}};
   EXPECT_THROW(ContactLaw::from_spec(spec, "law"), InputError);
   spec.normal = {"luding", {{"k1", 1e4}, {"youngs_modulus", 1e7}}};
-  EXPECT_THROW(ContactLaw::from_spec(spec, "law"), InputError) << "k1 and Y are alternatives (eq. 3)";
+  EXPECT_THROW(ContactLaw::from_spec(spec, "law"), InputError)
+      << "k1 and Y are alternatives (eq. 3)";
 }
 
 }  // namespace

@@ -12,8 +12,8 @@ constexpr double kG = 9.81;
 
 /// A sphere (R = 1 mm) resting on the plane z = 0 at its static overlap, under gravity
 /// g (sin theta, 0, -cos theta): an incline of angle theta.
-std::string on_plane(double theta, double mu, const std::string& extra_body, const std::string& rolling,
-                     double end_time) {
+std::string on_plane(double theta, double mu, const std::string& extra_body,
+                     const std::string& rolling, double end_time) {
   const double m = test::sphere_mass(1e-3, 2500.0), kn = 1e5;
   const double z = 1e-3 - m * kG * std::cos(theta) / kn;
   char buf[1024];
@@ -30,7 +30,8 @@ time_step: 2.0e-6
 end_time: %.17g
 output_every: 50
 )",
-                mu, rolling.c_str(), z, extra_body.c_str(), kG * std::sin(theta), -kG * std::cos(theta), end_time);
+                mu, rolling.c_str(), z, extra_body.c_str(), kG * std::sin(theta),
+                -kG * std::cos(theta), end_time);
   return buf;
 }
 
@@ -60,7 +61,8 @@ TEST(Coulomb, InclineBelowSlipThresholdRollsAtFiveSevenths) {
   const double theta = 20.0 * M_PI / 180.0;  // rolling needs mu >= 2/7 tan(theta) = 0.104
   std::vector<lab::SingleContactSample> s;
   test::run_contact(on_plane(theta, 0.5, "", "{model: none}", 0.05), &s);
-  EXPECT_NEAR(acceleration(s, 0.01, 0.05), 5.0 / 7.0 * kG * std::sin(theta), 0.01 * kG * std::sin(theta));
+  EXPECT_NEAR(acceleration(s, 0.01, 0.05), 5.0 / 7.0 * kG * std::sin(theta),
+              0.01 * kG * std::sin(theta));
   const auto& last = s.back();
   EXPECT_NEAR(last.w[0].y * 1e-3, last.v[0].x, 0.01 * last.v[0].x) << "no slip";
 }

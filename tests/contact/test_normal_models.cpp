@@ -19,7 +19,8 @@ std::string num(double v) {
 std::string head_on(const std::string& normal, double v0, double dt, double end_time) {
   return "contact_law:\n  normal: " + normal + "\n  tangential: {model: history, mu_s: 0.5}\n" +
          "bodies:\n  - {radius: 0.001, density: 2500, position: [-0.0011, 0, 0], velocity: [" +
-         num(v0) + ", 0, 0]}\n  - {radius: 0.001, density: 2500, position: [0.0011, 0, 0], velocity: [" +
+         num(v0) +
+         ", 0, 0]}\n  - {radius: 0.001, density: 2500, position: [0.0011, 0, 0], velocity: [" +
          num(-v0) + ", 0, 0]}\n" + "time_step: " + num(dt) + "\nend_time: " + num(end_time) + "\n";
 }
 
@@ -29,11 +30,11 @@ TEST(LinearSpringDashpot, RestitutionAndContactTimeMatchTheory) {
   const double kn = 1e4, m_star = test::sphere_mass(kR, kRho) / 2.0;
   for (double xi : {0.0, 0.05, 0.2, 0.5}) {
     const double t_c = M_PI / std::sqrt(kn / m_star * (1.0 - xi * xi));
-    const auto sum = test::run_contact(
-        head_on("{model: linear, kn: 1.0e4, damping_ratio: " + num(xi) +
-                    ", damp_approach_only: 0, clip_attraction: 0}",
-                0.5, t_c / 2000.0, 2e-4 + 2.0 * t_c),
-        nullptr);
+    const auto sum =
+        test::run_contact(head_on("{model: linear, kn: 1.0e4, damping_ratio: " + num(xi) +
+                                      ", damp_approach_only: 0, clip_attraction: 0}",
+                                  0.5, t_c / 2000.0, 2e-4 + 2.0 * t_c),
+                          nullptr);
     ASSERT_TRUE(sum.contact_ended) << "xi " << xi;
     const double e = std::exp(-M_PI * xi / std::sqrt(1.0 - xi * xi));
     EXPECT_NEAR(sum.restitution, e, 2e-3 * e + 1e-4) << "xi " << xi;
@@ -43,10 +44,11 @@ TEST(LinearSpringDashpot, RestitutionAndContactTimeMatchTheory) {
 
 // Damping only on approach (seed 001 eq. 4) dissipates less than damping throughout.
 TEST(LinearSpringDashpot, ApproachOnlyDampingDissipatesLess) {
-  const auto both = test::run_contact(
-      head_on("{model: linear, kn: 1.0e4, damping_ratio: 0.3, damp_approach_only: 0, clip_attraction: 0}", 0.5, 1e-7, 5e-4));
-  const auto approach = test::run_contact(
-      head_on("{model: linear, kn: 1.0e4, damping_ratio: 0.3, damp_approach_only: 1}", 0.5, 1e-7, 5e-4));
+  const auto both = test::run_contact(head_on(
+      "{model: linear, kn: 1.0e4, damping_ratio: 0.3, damp_approach_only: 0, clip_attraction: 0}",
+      0.5, 1e-7, 5e-4));
+  const auto approach = test::run_contact(head_on(
+      "{model: linear, kn: 1.0e4, damping_ratio: 0.3, damp_approach_only: 1}", 0.5, 1e-7, 5e-4));
   EXPECT_GT(approach.restitution, both.restitution + 0.05);
   EXPECT_LT(approach.restitution, 1.0);
 }
@@ -58,11 +60,13 @@ TEST(Hertz, ElasticImpactMatchesHertzTheory) {
   const double y = 1e7, nu = 0.3, v0 = 0.5, v = 2.0 * v0;
   const double y_star = y / (2.0 * (1.0 - nu * nu));
   const double r_star = kR / 2.0, m_star = test::sphere_mass(kR, kRho) / 2.0;
-  const double delta_max = std::pow(15.0 * m_star * v * v / (16.0 * y_star * std::sqrt(r_star)), 0.4);
+  const double delta_max =
+      std::pow(15.0 * m_star * v * v / (16.0 * y_star * std::sqrt(r_star)), 0.4);
   const double f_max = 4.0 / 3.0 * y_star * std::sqrt(r_star) * std::pow(delta_max, 1.5);
   const double t_c = 2.9432 * delta_max / v;
   const auto sum = test::run_contact(
-      head_on("{model: hertz, youngs_modulus: 1.0e7, poisson_ratio: 0.3, restitution: 1.0}", v0, 5e-8, 6e-4));
+      head_on("{model: hertz, youngs_modulus: 1.0e7, poisson_ratio: 0.3, restitution: 1.0}", v0,
+              5e-8, 6e-4));
   ASSERT_TRUE(sum.contact_ended);
   EXPECT_NEAR(sum.max_overlap, delta_max, 1e-3 * delta_max);
   EXPECT_NEAR(sum.max_force, f_max, 2e-3 * f_max);
@@ -72,7 +76,8 @@ TEST(Hertz, ElasticImpactMatchesHertzTheory) {
 
 // Hertz damping from the restitution coefficient: the measured restitution is speed independent.
 TEST(Hertz, RestitutionIsSpeedIndependent) {
-  const std::string law = "{model: hertz, youngs_modulus: 1.0e7, poisson_ratio: 0.3, restitution: 0.6}";
+  const std::string law =
+      "{model: hertz, youngs_modulus: 1.0e7, poisson_ratio: 0.3, restitution: 0.6}";
   const auto slow = test::run_contact(head_on(law, 0.2, 5e-8, 1.6e-3));
   const auto fast = test::run_contact(head_on(law, 1.0, 5e-8, 6e-4));
   ASSERT_TRUE(slow.contact_ended && fast.contact_ended);
@@ -92,7 +97,8 @@ class LudingReference {
       return 0.0;
     }
     delta_max_ = std::max(delta_max_, delta);
-    const double k2s = delta_max_ >= limit_ ? k2_ : k1_ + (k2_ - k1_) * delta_max_ / limit_;  // eq. 5
+    const double k2s =
+        delta_max_ >= limit_ ? k2_ : k1_ + (k2_ - k1_) * delta_max_ / limit_;  // eq. 5
     // Force-free overlap of the un-/reloading line; beyond delta*_max it stays at its value there.
     const double delta_0 = (1.0 - k1_ / k2s) * std::min(delta_max_, limit_);
     const double f_unload = k2s * (delta - delta_0);

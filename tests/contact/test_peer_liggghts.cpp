@@ -27,17 +27,20 @@ std::string run_command(const std::string& cmd) {
   return out;
 }
 
-fs::path peer_dir() { return fs::path(DEMCAL_SOURCE_DIR) / ".." / "shared" / "peers" / "liggghts"; }
+fs::path peer_dir() {
+  return fs::path(DEMCAL_SOURCE_DIR) / ".." / "shared" / "peers" / "liggghts";
+}
 
 /// Runs a LIGGGHTS input in a scratch directory (its output goes to ../out relative to it).
 std::string run_liggghts(const std::string& script, const std::string& vars, fs::path& scratch) {
   scratch = fs::temp_directory_path() / ("demcal_peer_" + std::to_string(::getpid()));
   fs::create_directories(scratch / "run");
   fs::create_directories(scratch / "out");
-  fs::copy_file(peer_dir() / script, scratch / "run" / script, fs::copy_options::overwrite_existing);
+  fs::copy_file(peer_dir() / script, scratch / "run" / script,
+                fs::copy_options::overwrite_existing);
   // LIGGGHTS loses its messages when stdout is not a terminal: run it under script(1).
-  return run_command("cd '" + (scratch / "run").string() + "' && script -qc 'liggghts -in " + script + " " +
-                     vars + "' /dev/null 2>&1");
+  return run_command("cd '" + (scratch / "run").string() + "' && script -qc 'liggghts -in " +
+                     script + " " + vars + "' /dev/null 2>&1");
 }
 
 double result_field(const std::string& log, const std::string& key) {
@@ -57,7 +60,8 @@ class PeerLiggghts : public ::testing::Test {
 
 TEST_F(PeerLiggghts, LinearCollisionRestitutionAgrees) {
   fs::path scratch;
-  const std::string log = run_liggghts("in.collision_hooke", "-var v0 0.5 -var gn 9859.895661", scratch);
+  const std::string log =
+      run_liggghts("in.collision_hooke", "-var v0 0.5 -var gn 9859.895661", scratch);
   const double e_liggghts = result_field(log, "e_measured");
   ASSERT_TRUE(std::isfinite(e_liggghts)) << log;
   // gamman = 9859.895661 1/s per effective mass -> xi = gamman sqrt(m*) / (2 sqrt(kn)).
@@ -73,7 +77,8 @@ bodies:
   - {radius: 0.001, density: 2500, position: [0.0011, 0, 0], velocity: [-0.5, 0, 0]}
 time_step: 1.0e-7
 end_time: 5.0e-4
-)", xi);
+)",
+                xi);
   const auto sum = test::run_contact(yaml);
   EXPECT_NEAR(sum.restitution, e_liggghts, 1e-6 * e_liggghts);
   fs::remove_all(scratch);

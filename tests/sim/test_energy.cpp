@@ -63,7 +63,8 @@ sim::World elastic_gas(int count, std::uint64_t seed) {
     hi_normal[k] = -1.0;
     hi_point[k] = kBox;
     w.walls.push_back(walls::make_wall("lo" + std::to_string(k), walls::Plane{Vec3{}, lo_normal}));
-    w.walls.push_back(walls::make_wall("hi" + std::to_string(k), walls::Plane{hi_point, hi_normal}));
+    w.walls.push_back(
+        walls::make_wall("hi" + std::to_string(k), walls::Plane{hi_point, hi_normal}));
   }
   Rng rng(seed);
   particles::InsertRequest req;

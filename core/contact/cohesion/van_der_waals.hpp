@@ -22,9 +22,11 @@ struct VanDerWaals {
   double d_max;    ///< D_max (m)
 
   static std::array<ParamInfo<VanDerWaals>, 3> table() {
-    return {{{"hamaker", "J", 0.0, 1e-10, kUnset, "Hamaker constant A_H", &VanDerWaals::hamaker},
-             {"d_min", "m", 1e-12, 1.0, 4e-10, "minimum surface distance D_min", &VanDerWaals::d_min},
-             {"d_max", "m", 1e-12, 1.0, kUnset, "cut-off surface distance D_max", &VanDerWaals::d_max}}};
+    return {
+        {{"hamaker", "J", 0.0, 1e-10, kUnset, "Hamaker constant A_H", &VanDerWaals::hamaker},
+         {"d_min", "m", 1e-12, 1.0, 4e-10, "minimum surface distance D_min", &VanDerWaals::d_min},
+         {"d_max", "m", 1e-12, 1.0, kUnset, "cut-off surface distance D_max",
+          &VanDerWaals::d_max}}};
   }
   void finalize(const std::string& where) {
     if (!is_set(hamaker)) throw InputError(where + ".hamaker", "required");

@@ -24,11 +24,12 @@ struct Hertz {
   double clip_attraction;  ///< 1: a net attractive force is set to zero (LIGGGHTS limitForce)
 
   static std::array<ParamInfo<Hertz>, 4> table() {
-    return {{{"youngs_modulus", "Pa", 1.0, 1e13, kUnset, "Young's modulus Y", &Hertz::youngs_modulus},
-             {"poisson_ratio", "-", 0.0, 0.499, 0.3, "Poisson's ratio nu", &Hertz::poisson_ratio},
-             {"restitution", "-", 1e-6, 1.0, 0.5, "coefficient of restitution e", &Hertz::restitution},
-             {"clip_attraction", "0/1", 0, 1, 0, "set a net attractive force to zero",
-              &Hertz::clip_attraction}}};
+    return {
+        {{"youngs_modulus", "Pa", 1.0, 1e13, kUnset, "Young's modulus Y", &Hertz::youngs_modulus},
+         {"poisson_ratio", "-", 0.0, 0.499, 0.3, "Poisson's ratio nu", &Hertz::poisson_ratio},
+         {"restitution", "-", 1e-6, 1.0, 0.5, "coefficient of restitution e", &Hertz::restitution},
+         {"clip_attraction", "0/1", 0, 1, 0, "set a net attractive force to zero",
+          &Hertz::clip_attraction}}};
   }
   void finalize(const std::string& where) {
     if (!is_set(youngs_modulus)) throw InputError(where + ".youngs_modulus", "required");
@@ -40,7 +41,9 @@ struct Hertz {
     damping_factor = -2.0 * kSqrtFiveSixths * beta * std::sqrt(2.0 * y_star);
   }
   /// Stiffness at an overlap of 1 % of the radius, used only for the sqrt(m/k) time-step check.
-  double max_stiffness(double r_eff) const { return 2.0 * y_star * std::sqrt(0.5 * r_eff * 0.01 * r_eff); }
+  double max_stiffness(double r_eff) const {
+    return 2.0 * y_star * std::sqrt(0.5 * r_eff * 0.01 * r_eff);
+  }
 
   // Derived by finalize(): Y*, G*, and -2 sqrt(5/6) beta sqrt(2 Y*) so that
   // gamma_n = damping_factor sqrt(sqrt(R* delta) m*).

@@ -8,13 +8,14 @@
 //   k2*       = k2 if delta_max >= delta*_max, else k1 + (k2 - k1) delta_max / delta*_max   (eq. 5)
 //   f_hys     = k1 delta on the loading branch, k2* (delta - delta_0) on un-/reloading,
 //               -kc delta on the adhesive branch, delta_0 = (1 - k1/k2*) delta_max         (eq. 6)
-//   fn        = f_hys + gamma_n vn,  gamma_n = sqrt(4 m* k1 / (1 + (pi / ln e)^2))        (eq. 7, 9)
+//   fn        = f_hys + gamma_n vn,  gamma_n = sqrt(4 m* k1 / (1 + (pi / ln e)^2))        (eq. 7,
+//   9)
 // Beyond delta*_max the contact is elastic with k2 about delta_0 = (1 - k1/k2) delta*_max.
 // On the adhesive branch delta_max is moved so that a reload leaves along the k2* line through the
 // current point: delta_max = (k2* + kc) / (k2* - k1) delta.
-// Eq. 8 of seed 000 writes the effective mass as 2 m_i m_j / (m_i + m_j); with that mass eq. 7 would
-// not give restitution e, so the reduced mass m* = m_i m_j / (m_i + m_j) is used, as LIGGGHTS does.
-// History: [0] delta_max (m).
+// Eq. 8 of seed 000 writes the effective mass as 2 m_i m_j / (m_i + m_j); with that mass eq. 7
+// would not give restitution e, so the reduced mass m* = m_i m_j / (m_i + m_j) is used, as LIGGGHTS
+// does. History: [0] delta_max (m).
 #include <array>
 #include <cmath>
 
@@ -36,9 +37,10 @@ struct Luding {
   double restitution;     ///< e (-)
 
   static std::array<ParamInfo<Luding>, 7> table() {
-    return {{{"k1", "N/m", 1e-12, 1e15, kUnset, "loading stiffness (or give youngs_modulus)", &Luding::k1},
-             {"youngs_modulus", "Pa", 1.0, 1e13, kUnset, "Y for k1 = 4/3 Y sqrt(r^2 delta') (eq. 3)",
-              &Luding::youngs_modulus},
+    return {{{"k1", "N/m", 1e-12, 1e15, kUnset, "loading stiffness (or give youngs_modulus)",
+              &Luding::k1},
+             {"youngs_modulus", "Pa", 1.0, 1e13, kUnset,
+              "Y for k1 = 4/3 Y sqrt(r^2 delta') (eq. 3)", &Luding::youngs_modulus},
              {"delta_prime", "-", 1e-6, 0.5, 0.01, "dimensionless overlap delta' of eq. 3",
               &Luding::delta_prime},
              {"k2_ratio", "-", 1.0001, 1e4, 5.0, "f1 = k2/k1, maximum unloading stiffness",

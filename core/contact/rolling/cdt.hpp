@@ -1,8 +1,8 @@
 #pragma once
 // Constant directional torque (seed 000 eq. 23; LIGGGHTS `rolling_friction cdt`):
 //   T_i = -mu_r F_c R* w_roll / |w_roll|,   T_j = -T_i
-// w_roll = the part of omega_i - omega_j perpendicular to n (the rolling, not the twisting, motion);
-// F_c the normal force of the Coulomb criterion (seed 000 eq. 18), so |T| <= mu_r R* F_n.
+// w_roll = the part of omega_i - omega_j perpendicular to n (the rolling, not the twisting,
+// motion); F_c the normal force of the Coulomb criterion (seed 000 eq. 18), so |T| <= mu_r R* F_n.
 // History: none.
 #include <array>
 

@@ -1,9 +1,9 @@
 #pragma once
 // Elastic-plastic spring-dashpot rolling resistance as a rolling quasi-force (seed 001 eq. 9-13):
 //   v_r   = -R* (omega_i - omega_j) x n                   (eq. 12)
-//   F_r  -= k_r v_r dt,  k_r = kr_ratio k_ref              (eq. 11; F_r first turned into the plane)
-//   |F_r| <= mu_r F_c (Coulomb-type cap)                   (eq. 13)
-//   T_i   = -R* n x F_r,  T_j = +R* n x F_r                 (eq. 9-10)
+//   F_r  -= k_r v_r dt,  k_r = kr_ratio k_ref              (eq. 11; F_r first turned into the
+//   plane) |F_r| <= mu_r F_c (Coulomb-type cap)                   (eq. 13) T_i   = -R* n x F_r, T_j
+//   = +R* n x F_r                 (eq. 9-10)
 // so |T| <= mu_r R* F_n.  History: [0..2] F_r (N).
 #include <array>
 #include <cmath>
@@ -28,7 +28,8 @@ struct Epsd {
     if (!is_set(mu_r)) throw InputError(where + ".mu_r", "required");
   }
 
-  Vec3 torque(const PairInput& in, const NormalResult& nr, double f_coulomb, double* history) const {
+  Vec3 torque(const PairInput& in, const NormalResult& nr, double f_coulomb,
+              double* history) const {
     Vec3 fr = load_vec(history);
     rotate_into_plane(fr, in.n);
     const Vec3 v_r = -in.r_star * cross(in.w_rel, in.n);
