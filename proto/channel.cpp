@@ -1,0 +1,48 @@
+#include "proto/channel.hpp"
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace demcal::proto {
+
+namespace {
+bool loopback(const std::string& a) {
+  return a.rfind("127.", 0) == 0 || a.rfind("localhost:", 0) == 0 || a.rfind("[::1]", 0) == 0;
+}
+}  // namespace
+
+std::shared_ptr<grpc::Channel> make_channel(const ChannelOptions& o) {
+  grpc::ChannelArguments args;
+  // Reconnect quickly after a coordinator restart.
+  args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 200);
+  args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 2000);
+  if (!o.tls_ca.empty()) {
+    std::ifstream in(o.tls_ca);
+    if (!in) throw std::runtime_error("cannot read " + o.tls_ca);
+    std::ostringstream s;
+    s << in.rdbuf();
+    grpc::SslCredentialsOptions ssl;
+    ssl.pem_root_certs = s.str();
+    return grpc::CreateCustomChannel(o.address, grpc::SslCredentials(ssl), args);
+  }
+  if (o.insecure)
+    return grpc::CreateCustomChannel(o.address, grpc::InsecureChannelCredentials(), args);
+  if (loopback(o.address))
+    return grpc::CreateCustomChannel(o.address, grpc::experimental::LocalCredentials(LOCAL_TCP),
+                                     args);
+  throw std::invalid_argument("coordinator " + o.address +
+                              " is not on loopback: give --tls-ca, or --insecure to send the "
+                              "token in clear text");
+}
+
+std::unique_ptr<grpc::ClientContext> make_context(const ChannelOptions& o,
+                                                  double deadline_seconds) {
+  auto ctx = std::make_unique<grpc::ClientContext>();
+  if (!o.token.empty()) ctx->AddMetadata("authorization", "Bearer " + o.token);
+  ctx->set_deadline(std::chrono::system_clock::now() +
+                    std::chrono::milliseconds(static_cast<long>(deadline_seconds * 1000)));
+  return ctx;
+}
+
+}  // namespace demcal::proto

@@ -1,0 +1,27 @@
+#pragma once
+// Client side of the transport, shared by the worker and the CLI: the channel to a
+// coordinator and the bearer token on each call. The token is added as call metadata, not as
+// call credentials (Debian's gRPC 1.51 drops those on channels it considers insecure); the
+// channel uses local credentials on loopback, TLS when a CA file is given.
+#include <grpcpp/grpcpp.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+namespace demcal::proto {
+
+struct ChannelOptions {
+  std::string address;  ///< host:port
+  std::string token;
+  std::string tls_ca;     ///< PEM file of the CA that signed the coordinator's certificate
+  bool insecure = false;  ///< plain TCP (a coordinator started with --insecure)
+};
+
+std::shared_ptr<grpc::Channel> make_channel(const ChannelOptions& options);
+
+/// A context carrying the token and a deadline.
+std::unique_ptr<grpc::ClientContext> make_context(const ChannelOptions& options,
+                                                  double deadline_seconds);
+
+}  // namespace demcal::proto

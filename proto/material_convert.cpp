@@ -1,0 +1,100 @@
+#include "proto/material_convert.hpp"
+
+#include "core/common/error.hpp"
+
+namespace demcal::proto {
+namespace {
+
+contact::SlotSpec to_slot(const v1::ContactSlot& s, const std::string& fallback_model) {
+  contact::SlotSpec out;
+  out.model = s.model().empty() ? fallback_model : s.model();
+  for (const auto& [k, v] : s.params()) out.params[k] = v;
+  return out;
+}
+
+contact::ContactLawSpec to_law(const v1::ContactLaw& law, const std::string& where) {
+  if (!law.has_normal())
+    throw InputError(where + ".normal", "missing (the normal slot is required)");
+  if (!law.has_tangential())
+    throw InputError(where + ".tangential", "missing (the tangential slot is required)");
+  if (law.normal().model().empty()) throw InputError(where + ".normal.model", "missing");
+  if (law.tangential().model().empty()) throw InputError(where + ".tangential.model", "missing");
+  contact::ContactLawSpec spec;
+  spec.normal = to_slot(law.normal(), "");
+  spec.tangential = to_slot(law.tangential(), "");
+  if (law.has_cohesion()) spec.cohesion = to_slot(law.cohesion(), "none");
+  if (law.has_rolling()) spec.rolling = to_slot(law.rolling(), "none");
+  return spec;
+}
+
+/// ContactLaw::from_spec names "<where>.<slot>.<param>"; the proto path has ".params." between.
+std::string proto_path(const std::string& core_where, const std::string& base) {
+  if (core_where.rfind(base + ".", 0) != 0) return core_where;
+  std::string rest = core_where.substr(base.size() + 1);
+  const auto dot = rest.find('.');
+  if (dot == std::string::npos) return core_where;
+  const std::string slot = rest.substr(0, dot), param = rest.substr(dot + 1);
+  if (param == "model") return core_where;
+  return base + "." + slot + ".params." + param;
+}
+
+}  // namespace
+
+lab::MaterialModel to_material_model(const v1::Material& m, const std::string& where) {
+  lab::MaterialModel model;
+  if (!m.has_particle_law()) throw InputError(where + ".particle_law", "missing");
+  model.particle_law = to_law(m.particle_law(), where + ".particle_law");
+  model.wall_law =
+      m.has_wall_law() ? to_law(m.wall_law(), where + ".wall_law") : model.particle_law;
+  switch (m.sizes().kind_case()) {
+    case v1::SizeDistribution::kMonodisperse:
+      model.sizes = particles::Monodisperse{m.sizes().monodisperse().radius()};
+      break;
+    case v1::SizeDistribution::kDiscrete: {
+      particles::DiscreteClasses d;
+      d.radii.assign(m.sizes().discrete().radii().begin(), m.sizes().discrete().radii().end());
+      d.mass_fractions.assign(m.sizes().discrete().mass_fractions().begin(),
+                              m.sizes().discrete().mass_fractions().end());
+      model.sizes = d;
+      break;
+    }
+    case v1::SizeDistribution::kLognormal: {
+      const auto& l = m.sizes().lognormal();
+      model.sizes = particles::LogNormal{l.median_radius(), l.sigma_g(),
+                                         l.truncate_k() > 0 ? l.truncate_k() : 2.5};
+      break;
+    }
+    default:
+      throw InputError(where + ".sizes", "needs one of: monodisperse, discrete, lognormal");
+  }
+  model.size_scale = m.size_scale() > 0 ? m.size_scale() : 1.0;
+  if (!(m.density() > 0)) throw InputError(where + ".density", "missing or not positive");
+  model.density = m.density();
+  if (m.has_scaling()) {
+    const std::string law = m.scaling().law().empty() ? "none" : m.scaling().law();
+    model.scaling = contact::scaling_law_from_name(law, where + ".scaling.law");
+    model.scale_factor = m.scaling().factor() > 0 ? m.scaling().factor() : 1.0;
+  }
+  try {
+    model.validate();
+  } catch (const InputError& e) {
+    std::string path = proto_path(e.where(), "particle_law");
+    if (path == e.where()) path = proto_path(e.where(), "wall_law");
+    throw InputError(where + "." + path, e.message());
+  }
+  return model;
+}
+
+lab::MaterialModel job_material(const v1::JobSpec& job) {
+  lab::MaterialModel model = to_material_model(job.material(), "job.material");
+  std::map<std::string, double> ordered(job.parameters().begin(), job.parameters().end());
+  for (const auto& [path, value] : ordered) lab::set_parameter(model, path, value);
+  model.validate();
+  return model;
+}
+
+lab::Settings to_settings(const google::protobuf::Map<std::string, double>& settings) {
+  return lab::Settings(settings.begin(), settings.end());
+}
+
+}  // namespace demcal::proto

@@ -1,0 +1,24 @@
+#pragma once
+// The one conversion between the proto material (demcal.v1.Material) and the core's
+// lab::MaterialModel, used by the coordinator (validation of factor paths and bounds) and by
+// the worker (building the job's material). Metadata only: links no physics.
+#include <map>
+#include <string>
+
+#include "core/lab/catalog.hpp"
+#include "core/lab/material.hpp"
+#include "demcal/v1/worker.pb.h"
+
+namespace demcal::proto {
+
+/// Builds and validates a material model; InputError names the field below `where`
+/// ("spec.material.particle_law.normal.params.k1").
+lab::MaterialModel to_material_model(const v1::Material& material, const std::string& where);
+
+/// The material of a job: its base material with the job's parameters set (factor values and
+/// fixed parameters).
+lab::MaterialModel job_material(const v1::JobSpec& job);
+
+lab::Settings to_settings(const google::protobuf::Map<std::string, double>& settings);
+
+}  // namespace demcal::proto

@@ -1,0 +1,37 @@
+#pragma once
+// Analysis on demand: the stored results of a campaign as a response matrix in design order,
+// effects through core/doe, and calibration against the measured targets through core/calib.
+#include <Eigen/Dense>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/calib/calibration.hpp"
+#include "core/doe/analysis.hpp"
+#include "server/plan.hpp"
+#include "server/store.hpp"
+
+namespace demcal::server {
+
+std::string metrics_to_json(const std::map<std::string, double>& metrics);
+std::map<std::string, double> metrics_from_json(const std::string& json);
+
+/// One row per design row (standard order), one column per plan.responses; NaN = no result.
+Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobRow>& jobs);
+
+doe::ResponseAnalysis analyse(const CampaignPlan& plan, const Eigen::VectorXd& y,
+                              doe::ModelKind model, double alpha);
+
+struct CalibrationOutcome {
+  calib::CalibrationResult result;
+  std::vector<std::string> metrics;  ///< responses calibrated, in problem order
+};
+/// Throws InputError when there is no target or a target's response has too few results.
+CalibrationOutcome calibrate_plan(const CampaignPlan& plan, const Eigen::MatrixXd& responses,
+                                  doe::ModelKind model, int starts, std::uint64_t seed);
+
+/// Mean of each response over the done jobs of `kind` (verification runs).
+std::map<std::string, double> mean_responses(const std::vector<JobRow>& jobs,
+                                             const std::string& kind);
+
+}  // namespace demcal::server

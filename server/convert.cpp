@@ -1,0 +1,434 @@
+#include "server/convert.hpp"
+
+#include <google/protobuf/util/json_util.h>
+
+#include <cmath>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "core/common/error.hpp"
+#include "core/doe/alias_structure.hpp"
+#include "core/doe/minimum_aberration.hpp"
+#include "core/lab/catalog.hpp"
+#include "proto/material_convert.hpp"
+
+namespace demcal::server {
+namespace {
+
+std::string idx(const std::string& field, int i) {
+  return field + "[" + std::to_string(i) + "]";
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << std::setprecision(6) << v;
+  return s.str();
+}
+
+const lab::ParameterInfo* find_parameter(const std::vector<lab::ParameterInfo>& table,
+                                         const std::string& path) {
+  for (const auto& p : table)
+    if (p.path == path) return &p;
+  return nullptr;
+}
+
+std::string known_paths(const std::vector<lab::ParameterInfo>& table) {
+  std::string s;
+  for (const auto& p : table) s += (s.empty() ? "" : ", ") + p.path;
+  return s;
+}
+
+/// Applies `value` at `path` to a copy of the model and checks the result as a whole.
+void check_settable(lab::MaterialModel model, const std::string& path, double value,
+                    const std::string& where) {
+  try {
+    lab::set_parameter(model, path, value);
+    model.validate();
+  } catch (const InputError& e) {
+    throw InputError(where, e.what());
+  }
+}
+
+std::uint64_t job_seed(const v1::LabTest& t, int replicate) {
+  return (t.seed() ? t.seed() : 1) + static_cast<std::uint64_t>(replicate - 1);
+}
+
+}  // namespace
+
+std::string to_json(const google::protobuf::Message& message) {
+  std::string out;
+  google::protobuf::util::JsonPrintOptions o;
+  o.preserve_proto_field_names = true;
+  (void)google::protobuf::util::MessageToJsonString(message, &out, o);
+  return out;
+}
+
+void from_json(const std::string& json, google::protobuf::Message& message) {
+  google::protobuf::util::JsonParseOptions o;
+  o.case_insensitive_enum_parsing = true;
+  const auto status = google::protobuf::util::JsonStringToMessage(json, &message, o);
+  if (!status.ok()) throw InputError("", std::string(status.message()));
+}
+
+CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs) {
+  CampaignPlan plan;
+  if (spec.name().empty()) throw InputError("spec.name", "missing");
+  if (!spec.has_material()) throw InputError("spec.material", "missing");
+  lab::MaterialModel model = proto::to_material_model(spec.material(), "spec.material");
+
+  if (spec.tests_size() == 0) throw InputError("spec.tests", "a campaign needs at least one test");
+  std::set<std::string> seen_tests;
+  for (int i = 0; i < spec.tests_size(); ++i) {
+    const auto& t = spec.tests(i);
+    const std::string where = "spec." + idx("tests", i);
+    const lab::LabTestInfo* info = nullptr;
+    try {
+      info = &lab::find_lab_info(t.test());
+    } catch (const InputError& e) {
+      throw InputError(where + ".test", e.message());
+    }
+    if (!seen_tests.insert(t.test()).second)
+      throw InputError(where + ".test", "test '" + t.test() + "' appears twice");
+    lab::validate_settings(*info, proto::to_settings(t.settings()), where + ".settings");
+    if (t.threads() < 0) throw InputError(where + ".threads", "must be >= 0");
+    plan.tests.push_back(t.test());
+    for (const auto& m : info->metrics) plan.responses.push_back(t.test() + "." + m.name);
+  }
+
+  {
+    std::map<std::string, double> fixed(spec.fixed().begin(), spec.fixed().end());
+    for (const auto& [path, value] : fixed) {
+      const std::string where = "spec.fixed." + path;
+      if (!find_parameter(lab::parameters(model), path))
+        throw InputError(where, "not a parameter of this material model (known: " +
+                                    known_paths(lab::parameters(model)) + ")");
+      check_settable(model, path, value, where);
+      lab::set_parameter(model, path, value);
+    }
+  }
+
+  const auto table = lab::parameters(model);
+  if (spec.factors_size() == 0) throw InputError("spec.factors", "a campaign needs factors");
+  if (spec.factors_size() > doe::kMaxFactors)
+    throw InputError("spec.factors", "at most " + std::to_string(doe::kMaxFactors) + " factors");
+  std::set<std::string> seen;
+  for (int i = 0; i < spec.factors_size(); ++i) {
+    const auto& f = spec.factors(i);
+    const std::string where = "spec." + idx("factors", i);
+    const auto* info = find_parameter(table, f.path());
+    if (!info)
+      throw InputError(where + ".path", "'" + f.path() +
+                                            "' is not a parameter of this material model (known: " +
+                                            known_paths(table) + ")");
+    if (spec.fixed().count(f.path()))
+      throw InputError(where + ".path", "'" + f.path() + "' is also in spec.fixed");
+    if (!seen.insert(f.path()).second)
+      throw InputError(where + ".path", "'" + f.path() + "' is a factor twice");
+    if (!(f.low() < f.high()))
+      throw InputError(where + ".high", "must be above low (" + fmt(f.low()) + ")");
+    if (f.low() < info->lo)
+      throw InputError(where + ".low", fmt(f.low()) + " is below the valid range [" +
+                                           fmt(info->lo) + ", " + fmt(info->hi) + "] " +
+                                           info->unit);
+    if (f.high() > info->hi)
+      throw InputError(where + ".high", fmt(f.high()) + " is above the valid range [" +
+                                            fmt(info->lo) + ", " + fmt(info->hi) + "] " +
+                                            info->unit);
+    const bool log = f.scale() == v1::Factor::LOG;
+    if (log && !(f.low() > 0)) throw InputError(where + ".low", "must be > 0 on a log scale");
+    check_settable(model, f.path(), f.low(), where + ".low");
+    check_settable(model, f.path(), f.high(), where + ".high");
+    plan.factors.push_back(
+        {f.path(), doe::Factor{f.name().empty() ? f.path() : f.name(), f.low(), f.high(),
+                               log ? doe::Scale::kLog : doe::Scale::kLinear}});
+  }
+
+  const int k = spec.factors_size();
+  const auto& d = spec.design();
+  const int full = 1 << k;
+  int runs = d.runs() ? d.runs() : full;
+  if (d.type() == v1::Design::FULL_FACTORIAL) {
+    if (d.runs() && d.runs() != full)
+      throw InputError("spec.design.runs", "a full factorial of " + std::to_string(k) +
+                                               " factors has " + std::to_string(full) + " runs");
+    runs = full;
+  }
+  if (runs < 2 || (runs & (runs - 1)) != 0 || runs > full)
+    throw InputError("spec.design.runs", std::to_string(runs) + " is not a power of two in [2, 2^" +
+                                             std::to_string(k) + "]");
+  if (runs <= k)
+    throw InputError("spec.design.runs", std::to_string(runs) + " runs cannot estimate " +
+                                             std::to_string(k) + " main effects (need at least " +
+                                             std::to_string(k + 1) + ")");
+  if (d.centre_points() < 0) throw InputError("spec.design.centre_points", "must be >= 0");
+  if (d.replicates() < 0) throw InputError("spec.design.replicates", "must be >= 0");
+  try {
+    if (!d.generators().empty()) {
+      plan.design = doe::fractional_factorial(k, d.generators());
+      if (plan.design.runs() != runs)
+        throw InputError("", "the generators give " + std::to_string(plan.design.runs()) +
+                                 " runs, not " + std::to_string(runs));
+    } else {
+      plan.design = runs == full ? doe::full_factorial(k) : doe::minimum_aberration_design(k, runs);
+    }
+  } catch (const InputError& e) {
+    throw InputError(d.generators().empty() ? "spec.design.runs" : "spec.design.generators",
+                     e.message());
+  }
+  for (std::size_t i = 0; i < plan.factors.size(); ++i)
+    plan.design.factor_names[i] = plan.factors[i].factor.name;
+  doe::add_centre_points(plan.design, d.centre_points());
+  doe::replicate_runs(plan.design, d.replicates() ? d.replicates() : 1);
+  if (d.seed()) doe::randomise_run_order(plan.design, d.seed());
+
+  for (int i = 0; i < spec.measurements_size(); ++i) {
+    const auto& m = spec.measurements(i);
+    const std::string where = "spec." + idx("measurements", i);
+    std::vector<std::string> matches;
+    for (const auto& r : plan.responses) {
+      const auto dot = r.find('.');
+      if (r.substr(dot + 1) == m.metric() && (m.test().empty() || r.substr(0, dot) == m.test()))
+        matches.push_back(r);
+    }
+    if (!m.test().empty() && !seen_tests.count(m.test()))
+      throw InputError(where + ".test", "'" + m.test() + "' is not one of the campaign's tests");
+    if (matches.empty())
+      throw InputError(where + ".metric", "no test of the campaign reports '" + m.metric() + "'");
+    if (matches.size() > 1)
+      throw InputError(where + ".test",
+                       "metric '" + m.metric() + "' is reported by several tests: name the test");
+    if (!std::isfinite(m.value()) || m.value() == 0.0)
+      throw InputError(where + ".value", "must be finite and non-zero (errors are relative)");
+    if (m.uncertainty() < 0) throw InputError(where + ".uncertainty", "must be >= 0");
+    if (m.weight() < 0) throw InputError(where + ".weight", "must be >= 0");
+    Target t{matches.front(), m.value(), m.weight() > 0 ? m.weight() : 1.0, std::nullopt,
+             m.source()};
+    if (m.uncertainty() > 0) t.uncertainty = m.uncertainty();
+    plan.targets.push_back(t);
+  }
+
+  // One job per design row and test.
+  for (int r = 0; r < plan.design.runs(); ++r) {
+    for (const auto& t : spec.tests()) {
+      v1::JobSpec job;
+      job.set_campaign_id(0);
+      job.set_test(t.test());
+      *job.mutable_settings() = t.settings();
+      *job.mutable_material() = spec.material();
+      *job.mutable_parameters() = spec.fixed();
+      for (std::size_t f = 0; f < plan.factors.size(); ++f)
+        (*job.mutable_parameters())[plan.factors[f].path] =
+            plan.factors[f].factor.to_natural(plan.design.coded(r, Eigen::Index(f)));
+      job.set_seed(job_seed(t, plan.design.replicate[std::size_t(r)]));
+      job.set_threads(t.threads());
+      jobs.push_back(
+          {r + 1, plan.design.run_order[std::size_t(r)], t.test(), "design", to_json(job)});
+    }
+  }
+  return plan;
+}
+
+std::vector<NewJob> verification_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
+                                      const Eigen::VectorXd& natural) {
+  std::vector<NewJob> jobs;
+  int order = 0;
+  for (const auto& t : spec.tests()) {
+    v1::JobSpec job;
+    job.set_test(t.test());
+    *job.mutable_settings() = t.settings();
+    *job.mutable_material() = spec.material();
+    *job.mutable_parameters() = spec.fixed();
+    for (std::size_t f = 0; f < plan.factors.size(); ++f)
+      (*job.mutable_parameters())[plan.factors[f].path] = natural(Eigen::Index(f));
+    job.set_seed(job_seed(t, 1));
+    job.set_threads(t.threads());
+    jobs.push_back({0, ++order, t.test(), "verify", to_json(job)});
+  }
+  return jobs;
+}
+
+std::vector<std::string> factor_legend(const CampaignPlan& plan) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < plan.factors.size(); ++i) {
+    const auto& f = plan.factors[i];
+    std::string s = std::string(1, doe::factor_letter(int(i))) + "=" + f.factor.name;
+    if (f.factor.name != f.path) s += " (" + f.path + ")";
+    s += " [" + fmt(f.factor.low) + ", " + fmt(f.factor.high) + "]";
+    if (f.factor.scale == doe::Scale::kLog) s += " log";
+    out.push_back(s);
+  }
+  return out;
+}
+
+v1::DesignSummary design_summary(const CampaignPlan& plan, int jobs) {
+  v1::DesignSummary s;
+  const auto a = doe::analyse_aliasing(plan.design.coded);
+  s.set_description(plan.design.description);
+  s.set_runs(plan.design.runs());
+  s.set_jobs(jobs);
+  s.set_resolution(doe::resolution_name(a.resolution));
+  s.set_generators(doe::generators_text(plan.design));
+  for (const auto& w : a.defining_relation) s.add_defining_relation(doe::word_name(w));
+  for (const auto& c : a.two_factor_chains) s.add_two_factor_alias_chains(doe::chain_name(c));
+  for (const auto& c : a.main_effect_chains) s.add_main_effect_alias_chains(doe::chain_name(c));
+  for (const auto w : a.clear_two_factor) s.add_clear_two_factor_interactions(doe::word_name(w));
+  for (const auto& l : factor_legend(plan)) s.add_factor_letters(l);
+  return s;
+}
+
+v1::DesignReply design_reply(const CampaignPlan& plan, int jobs) {
+  v1::DesignReply r;
+  *r.mutable_summary() = design_summary(plan, jobs);
+  for (const auto& f : plan.factors) r.add_factors(f.path);
+  const auto& d = plan.design;
+  for (int row : d.rows_in_run_order()) {
+    auto* run = r.add_runs();
+    run->set_std_order(row + 1);
+    run->set_run_order(d.run_order[std::size_t(row)]);
+    run->set_point_type(doe::to_string(d.point_type[std::size_t(row)]));
+    run->set_replicate(d.replicate[std::size_t(row)]);
+    for (int c = 0; c < d.factors(); ++c) {
+      run->add_coded(d.coded(row, c));
+      run->add_natural(plan.factors[std::size_t(c)].factor.to_natural(d.coded(row, c)));
+    }
+  }
+  return r;
+}
+
+v1::Progress progress_message(const CampaignRow& row, const Counts& c, double now) {
+  v1::Progress p;
+  p.set_queued(c.queued);
+  p.set_leased(c.leased);
+  p.set_done(c.done);
+  p.set_failed(c.failed);
+  p.set_cancelled(c.cancelled);
+  p.set_total(c.total());
+  const double end = row.finished > 0 ? row.finished : now;
+  const double elapsed = std::max(0.0, end - row.created);
+  p.set_elapsed_seconds(elapsed);
+  const auto finished = c.done + c.failed;
+  const auto remaining = c.queued + c.leased;
+  p.set_eta_seconds(remaining == 0 ? 0.0
+                    : finished > 0 ? elapsed / double(finished) * double(remaining)
+                                   : -1.0);
+  return p;
+}
+
+v1::Campaign campaign_message(const CampaignRow& row, const Counts& counts, double now,
+                              bool with_spec) {
+  v1::Campaign c;
+  c.set_id(row.id);
+  c.set_name(row.name);
+  c.set_state(row.state == "running"     ? v1::RUNNING
+              : row.state == "done"      ? v1::DONE
+              : row.state == "cancelled" ? v1::CANCELLED
+                                         : v1::CAMPAIGN_STATE_UNSPECIFIED);
+  *c.mutable_progress() = progress_message(row, counts, now);
+  const auto t = static_cast<std::time_t>(row.created);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  c.set_created_at(buf);
+  if (with_spec) from_json(row.spec_json, *c.mutable_spec());
+  return c;
+}
+
+v1::JobResult job_message(const JobRow& job) {
+  v1::JobResult r;
+  r.set_job_id(job.id);
+  r.set_std_order(job.std_order);
+  r.set_test(job.test);
+  r.set_kind(job.kind);
+  r.set_state(job.state);
+  r.set_attempt(job.attempt);
+  if (job.metrics_json)
+    for (const auto& [k, v] : metrics_from_json(*job.metrics_json)) (*r.mutable_metrics())[k] = v;
+  r.set_error(job.error);
+  r.set_worker(job.worker);
+  r.set_wall_seconds(job.wall_seconds);
+  return r;
+}
+
+v1::MetricEffects effects_message(const std::string& response, const doe::ResponseAnalysis& a) {
+  v1::MetricEffects m;
+  m.set_metric(response);
+  m.set_runs_used(a.balance.runs_used);
+  m.set_runs_total(a.balance.runs_total);
+  std::vector<const doe::EffectEstimate*> by_size;
+  for (const auto& e : a.effects) by_size.push_back(&e);
+  std::stable_sort(by_size.begin(), by_size.end(),
+                   [](auto x, auto y) { return std::abs(x->effect) > std::abs(y->effect); });
+  for (const auto* e : by_size) {
+    auto* o = m.add_effects();
+    o->set_chain(e->term.name());
+    o->set_effect(e->effect);
+    o->set_active_me(e->active);
+    o->set_active_sme(e->active_simultaneous);
+  }
+  if (a.lenth) {
+    m.set_pse(a.lenth->pse);
+    m.set_me(a.lenth->me);
+    m.set_sme(a.lenth->sme);
+    m.set_lenth_df(a.lenth->degrees_of_freedom);
+  }
+  m.set_intercept(a.fit.intercept);
+  for (std::size_t i = 0; i < a.fit.terms.size(); ++i) {
+    auto* c = m.add_coefficients();
+    c->set_chain(a.fit.terms[i].name());
+    c->set_coefficient(a.fit.coefficients(Eigen::Index(i)));
+    c->set_standard_error(a.fit.standard_errors.size() ? a.fit.standard_errors(Eigen::Index(i))
+                                                       : std::nan(""));
+  }
+  m.set_r_squared(a.fit.r_squared);
+  m.set_curvature_available(a.curvature.available);
+  m.set_curvature_p(a.curvature.p_value);
+  m.set_curvature_significant(a.curvature.significant);
+  for (const auto& n : a.notes) m.add_notes(n);
+  return m;
+}
+
+std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
+                            const std::vector<JobRow>& jobs, const std::string& format) {
+  const Eigen::MatrixXd y = response_matrix(plan, jobs);
+  const auto& d = plan.design;
+  if (format == "csv") {
+    std::ostringstream s;
+    s << std::setprecision(10) << "run,std_order,point_type,replicate";
+    for (const auto& f : plan.factors) s << "," << f.factor.name;
+    for (const auto& r : plan.responses) s << "," << r;
+    s << "\n";
+    for (int r : d.rows_in_run_order()) {
+      s << d.run_order[std::size_t(r)] << "," << r + 1 << ","
+        << doe::to_string(d.point_type[std::size_t(r)]) << "," << d.replicate[std::size_t(r)];
+      for (std::size_t f = 0; f < plan.factors.size(); ++f)
+        s << "," << plan.factors[f].factor.to_natural(d.coded(r, Eigen::Index(f)));
+      for (Eigen::Index c = 0; c < y.cols(); ++c) {
+        s << ",";
+        if (std::isfinite(y(r, c)))
+          s << y(r, c);
+        else
+          s << "NA";
+      }
+      s << "\n";
+    }
+    return s.str();
+  }
+  nlohmann::json j;
+  j["id"] = row.id;
+  j["name"] = row.name;
+  j["state"] = row.state;
+  j["spec"] = nlohmann::json::parse(row.spec_json);
+  j["design"] = nlohmann::json::parse(plan_to_json(plan));
+  for (const auto& job : jobs) {
+    nlohmann::json o = {
+        {"job_id", job.id},   {"std_order", job.std_order}, {"test", job.test},
+        {"kind", job.kind},   {"state", job.state},         {"attempt", job.attempt},
+        {"error", job.error}, {"worker", job.worker},       {"wall_seconds", job.wall_seconds}};
+    if (job.metrics_json) o["metrics"] = nlohmann::json::parse(*job.metrics_json);
+    j["jobs"].push_back(o);
+  }
+  return j.dump(2);
+}
+
+}  // namespace demcal::server

@@ -1,0 +1,42 @@
+#pragma once
+// The coordinator's edge: proto messages in, domain values out, and back. Nothing else in
+// server/ reads a proto field for domain logic.
+#include <string>
+#include <vector>
+
+#include "core/doe/analysis.hpp"
+#include "demcal/v1/worker.pb.h"
+#include "server/analysis.hpp"
+#include "server/plan.hpp"
+#include "server/store.hpp"
+
+namespace demcal::server {
+
+/// Validates a spec and plans it; InputError names the field ("spec.factors[2].high").
+/// Factor paths must exist in the material's parameter table (lab::parameters) with bounds
+/// inside the valid range; tests, settings and measured metrics must exist in the catalogue.
+CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs);
+
+/// Jobs that simulate each test at one parameter set (verification of a calibration).
+std::vector<NewJob> verification_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
+                                      const Eigen::VectorXd& natural);
+
+v1::DesignSummary design_summary(const CampaignPlan& plan, int jobs);
+v1::DesignReply design_reply(const CampaignPlan& plan, int jobs);
+v1::Campaign campaign_message(const CampaignRow& row, const Counts& counts, double now,
+                              bool with_spec);
+v1::Progress progress_message(const CampaignRow& row, const Counts& counts, double now);
+v1::JobResult job_message(const JobRow& job);
+v1::MetricEffects effects_message(const std::string& response, const doe::ResponseAnalysis& a);
+std::vector<std::string> factor_legend(const CampaignPlan& plan);
+
+std::string to_json(const google::protobuf::Message& message);
+/// Parses JSON into a message; InputError on unknown fields or bad values.
+void from_json(const std::string& json, google::protobuf::Message& message);
+
+/// The whole campaign (spec, design, runs, results) as JSON, or as a CSV of the design in
+/// natural units plus one column per response (readable by `demcal analyze`).
+std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
+                            const std::vector<JobRow>& jobs, const std::string& format);
+
+}  // namespace demcal::server

@@ -1,0 +1,89 @@
+#include "server/coordinator.hpp"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <spdlog/spdlog.h>
+
+#include <stdexcept>
+
+#include "server/auth.hpp"
+
+namespace demcal::server {
+
+Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(options)) {
+  if (options_.lease_seconds <= 0 || options_.heartbeat_seconds <= 0 ||
+      options_.heartbeat_seconds >= options_.lease_seconds)
+    throw std::invalid_argument("need 0 < heartbeat < lease (got heartbeat " +
+                                std::to_string(options_.heartbeat_seconds) + " s, lease " +
+                                std::to_string(options_.lease_seconds) + " s)");
+  if (options_.max_attempts < 1) throw std::invalid_argument("max attempts must be >= 1");
+  if (options_.token.empty() && !is_loopback(options_.listen))
+    throw std::invalid_argument("a coordinator listening beyond loopback needs --token");
+  store_ = std::make_unique<Store>(options_.db,
+                                   StoreLimits{options_.lease_seconds, options_.max_attempts});
+  ServiceConfig config{options_.token, options_.heartbeat_seconds,
+                       std::min(1.0, options_.heartbeat_seconds)};
+  campaigns_ = std::make_unique<CampaignServiceImpl>(*store_, config, stopping_);
+  workers_ = std::make_unique<WorkerServiceImpl>(*store_, config);
+
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder builder;
+  const auto creds =
+      server_credentials(options_.listen, options_.tls_cert, options_.tls_key, options_.insecure);
+  if (options_.insecure)
+    spdlog::warn("listening on {} without TLS: tokens and data travel in clear text",
+                 options_.listen);
+  builder.AddListeningPort(options_.listen, creds, &port_);
+  builder.RegisterService(campaigns_.get());
+  builder.RegisterService(workers_.get());
+  server_ = builder.BuildAndStart();
+  if (!server_ || port_ == 0) throw std::runtime_error("cannot listen on " + options_.listen);
+  if (auto* health = server_->GetHealthCheckService()) health->SetServingStatus(true);
+  spdlog::info("coordinator on port {} (db {}, lease {} s, heartbeat {} s, {} attempts{})", port_,
+               options_.db, options_.lease_seconds, options_.heartbeat_seconds,
+               options_.max_attempts, options_.token.empty() ? ", NO AUTH" : "");
+  for (const auto& c : store_->campaigns())
+    if (c.state == "running") spdlog::info("resuming campaign {} '{}'", c.id, c.name);
+  reaper_ = std::thread([this] { reap_loop(); });
+}
+
+Coordinator::~Coordinator() {
+  shutdown();
+}
+
+void Coordinator::reap_loop() {
+  std::unique_lock lock(mutex_);
+  while (!shut_) {
+    lock.unlock();
+    try {
+      if (const int n = store_->reap(now_seconds()); n > 0)
+        spdlog::warn("reaper: {} expired lease(s) returned to the queue or failed", n);
+    } catch (const std::exception& e) {
+      spdlog::error("reaper: {}", e.what());
+    }
+    lock.lock();
+    cv_.wait_for(lock, std::chrono::duration<double>(options_.reaper_seconds),
+                 [this] { return shut_; });
+  }
+}
+
+void Coordinator::shutdown() {
+  {
+    std::lock_guard lock(mutex_);
+    if (shut_) return;
+    shut_ = true;
+  }
+  cv_.notify_all();
+  stopping_ = true;
+  if (auto* health = server_->GetHealthCheckService()) health->SetServingStatus(false);
+  server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+  if (reaper_.joinable()) reaper_.join();
+  spdlog::info("coordinator stopped");
+}
+
+void Coordinator::wait() {
+  server_->Wait();
+}
+
+}  // namespace demcal::server

@@ -1,0 +1,56 @@
+#pragma once
+// The coordinator: the store, the two services, grpc.health.v1, reflection and the lease
+// reaper, wired into one gRPC server. Used by `demcal-server` and by `demcal run`.
+#include <grpcpp/grpcpp.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "server/services.hpp"
+#include "server/store.hpp"
+
+namespace demcal::server {
+
+struct CoordinatorOptions {
+  std::string listen = "127.0.0.1:7311";  ///< port 0 picks a free one (see port())
+  std::string db = "demcal.db";
+  std::string token;  ///< empty: no auth (only allowed on loopback)
+  double lease_seconds = 60.0;
+  double heartbeat_seconds = 10.0;
+  double reaper_seconds = 1.0;
+  int max_attempts = 3;
+  std::string tls_cert, tls_key;
+  bool insecure = false;  ///< plain TCP (behind a trusted network or a TLS-terminating proxy)
+};
+
+class Coordinator {
+ public:
+  /// Opens the store, starts serving and the reaper; throws on a bad option or address.
+  explicit Coordinator(CoordinatorOptions options);
+  ~Coordinator();
+  int port() const { return port_; }
+  Store& store() { return *store_; }
+  /// Stops accepting calls, ends watches, waits for handlers and stops the reaper.
+  void shutdown();
+  void wait();
+
+ private:
+  void reap_loop();
+  CoordinatorOptions options_;
+  std::unique_ptr<Store> store_;
+  std::atomic<bool> stopping_{false};
+  std::unique_ptr<CampaignServiceImpl> campaigns_;
+  std::unique_ptr<WorkerServiceImpl> workers_;
+  std::unique_ptr<grpc::Server> server_;
+  int port_ = 0;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::thread reaper_;
+  bool shut_ = false;
+};
+
+}  // namespace demcal::server

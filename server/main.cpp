@@ -1,0 +1,59 @@
+// demcal-server: the coordinator. main only wires: flags, the coordinator, wait for a signal.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <csignal>
+#include <cstdlib>
+#include <fstream>
+
+#include "server/coordinator.hpp"
+
+int main(int argc, char** argv) {
+  demcal::server::CoordinatorOptions o;
+  std::string port_file, token_file;
+  CLI::App app{"demcal-server - the calibration coordinator (SQLite store, gRPC services)"};
+  app.add_option("--listen", o.listen, "address:port (port 0 = any free port)")
+      ->capture_default_str();
+  app.add_option("--db", o.db, "SQLite file")->capture_default_str();
+  app.add_option("--token", o.token, "bearer token workers and clients must send")
+      ->envname("DEMCAL_TOKEN");
+  app.add_option("--token-file", token_file, "read the token from a file");
+  app.add_option("--lease", o.lease_seconds, "lease duration (s)")->capture_default_str();
+  app.add_option("--heartbeat", o.heartbeat_seconds, "heartbeat interval asked of workers (s)")
+      ->capture_default_str();
+  app.add_option("--reaper-interval", o.reaper_seconds, "how often expired leases are reaped (s)")
+      ->capture_default_str();
+  app.add_option("--max-attempts", o.max_attempts, "leases per job before it fails")
+      ->capture_default_str();
+  app.add_option("--tls-cert", o.tls_cert, "PEM certificate chain (enables TLS)");
+  app.add_option("--tls-key", o.tls_key, "PEM private key");
+  app.add_flag("--insecure", o.insecure, "plain TCP: tokens and data in clear text");
+  app.add_option("--port-file", port_file, "write the port listened on to this file");
+  CLI11_PARSE(app, argc, argv);
+  if (!token_file.empty()) {
+    std::ifstream in(token_file);
+    std::getline(in, o.token);
+  }
+  // Signals are taken synchronously by this thread; every other thread inherits the mask.
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  try {
+    demcal::server::Coordinator coordinator(o);
+    if (!port_file.empty()) {
+      const std::string tmp = port_file + ".tmp";
+      std::ofstream(tmp) << coordinator.port() << "\n";
+      std::rename(tmp.c_str(), port_file.c_str());
+    }
+    int sig = 0;
+    sigwait(&set, &sig);
+    spdlog::info("signal {}: shutting down", sig);
+    coordinator.shutdown();
+  } catch (const std::exception& e) {
+    spdlog::critical("{}", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,38 @@
+#pragma once
+// A validated campaign in domain terms: the factors (parameter paths with their doe::Factor
+// boxes), the design, the responses (test.metric) and the measured targets. Built from the
+// proto spec in convert.cpp; stored as JSON in campaigns.design_json so that analysis after a
+// restart uses exactly the design that was run.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/doe/design.hpp"
+#include "core/doe/factor.hpp"
+
+namespace demcal::server {
+
+struct PlannedFactor {
+  std::string path;
+  doe::Factor factor;  ///< factor.name = the label shown in tables
+};
+
+struct Target {
+  std::string response;  ///< test.metric
+  double value = 0.0, weight = 1.0;
+  std::optional<double> uncertainty;
+  std::string source;
+};
+
+struct CampaignPlan {
+  std::vector<PlannedFactor> factors;
+  doe::Design design;
+  std::vector<std::string> tests;
+  std::vector<std::string> responses;  ///< test.metric, tests in spec order
+  std::vector<Target> targets;
+};
+
+std::string plan_to_json(const CampaignPlan& plan);
+CampaignPlan plan_from_json(const std::string& json);
+
+}  // namespace demcal::server

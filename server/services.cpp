@@ -1,0 +1,315 @@
+#include "server/services.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <thread>
+
+#include "core/common/error.hpp"
+#include "server/analysis.hpp"
+#include "server/auth.hpp"
+#include "server/convert.hpp"
+
+namespace demcal::server {
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+namespace {
+
+grpc::Status invalid(const InputError& e) {
+  return {grpc::StatusCode::INVALID_ARGUMENT, e.what()};
+}
+grpc::Status not_found(std::int64_t id) {
+  return {grpc::StatusCode::NOT_FOUND, "no campaign " + std::to_string(id)};
+}
+grpc::Status internal(const std::exception& e) {
+  spdlog::error("internal error: {}", e.what());
+  return {grpc::StatusCode::INTERNAL, e.what()};
+}
+
+#define DEMCAL_AUTHORIZE(ctx)                                    \
+  if (auto s = authorize(*(ctx), config_.token); !s.ok()) {      \
+    spdlog::warn("unauthenticated call from {}", (ctx)->peer()); \
+    return s;                                                    \
+  }
+
+doe::ModelKind model_kind(const std::string& text, const std::string& where) {
+  return text.empty() ? doe::ModelKind::kTwoFactor : doe::parse_model_kind(text, where);
+}
+
+}  // namespace
+
+grpc::Status CampaignServiceImpl::Submit(grpc::ServerContext* ctx, const v1::SubmitRequest* req,
+                                         v1::SubmitReply* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  try {
+    std::vector<NewJob> jobs;
+    const CampaignPlan plan = plan_campaign(req->spec(), jobs);
+    const auto id = store_.create_campaign(req->spec().name(), to_json(req->spec()),
+                                           plan_to_json(plan), jobs, now_seconds());
+    reply->set_id(id);
+    *reply->mutable_design() = design_summary(plan, int(jobs.size()));
+    spdlog::info("campaign {} '{}' submitted: {} runs, {} jobs", id, req->spec().name(),
+                 plan.design.runs(), jobs.size());
+    return grpc::Status::OK;
+  } catch (const InputError& e) {
+    spdlog::info("submit rejected: {}", e.what());
+    return invalid(e);
+  } catch (const std::exception& e) {
+    return internal(e);
+  }
+}
+
+grpc::Status CampaignServiceImpl::Get(grpc::ServerContext* ctx, const v1::GetRequest* req,
+                                      v1::Campaign* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  const auto row = store_.campaign(req->id());
+  if (!row) return not_found(req->id());
+  *reply = campaign_message(*row, store_.counts(row->id), now_seconds(), true);
+  return grpc::Status::OK;
+}
+
+grpc::Status CampaignServiceImpl::List(grpc::ServerContext* ctx, const v1::ListRequest*,
+                                       v1::ListReply* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  const double now = now_seconds();
+  for (const auto& row : store_.campaigns())
+    *reply->add_campaigns() = campaign_message(row, store_.counts(row.id), now, false);
+  return grpc::Status::OK;
+}
+
+grpc::Status CampaignServiceImpl::Cancel(grpc::ServerContext* ctx, const v1::CancelRequest* req,
+                                         v1::Campaign* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  if (!store_.cancel(req->id(), now_seconds())) return not_found(req->id());
+  spdlog::info("campaign {} cancelled", req->id());
+  const auto row = store_.campaign(req->id());
+  *reply = campaign_message(*row, store_.counts(row->id), now_seconds(), false);
+  return grpc::Status::OK;
+}
+
+grpc::Status CampaignServiceImpl::Watch(grpc::ServerContext* ctx, const v1::WatchRequest* req,
+                                        grpc::ServerWriter<v1::Progress>* writer) {
+  DEMCAL_AUTHORIZE(ctx);
+  const double interval = req->interval_seconds() > 0 ? req->interval_seconds() : 0.5;
+  std::string last;
+  double last_sent = 0.0;
+  while (!ctx->IsCancelled() && !stopping_) {
+    const auto row = store_.campaign(req->id());
+    if (!row) return not_found(req->id());
+    const double now = now_seconds();
+    const v1::Progress p = progress_message(*row, store_.counts(row->id), now);
+    v1::Progress key = p;
+    key.clear_elapsed_seconds();
+    key.clear_eta_seconds();
+    const std::string k = key.SerializeAsString();
+    if (k != last || now - last_sent > 5.0) {
+      if (!writer->Write(p)) return grpc::Status::OK;
+      last = k;
+      last_sent = now;
+    }
+    if (row->state != "running") return grpc::Status::OK;
+    std::this_thread::sleep_for(std::chrono::duration<double>(interval));
+  }
+  return {grpc::StatusCode::CANCELLED, "watch ended"};
+}
+
+grpc::Status CampaignServiceImpl::GetDesign(grpc::ServerContext* ctx, const v1::GetRequest* req,
+                                            v1::DesignReply* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  const auto row = store_.campaign(req->id());
+  if (!row) return not_found(req->id());
+  *reply = design_reply(plan_from_json(row->design_json), int(store_.counts(row->id).total()));
+  return grpc::Status::OK;
+}
+
+grpc::Status CampaignServiceImpl::GetResults(grpc::ServerContext* ctx, const v1::GetRequest* req,
+                                             v1::ResultsReply* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  if (!store_.campaign(req->id())) return not_found(req->id());
+  for (const auto& job : store_.jobs(req->id())) *reply->add_jobs() = job_message(job);
+  return grpc::Status::OK;
+}
+
+grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
+                                             const v1::EffectsRequest* req,
+                                             v1::EffectsReply* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  const auto row = store_.campaign(req->id());
+  if (!row) return not_found(req->id());
+  try {
+    const CampaignPlan plan = plan_from_json(row->design_json);
+    const Eigen::MatrixXd y = response_matrix(plan, store_.jobs(row->id));
+    const auto kind = model_kind(req->model(), "model");
+    const double alpha = req->alpha() > 0 ? req->alpha() : 0.05;
+    for (const auto& l : factor_legend(plan)) reply->add_factor_letters(l);
+    for (std::size_t c = 0; c < plan.responses.size(); ++c) {
+      const Eigen::VectorXd col = y.col(Eigen::Index(c));
+      if (!col.array().isFinite().any()) {
+        auto* m = reply->add_metrics();
+        m->set_metric(plan.responses[c]);
+        m->set_runs_total(plan.design.runs());
+        m->add_notes("no results yet");
+        continue;
+      }
+      try {
+        *reply->add_metrics() = effects_message(plan.responses[c], analyse(plan, col, kind, alpha));
+      } catch (const InputError& e) {
+        auto* m = reply->add_metrics();
+        m->set_metric(plan.responses[c]);
+        m->add_notes(std::string("not analysable yet: ") + e.what());
+      }
+    }
+    return grpc::Status::OK;
+  } catch (const InputError& e) {
+    return invalid(e);
+  } catch (const std::exception& e) {
+    return internal(e);
+  }
+}
+
+grpc::Status CampaignServiceImpl::Calibrate(grpc::ServerContext* ctx,
+                                            const v1::CalibrateRequest* req,
+                                            v1::CalibrateReply* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  const auto row = store_.campaign(req->id());
+  if (!row) return not_found(req->id());
+  try {
+    const CampaignPlan plan = plan_from_json(row->design_json);
+    const auto jobs = store_.jobs(row->id);
+    const auto kind = model_kind(req->model(), "model");
+    CalibrationOutcome out;
+    try {
+      out = calibrate_plan(plan, response_matrix(plan, jobs), kind,
+                           req->starts() > 0 ? req->starts() : 16, req->seed() ? req->seed() : 1);
+    } catch (const InputError& e) {
+      return {grpc::StatusCode::FAILED_PRECONDITION, e.what()};
+    }
+    const auto& r = out.result;
+    for (std::size_t f = 0; f < plan.factors.size(); ++f) {
+      (*reply->mutable_proposed())[plan.factors[f].path] = r.natural(Eigen::Index(f));
+      reply->add_factor_paths(plan.factors[f].path);
+      reply->add_proposed_values(r.natural(Eigen::Index(f)));
+    }
+    reply->set_objective(r.objective);
+    // One verification round per campaign: the proposal is deterministic for a seed.
+    std::vector<std::int64_t> verify_ids;
+    for (const auto& j : jobs)
+      if (j.kind == "verify") verify_ids.push_back(j.id);
+    if (req->verify() && verify_ids.empty()) {
+      v1::CampaignSpec spec;
+      from_json(row->spec_json, spec);
+      verify_ids = store_.add_jobs(row->id, verification_jobs(spec, plan, r.natural));
+      spdlog::info("campaign {}: {} verification jobs queued", row->id, verify_ids.size());
+    }
+    for (const auto id : verify_ids) reply->add_verification_jobs(id);
+    const auto vc = store_.counts(row->id, "verify");
+    reply->set_verification_state(vc.total() == 0             ? "none"
+                                  : vc.queued + vc.leased > 0 ? "running"
+                                                              : "done");
+    const auto simulated = mean_responses(store_.jobs(row->id), "verify");
+    for (const auto& m : r.metrics) {
+      auto* o = reply->add_metrics();
+      o->set_metric(m.name);
+      o->set_target(m.target);
+      o->set_predicted(m.predicted);
+      o->set_relative_error(m.relative_error);
+      o->set_envelope_min(m.envelope.min);
+      o->set_envelope_max(m.envelope.max);
+      o->set_reachable(m.reachable);
+      o->set_statement(m.statement);
+      if (const auto it = simulated.find(m.name); it != simulated.end()) {
+        o->set_simulated_available(true);
+        o->set_simulated(it->second);
+      }
+    }
+    return grpc::Status::OK;
+  } catch (const InputError& e) {
+    return invalid(e);
+  } catch (const std::exception& e) {
+    return internal(e);
+  }
+}
+
+grpc::Status CampaignServiceImpl::Export(grpc::ServerContext* ctx, const v1::ExportRequest* req,
+                                         v1::ExportReply* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  const auto row = store_.campaign(req->id());
+  if (!row) return not_found(req->id());
+  const std::string format = req->format().empty() ? "json" : req->format();
+  if (format != "json" && format != "csv")
+    return {grpc::StatusCode::INVALID_ARGUMENT, "format: expected csv or json"};
+  reply->set_format(format);
+  reply->set_content(
+      export_campaign(*row, plan_from_json(row->design_json), store_.jobs(row->id), format));
+  return grpc::Status::OK;
+}
+
+// ---- WorkerService ----
+
+grpc::Status WorkerServiceImpl::Lease(grpc::ServerContext* ctx, const v1::LeaseRequest* req,
+                                      v1::LeaseReply* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  reply->set_lease_seconds(store_.limits().lease_seconds);
+  reply->set_heartbeat_seconds(config_.heartbeat_seconds);
+  reply->set_retry_after_seconds(config_.idle_retry_seconds);
+  const auto job = store_.lease(req->worker(), now_seconds());
+  if (!job) return grpc::Status::OK;
+  v1::JobSpec spec;
+  try {
+    from_json(job->payload, spec);
+  } catch (const std::exception& e) {
+    return internal(e);
+  }
+  spec.set_job_id(job->id);
+  spec.set_attempt(job->attempt);
+  spec.set_campaign_id(job->campaign_id);
+  *reply->mutable_job() = spec;
+  spdlog::info("job {} ({} run {}) leased to {} (attempt {})", job->id, job->test, job->std_order,
+               req->worker(), job->attempt);
+  return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* ctx, const v1::HeartbeatRequest* req,
+                                          v1::HeartbeatReply* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  if (!store_.heartbeat(req->job_id(), req->attempt(), now_seconds()))
+    return {grpc::StatusCode::FAILED_PRECONDITION,
+            "job " + std::to_string(req->job_id()) + " attempt " + std::to_string(req->attempt()) +
+                " is not the current lease"};
+  reply->set_lease_seconds(store_.limits().lease_seconds);
+  return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::CompleteRequest* req,
+                                         v1::CompleteReply*) {
+  DEMCAL_AUTHORIZE(ctx);
+  std::map<std::string, double> metrics(req->metrics().begin(), req->metrics().end());
+  if (!store_.complete(req->job_id(), req->attempt(), req->worker(), metrics_to_json(metrics),
+                       req->wall_seconds(), now_seconds())) {
+    spdlog::warn("job {}: result of attempt {} from {} rejected (not the current lease)",
+                 req->job_id(), req->attempt(), req->worker());
+    return {grpc::StatusCode::FAILED_PRECONDITION,
+            "job " + std::to_string(req->job_id()) + " attempt " + std::to_string(req->attempt()) +
+                " is not the current lease; result not stored"};
+  }
+  spdlog::info("job {} done by {} in {:.2f} s", req->job_id(), req->worker(), req->wall_seconds());
+  return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::Fail(grpc::ServerContext* ctx, const v1::FailRequest* req,
+                                     v1::FailReply*) {
+  DEMCAL_AUTHORIZE(ctx);
+  if (!store_.fail(req->job_id(), req->attempt(), req->reason(), req->retryable(), req->give_back(),
+                   now_seconds()))
+    return {grpc::StatusCode::FAILED_PRECONDITION,
+            "job " + std::to_string(req->job_id()) + " attempt " + std::to_string(req->attempt()) +
+                " is not the current lease"};
+  spdlog::info("job {} attempt {} {} by {}: {}", req->job_id(), req->attempt(),
+               req->give_back() ? "given back" : "failed", req->worker(), req->reason());
+  return grpc::Status::OK;
+}
+
+}  // namespace demcal::server

@@ -1,0 +1,64 @@
+#pragma once
+// The coordinator's two gRPC services, one final class each. Handlers authorize, convert at
+// the edge (convert.hpp) and call the store and the analysis; invalid input is answered with
+// INVALID_ARGUMENT naming the field, a stale lease with FAILED_PRECONDITION.
+#include <atomic>
+#include <string>
+
+#include "demcal/v1/campaign.grpc.pb.h"
+#include "demcal/v1/worker.grpc.pb.h"
+#include "server/store.hpp"
+
+namespace demcal::server {
+
+struct ServiceConfig {
+  std::string token;
+  double heartbeat_seconds = 10.0;
+  double idle_retry_seconds = 1.0;
+};
+
+double now_seconds();
+
+class CampaignServiceImpl final : public v1::CampaignService::Service {
+ public:
+  CampaignServiceImpl(Store& store, ServiceConfig config, const std::atomic<bool>& stopping)
+      : store_(store), config_(std::move(config)), stopping_(stopping) {}
+
+  grpc::Status Submit(grpc::ServerContext*, const v1::SubmitRequest*, v1::SubmitReply*) override;
+  grpc::Status Get(grpc::ServerContext*, const v1::GetRequest*, v1::Campaign*) override;
+  grpc::Status List(grpc::ServerContext*, const v1::ListRequest*, v1::ListReply*) override;
+  grpc::Status Cancel(grpc::ServerContext*, const v1::CancelRequest*, v1::Campaign*) override;
+  grpc::Status Watch(grpc::ServerContext*, const v1::WatchRequest*,
+                     grpc::ServerWriter<v1::Progress>*) override;
+  grpc::Status GetDesign(grpc::ServerContext*, const v1::GetRequest*, v1::DesignReply*) override;
+  grpc::Status GetResults(grpc::ServerContext*, const v1::GetRequest*, v1::ResultsReply*) override;
+  grpc::Status GetEffects(grpc::ServerContext*, const v1::EffectsRequest*,
+                          v1::EffectsReply*) override;
+  grpc::Status Calibrate(grpc::ServerContext*, const v1::CalibrateRequest*,
+                         v1::CalibrateReply*) override;
+  grpc::Status Export(grpc::ServerContext*, const v1::ExportRequest*, v1::ExportReply*) override;
+
+ private:
+  Store& store_;
+  ServiceConfig config_;
+  const std::atomic<bool>& stopping_;
+};
+
+class WorkerServiceImpl final : public v1::WorkerService::Service {
+ public:
+  WorkerServiceImpl(Store& store, ServiceConfig config)
+      : store_(store), config_(std::move(config)) {}
+
+  grpc::Status Lease(grpc::ServerContext*, const v1::LeaseRequest*, v1::LeaseReply*) override;
+  grpc::Status Heartbeat(grpc::ServerContext*, const v1::HeartbeatRequest*,
+                         v1::HeartbeatReply*) override;
+  grpc::Status Complete(grpc::ServerContext*, const v1::CompleteRequest*,
+                        v1::CompleteReply*) override;
+  grpc::Status Fail(grpc::ServerContext*, const v1::FailRequest*, v1::FailReply*) override;
+
+ private:
+  Store& store_;
+  ServiceConfig config_;
+};
+
+}  // namespace demcal::server

@@ -1,0 +1,435 @@
+#include "server/store.hpp"
+
+#include <stdexcept>
+#include <tuple>
+
+namespace demcal::server {
+namespace {
+
+/// Schema migrations: migration i takes user_version i to i + 1. Never edit a released one.
+const std::vector<const char*>& migrations() {
+  static const std::vector<const char*> m = {
+      R"sql(
+      CREATE TABLE campaigns (
+        id INTEGER PRIMARY KEY AUTOINCREMENT,
+        name TEXT NOT NULL,
+        state TEXT NOT NULL CHECK (state IN ('running', 'done', 'cancelled')),
+        spec_json TEXT NOT NULL,
+        design_json TEXT NOT NULL,
+        created REAL NOT NULL,
+        finished REAL NOT NULL DEFAULT 0);
+      CREATE TABLE jobs (
+        id INTEGER PRIMARY KEY AUTOINCREMENT,
+        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
+        std_order INTEGER NOT NULL,
+        run_order INTEGER NOT NULL,
+        test TEXT NOT NULL,
+        kind TEXT NOT NULL CHECK (kind IN ('design', 'verify')),
+        payload TEXT NOT NULL,
+        state TEXT NOT NULL
+          CHECK (state IN ('queued', 'leased', 'done', 'failed', 'cancelled')),
+        attempt INTEGER NOT NULL DEFAULT 0,
+        counted INTEGER NOT NULL DEFAULT 0,
+        lease_deadline REAL NOT NULL DEFAULT 0,
+        worker TEXT NOT NULL DEFAULT '',
+        error TEXT NOT NULL DEFAULT '',
+        finished REAL NOT NULL DEFAULT 0);
+      CREATE INDEX jobs_queue ON jobs (state, campaign_id, kind, run_order);
+      CREATE INDEX jobs_campaign ON jobs (campaign_id);
+      CREATE TABLE results (
+        job_id INTEGER PRIMARY KEY REFERENCES jobs(id),
+        attempt INTEGER NOT NULL,
+        worker TEXT NOT NULL,
+        metrics_json TEXT NOT NULL,
+        wall_seconds REAL NOT NULL,
+        stored REAL NOT NULL);
+      )sql",
+  };
+  return m;
+}
+
+}  // namespace
+
+class Store::Statement {
+ public:
+  Statement(sqlite3* db, const char* sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK)
+      throw std::runtime_error(std::string("sqlite prepare: ") + sqlite3_errmsg(db) + " in " + sql);
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  Statement& bind(int i, std::int64_t v) {
+    sqlite3_bind_int64(stmt_, i, v);
+    return *this;
+  }
+  Statement& bind(int i, int v) { return bind(i, static_cast<std::int64_t>(v)); }
+  Statement& bind(int i, double v) {
+    sqlite3_bind_double(stmt_, i, v);
+    return *this;
+  }
+  Statement& bind(int i, const std::string& v) {
+    sqlite3_bind_text(stmt_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+    return *this;
+  }
+  /// True while there is a row.
+  bool step() {
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    throw std::runtime_error(std::string("sqlite step: ") + sqlite3_errmsg(db_));
+  }
+  std::int64_t i64(int c) const { return sqlite3_column_int64(stmt_, c); }
+  int i32(int c) const { return sqlite3_column_int(stmt_, c); }
+  double f64(int c) const { return sqlite3_column_double(stmt_, c); }
+  bool is_null(int c) const { return sqlite3_column_type(stmt_, c) == SQLITE_NULL; }
+  std::string text(int c) const {
+    const auto* p = sqlite3_column_text(stmt_, c);
+    return p ? std::string(reinterpret_cast<const char*>(p)) : std::string();
+  }
+
+ private:
+  sqlite3* db_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+/// BEGIN IMMEDIATE ... COMMIT; rolls back unless committed.
+class Store::Transaction {
+ public:
+  explicit Transaction(Store& s) : s_(s) { s_.exec("BEGIN IMMEDIATE"); }
+  ~Transaction() {
+    if (!done_) sqlite3_exec(s_.db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  }
+  void commit() {
+    s_.exec("COMMIT");
+    done_ = true;
+  }
+
+ private:
+  Store& s_;
+  bool done_ = false;
+};
+
+Store::Store(const std::string& path, StoreLimits limits) : limits_(limits) {
+  if (sqlite3_open_v2(path.c_str(), &db_,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
+                      nullptr) != SQLITE_OK) {
+    const std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    throw std::runtime_error("cannot open " + path + ": " + msg);
+  }
+  sqlite3_busy_timeout(db_, 10000);
+  exec("PRAGMA journal_mode=WAL");
+  exec("PRAGMA synchronous=FULL");
+  exec("PRAGMA foreign_keys=ON");
+  migrate();
+}
+
+Store::~Store() {
+  sqlite3_close(db_);
+}
+
+void Store::exec(const char* sql) {
+  char* err = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+    const std::string msg = err ? err : "?";
+    sqlite3_free(err);
+    throw std::runtime_error("sqlite: " + msg);
+  }
+}
+
+int Store::latest_schema_version() {
+  return static_cast<int>(migrations().size());
+}
+
+int Store::schema_version() {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, "PRAGMA user_version");
+  s.step();
+  return s.i32(0);
+}
+
+std::string Store::journal_mode() {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, "PRAGMA journal_mode");
+  s.step();
+  return s.text(0);
+}
+
+void Store::migrate() {
+  Transaction tx(*this);
+  Statement v(db_, "PRAGMA user_version");
+  v.step();
+  const int version = v.i32(0);
+  if (version > latest_schema_version())
+    throw std::runtime_error("database schema version " + std::to_string(version) +
+                             " is newer than this coordinator's " +
+                             std::to_string(latest_schema_version()));
+  for (int i = version; i < latest_schema_version(); ++i) {
+    exec(migrations()[std::size_t(i)]);
+    exec(("PRAGMA user_version=" + std::to_string(i + 1)).c_str());
+  }
+  tx.commit();
+}
+
+std::int64_t Store::create_campaign(const std::string& name, const std::string& spec_json,
+                                    const std::string& design_json, const std::vector<NewJob>& jobs,
+                                    double now) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  Statement c(db_,
+              "INSERT INTO campaigns (name, state, spec_json, design_json, created) "
+              "VALUES (?, 'running', ?, ?, ?)");
+  c.bind(1, name).bind(2, spec_json).bind(3, design_json).bind(4, now).step();
+  const std::int64_t id = sqlite3_last_insert_rowid(db_);
+  for (const auto& job : jobs) {
+    Statement s(db_,
+                "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state) "
+                "VALUES (?, ?, ?, ?, ?, ?, 'queued')");
+    s.bind(1, id).bind(2, job.std_order).bind(3, job.run_order).bind(4, job.test);
+    s.bind(5, job.kind).bind(6, job.payload).step();
+  }
+  tx.commit();
+  return id;
+}
+
+namespace {
+constexpr const char* kCampaignColumns =
+    "SELECT id, name, state, spec_json, design_json, created, finished FROM campaigns";
+}
+
+std::optional<CampaignRow> Store::campaign(std::int64_t id) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, (std::string(kCampaignColumns) + " WHERE id = ?").c_str());
+  s.bind(1, id);
+  if (!s.step()) return std::nullopt;
+  return CampaignRow{s.i64(0), s.text(1), s.text(2), s.text(3), s.text(4), s.f64(5), s.f64(6)};
+}
+
+std::vector<CampaignRow> Store::campaigns() {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, (std::string(kCampaignColumns) + " ORDER BY id").c_str());
+  std::vector<CampaignRow> out;
+  while (s.step())
+    out.push_back({s.i64(0), s.text(1), s.text(2), s.text(3), s.text(4), s.f64(5), s.f64(6)});
+  return out;
+}
+
+Counts Store::counts(std::int64_t campaign_id, const std::string& kind) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_,
+              "SELECT state, COUNT(*) FROM jobs WHERE campaign_id = ? AND (? = '' OR kind = ?) "
+              "GROUP BY state");
+  s.bind(1, campaign_id).bind(2, kind).bind(3, kind);
+  Counts c;
+  while (s.step()) {
+    const std::string st = s.text(0);
+    const std::int64_t n = s.i64(1);
+    if (st == "queued") c.queued = n;
+    if (st == "leased") c.leased = n;
+    if (st == "done") c.done = n;
+    if (st == "failed") c.failed = n;
+    if (st == "cancelled") c.cancelled = n;
+  }
+  return c;
+}
+
+namespace {
+constexpr const char* kJobColumns =
+    "SELECT j.id, j.campaign_id, j.std_order, j.run_order, j.test, j.kind, j.state, j.payload, "
+    "j.worker, j.error, j.attempt, j.counted, j.lease_deadline, r.metrics_json, "
+    "COALESCE(r.wall_seconds, 0), j.finished FROM jobs j LEFT JOIN results r ON r.job_id = j.id";
+}
+
+template <class S>
+JobRow read_job(const S& s) {
+  JobRow j;
+  j.id = s.i64(0);
+  j.campaign_id = s.i64(1);
+  j.std_order = s.i32(2);
+  j.run_order = s.i32(3);
+  j.test = s.text(4);
+  j.kind = s.text(5);
+  j.state = s.text(6);
+  j.payload = s.text(7);
+  j.worker = s.text(8);
+  j.error = s.text(9);
+  j.attempt = s.i32(10);
+  j.counted = s.i32(11);
+  j.lease_deadline = s.f64(12);
+  if (!s.is_null(13)) j.metrics_json = s.text(13);
+  j.wall_seconds = s.f64(14);
+  j.finished = s.f64(15);
+  return j;
+}
+
+std::vector<JobRow> Store::jobs(std::int64_t campaign_id) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, (std::string(kJobColumns) + " WHERE j.campaign_id = ? ORDER BY j.id").c_str());
+  s.bind(1, campaign_id);
+  std::vector<JobRow> out;
+  while (s.step()) out.push_back(read_job(s));
+  return out;
+}
+
+std::optional<JobRow> Store::job(std::int64_t job_id) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, (std::string(kJobColumns) + " WHERE j.id = ?").c_str());
+  s.bind(1, job_id);
+  if (!s.step()) return std::nullopt;
+  return read_job(s);
+}
+
+bool Store::cancel(std::int64_t campaign_id, double now) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  Statement c(db_, "UPDATE campaigns SET state = 'cancelled', finished = ? WHERE id = ?");
+  c.bind(1, now).bind(2, campaign_id).step();
+  if (sqlite3_changes(db_) == 0) return false;
+  Statement j(db_,
+              "UPDATE jobs SET state = 'cancelled', finished = ? "
+              "WHERE campaign_id = ? AND state IN ('queued', 'leased')");
+  j.bind(1, now).bind(2, campaign_id).step();
+  tx.commit();
+  return true;
+}
+
+std::vector<std::int64_t> Store::add_jobs(std::int64_t campaign_id,
+                                          const std::vector<NewJob>& jobs) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  std::vector<std::int64_t> ids;
+  for (const auto& job : jobs) {
+    Statement s(db_,
+                "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state) "
+                "VALUES (?, ?, ?, ?, ?, ?, 'queued')");
+    s.bind(1, campaign_id).bind(2, job.std_order).bind(3, job.run_order).bind(4, job.test);
+    s.bind(5, job.kind).bind(6, job.payload).step();
+    ids.push_back(sqlite3_last_insert_rowid(db_));
+  }
+  Statement c(
+      db_, "UPDATE campaigns SET state = 'running', finished = 0 WHERE id = ? AND state = 'done'");
+  c.bind(1, campaign_id).step();
+  tx.commit();
+  return ids;
+}
+
+std::optional<JobRow> Store::lease(const std::string& worker, double now) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  Statement s(db_,
+              "SELECT j.id FROM jobs j JOIN campaigns c ON c.id = j.campaign_id "
+              "WHERE j.state = 'queued' AND c.state = 'running' "
+              "ORDER BY j.campaign_id, j.kind, j.run_order, j.id LIMIT 1");
+  if (!s.step()) return std::nullopt;
+  const std::int64_t id = s.i64(0);
+  Statement u(db_,
+              "UPDATE jobs SET state = 'leased', attempt = attempt + 1, counted = counted + 1, "
+              "lease_deadline = ?, worker = ? WHERE id = ? AND state = 'queued'");
+  u.bind(1, now + limits_.lease_seconds).bind(2, worker).bind(3, id).step();
+  Statement r(db_, (std::string(kJobColumns) + " WHERE j.id = ?").c_str());
+  r.bind(1, id);
+  r.step();
+  JobRow job = read_job(r);
+  tx.commit();
+  return job;
+}
+
+bool Store::heartbeat(std::int64_t job_id, int attempt, double now) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  Statement u(db_,
+              "UPDATE jobs SET lease_deadline = ? WHERE id = ? AND attempt = ? AND "
+              "state = 'leased' AND lease_deadline >= ?");
+  u.bind(1, now + limits_.lease_seconds).bind(2, job_id).bind(3, attempt).bind(4, now).step();
+  const bool ok = sqlite3_changes(db_) == 1;
+  tx.commit();
+  return ok;
+}
+
+bool Store::complete(std::int64_t job_id, int attempt, const std::string& worker,
+                     const std::string& metrics_json, double wall_seconds, double now) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  Statement u(db_,
+              "UPDATE jobs SET state = 'done', finished = ?, error = '' WHERE id = ? AND "
+              "attempt = ? AND state = 'leased' AND lease_deadline >= ?");
+  u.bind(1, now).bind(2, job_id).bind(3, attempt).bind(4, now).step();
+  if (sqlite3_changes(db_) != 1) return false;  // rolled back: not the current lease
+  Statement r(db_,
+              "INSERT INTO results (job_id, attempt, worker, metrics_json, wall_seconds, stored) "
+              "VALUES (?, ?, ?, ?, ?, ?)");
+  r.bind(1, job_id).bind(2, attempt).bind(3, worker).bind(4, metrics_json);
+  r.bind(5, wall_seconds).bind(6, now).step();
+  finish_campaigns(now);
+  tx.commit();
+  return true;
+}
+
+bool Store::requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason,
+                            bool retryable, double now) {
+  const bool fail_now = !retryable || counted >= limits_.max_attempts;
+  Statement u(db_, fail_now ? "UPDATE jobs SET state = 'failed', error = ?, finished = ?, "
+                              "lease_deadline = 0 WHERE id = ?"
+                            : "UPDATE jobs SET state = 'queued', error = ?, finished = ?, "
+                              "lease_deadline = 0 WHERE id = ?");
+  u.bind(1, reason).bind(2, fail_now ? now : 0.0).bind(3, job_id).step();
+  return fail_now;
+}
+
+bool Store::fail(std::int64_t job_id, int attempt, const std::string& reason, bool retryable,
+                 bool give_back, double now) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  Statement s(db_,
+              "SELECT counted FROM jobs WHERE id = ? AND attempt = ? AND state = 'leased' AND "
+              "lease_deadline >= ?");
+  s.bind(1, job_id).bind(2, attempt).bind(3, now);
+  if (!s.step()) return false;
+  const int counted = s.i32(0);
+  if (give_back) {
+    Statement u(db_,
+                "UPDATE jobs SET state = 'queued', counted = counted - 1, lease_deadline = 0, "
+                "error = ? WHERE id = ?");
+    u.bind(1, "given back: " + reason).bind(2, job_id).step();
+  } else {
+    requeue_or_fail(job_id, counted, reason, retryable, now);
+  }
+  finish_campaigns(now);
+  tx.commit();
+  return true;
+}
+
+int Store::reap(double now) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  Statement s(db_,
+              "SELECT id, counted, worker FROM jobs WHERE state = 'leased' AND lease_deadline < ?");
+  s.bind(1, now);
+  std::vector<std::tuple<std::int64_t, int, std::string>> expired;
+  while (s.step()) expired.emplace_back(s.i64(0), s.i32(1), s.text(2));
+  for (const auto& [id, counted, worker] : expired)
+    requeue_or_fail(id, counted,
+                    "lease of worker '" + worker + "' expired (attempt " + std::to_string(counted) +
+                        " of " + std::to_string(limits_.max_attempts) + ")",
+                    true, now);
+  if (!expired.empty()) finish_campaigns(now);
+  tx.commit();
+  return static_cast<int>(expired.size());
+}
+
+void Store::finish_campaigns(double now) {
+  Statement u(db_,
+              "UPDATE campaigns SET state = 'done', finished = ? WHERE state = 'running' AND "
+              "NOT EXISTS (SELECT 1 FROM jobs j WHERE j.campaign_id = campaigns.id AND "
+              "j.state IN ('queued', 'leased'))");
+  u.bind(1, now).step();
+}
+
+int Store::result_count(std::int64_t job_id) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, "SELECT COUNT(*) FROM results WHERE job_id = ?");
+  s.bind(1, job_id);
+  s.step();
+  return s.i32(0);
+}
+
+}  // namespace demcal::server

@@ -1,0 +1,119 @@
+#pragma once
+// The coordinator's SQLite store: all SQL of demcal lives in this class. WAL journal with
+// synchronous=FULL (a result acknowledged to a worker survives a power cut), versioned schema
+// migrations (PRAGMA user_version), RAII transactions that roll back unless committed, and
+// BEGIN IMMEDIATE for every write so that two writers never deadlock on a lock upgrade.
+//
+// Job state machine:  queued --Lease--> leased --Complete--> done
+//                                       leased --Fail(retryable) / lease expired--> queued
+//                                                  (failed once the attempt cap is reached)
+//                                       leased --Fail(not retryable)--> failed
+//                                       leased --Fail(give_back)--> queued (attempt not counted)
+//                      queued|leased --Cancel--> cancelled
+// Every lease increments the job's attempt number; Heartbeat, Complete and Fail name
+// (job, attempt) and change nothing unless that lease is the current one and has not expired.
+// A result is stored at most once per job (results.job_id is the primary key).
+#include <sqlite3.h>
+
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace demcal::server {
+
+struct CampaignRow {
+  std::int64_t id = 0;
+  std::string name;
+  std::string state;  ///< running | done | cancelled
+  std::string spec_json, design_json;
+  double created = 0.0, finished = 0.0;  ///< unix seconds; finished 0 while running
+};
+
+struct NewJob {
+  int std_order = 0;  ///< 1-based design row; 0 for a verification job
+  int run_order = 0;
+  std::string test;
+  std::string kind = "design";  ///< design | verify
+  std::string payload;          ///< JobSpec as JSON (without id and attempt)
+};
+
+struct JobRow {
+  std::int64_t id = 0, campaign_id = 0;
+  int std_order = 0, run_order = 0;
+  std::string test, kind, state, payload, worker, error;
+  int attempt = 0;  ///< leases handed out so far (the current lease's number)
+  int counted = 0;  ///< attempts counted against the cap (give-backs are not)
+  double lease_deadline = 0.0;
+  std::optional<std::string> metrics_json;  ///< the stored result
+  double wall_seconds = 0.0;
+  double finished = 0.0;
+};
+
+struct Counts {
+  std::int64_t queued = 0, leased = 0, done = 0, failed = 0, cancelled = 0;
+  std::int64_t total() const { return queued + leased + done + failed + cancelled; }
+};
+
+struct StoreLimits {
+  double lease_seconds = 60.0;
+  int max_attempts = 3;
+};
+
+class Store {
+ public:
+  /// Opens (creating if needed) and migrates; path ":memory:" for tests.
+  explicit Store(const std::string& path, StoreLimits limits = {});
+  ~Store();
+  Store(const Store&) = delete;
+  Store& operator=(const Store&) = delete;
+
+  static int latest_schema_version();
+  int schema_version();
+  std::string journal_mode();
+  const StoreLimits& limits() const { return limits_; }
+
+  std::int64_t create_campaign(const std::string& name, const std::string& spec_json,
+                               const std::string& design_json, const std::vector<NewJob>& jobs,
+                               double now);
+  std::optional<CampaignRow> campaign(std::int64_t id);
+  std::vector<CampaignRow> campaigns();
+  Counts counts(std::int64_t campaign_id, const std::string& kind = "");
+  std::vector<JobRow> jobs(std::int64_t campaign_id);
+  std::optional<JobRow> job(std::int64_t job_id);
+  /// Cancels every queued or leased job; false when the campaign does not exist.
+  bool cancel(std::int64_t campaign_id, double now);
+  /// Adds jobs to an existing campaign (verification runs); the campaign runs again.
+  std::vector<std::int64_t> add_jobs(std::int64_t campaign_id, const std::vector<NewJob>& jobs);
+
+  /// The next queued job (oldest campaign first, then run order), leased to `worker`.
+  std::optional<JobRow> lease(const std::string& worker, double now);
+  /// Extends the current, unexpired lease; false otherwise.
+  bool heartbeat(std::int64_t job_id, int attempt, double now);
+  /// Stores the result of the current, unexpired lease exactly once; false otherwise.
+  bool complete(std::int64_t job_id, int attempt, const std::string& worker,
+                const std::string& metrics_json, double wall_seconds, double now);
+  /// See the state machine above; false when the lease is not the current one.
+  bool fail(std::int64_t job_id, int attempt, const std::string& reason, bool retryable,
+            bool give_back, double now);
+  /// Expired leases go back to the queue, or fail at the attempt cap. Returns jobs reaped.
+  int reap(double now);
+  /// Results stored for a job (0 or 1: the primary key makes 2 impossible), for tests.
+  int result_count(std::int64_t job_id);
+
+ private:
+  class Transaction;
+  class Statement;
+  void exec(const char* sql);
+  void migrate();
+  void finish_campaigns(double now);
+  bool requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason, bool retryable,
+                       double now);
+
+  sqlite3* db_ = nullptr;
+  StoreLimits limits_;
+  std::mutex mutex_;
+};
+
+}  // namespace demcal::server

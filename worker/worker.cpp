@@ -1,0 +1,241 @@
+#include "worker/worker.hpp"
+
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <future>
+#include <mutex>
+#include <optional>
+#include <random>
+#include <thread>
+
+#include "core/common/error.hpp"
+#include "core/lab/lab_test.hpp"
+#include "demcal/v1/worker.grpc.pb.h"
+#include "proto/material_convert.hpp"
+
+namespace demcal::worker {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Sleeps up to `seconds`, waking early on a stop request.
+void nap(double seconds, const StopFlags& flags) {
+  const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+  while (Clock::now() < end && !flags.stop && !flags.abort)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+}
+
+struct Outcome {
+  bool ok = false;
+  std::map<std::string, double> metrics;
+  std::string reason;
+  bool retryable = false;
+};
+
+Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progress) {
+  Outcome o;
+  try {
+    const lab::MaterialModel material = proto::job_material(job);
+    lab::RunOptions ro;
+    ro.threads = job.threads() > 0 ? job.threads() : threads;
+    ro.seed = job.seed() ? job.seed() : 1;
+    ro.progress = [&progress](double f) { progress = f; };
+    const lab::LabOutput out =
+        lab::run_lab_test(job.test(), material, proto::to_settings(job.settings()), ro);
+    o.ok = true;
+    o.metrics = out.metrics;
+  } catch (const SimulationFailure& e) {
+    o.reason = std::string("simulation failed (") + to_string(e.reason()) + "): " + e.what();
+  } catch (const InputError& e) {
+    o.reason = std::string("invalid job: ") + e.what();
+  } catch (const std::exception& e) {
+    o.reason = std::string("worker error: ") + e.what();
+    o.retryable = true;
+  }
+  return o;
+}
+
+}  // namespace
+
+WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
+  WorkerStats stats;
+  const std::string id = [&] {
+    if (!opt.id.empty()) return opt.id;
+    char host[256] = {};
+    gethostname(host, sizeof host - 1);
+    return std::string(host) + ":" + std::to_string(getpid());
+  }();
+  auto channel = proto::make_channel(opt.channel);
+  auto stub = v1::WorkerService::NewStub(channel);
+  std::mt19937_64 jitter(std::hash<std::string>{}(id));
+  double backoff = 0.2;
+  auto back_off = [&](const grpc::Status& s, const char* what) {
+    spdlog::warn("{}: coordinator {} unavailable ({}); retrying in {:.1f} s", what,
+                 opt.channel.address, s.error_message(), backoff);
+    nap(backoff * (0.75 + 0.5 * std::uniform_real_distribution<>(0, 1)(jitter)), flags);
+    backoff = std::min(opt.max_backoff, backoff * 2);
+  };
+  auto idle_since = Clock::now();
+  spdlog::info("worker {} -> {} ({} threads)", id, opt.channel.address, opt.threads);
+
+  while (!flags.stop && !flags.abort) {
+    if (opt.max_jobs > 0 && stats.completed + stats.failed >= opt.max_jobs) break;
+    v1::LeaseRequest lreq;
+    lreq.set_worker(id);
+    v1::LeaseReply lease;
+    const auto ls = stub->Lease(proto::make_context(opt.channel, 10).get(), lreq, &lease);
+    if (ls.error_code() == grpc::StatusCode::UNAUTHENTICATED) {
+      spdlog::error("coordinator refused the token: {}", ls.error_message());
+      stats.unauthenticated = true;
+      break;
+    }
+    if (!ls.ok()) {
+      back_off(ls, "lease");
+      continue;
+    }
+    backoff = 0.2;
+    if (!lease.has_job()) {
+      if (opt.idle_exit > 0 &&
+          std::chrono::duration<double>(Clock::now() - idle_since).count() > opt.idle_exit)
+        break;
+      nap(lease.retry_after_seconds() > 0 ? lease.retry_after_seconds() : 1.0, flags);
+      continue;
+    }
+    const v1::JobSpec job = lease.job();
+    spdlog::info("job {} attempt {}: {} (campaign {})", job.job_id(), job.attempt(), job.test(),
+                 job.campaign_id());
+    const auto started = Clock::now();
+
+    // Heartbeats from their own thread, so a long simulation step never lets the lease lapse.
+    std::atomic<double> progress{0.0};
+    std::atomic<bool> lease_lost{false};
+    std::mutex hb_mutex;
+    std::condition_variable hb_cv;
+    bool hb_stop = false;
+    const double hb_every = lease.heartbeat_seconds() > 0 ? lease.heartbeat_seconds() : 10.0;
+    std::thread heartbeat([&] {
+      std::unique_lock lock(hb_mutex);
+      while (
+          !hb_cv.wait_for(lock, std::chrono::duration<double>(hb_every), [&] { return hb_stop; })) {
+        lock.unlock();
+        v1::HeartbeatRequest h;
+        h.set_job_id(job.job_id());
+        h.set_attempt(job.attempt());
+        h.set_worker(id);
+        h.set_progress(progress);
+        v1::HeartbeatReply hr;
+        const auto s = stub->Heartbeat(proto::make_context(opt.channel, 5).get(), h, &hr);
+        if (s.error_code() == grpc::StatusCode::FAILED_PRECONDITION && !lease_lost) {
+          lease_lost = true;
+          spdlog::warn("job {}: lease {} lost ({}); its result will be refused", job.job_id(),
+                       job.attempt(), s.error_message());
+        } else if (!s.ok() && !lease_lost) {
+          spdlog::warn("job {}: heartbeat failed: {}", job.job_id(), s.error_message());
+        }
+        lock.lock();
+      }
+    });
+    auto stop_heartbeat = [&] {
+      {
+        std::lock_guard lock(hb_mutex);
+        hb_stop = true;
+      }
+      hb_cv.notify_all();
+      heartbeat.join();
+    };
+
+    // The simulation runs on its own thread so that a stop request can give the lease back.
+    auto task = std::make_shared<std::packaged_task<Outcome()>>(
+        [job, threads = opt.threads, &progress] { return run_job(job, threads, progress); });
+    auto future = task->get_future();
+    std::thread sim([task] { (*task)(); });
+    std::optional<Clock::time_point> stop_seen;
+    bool give_back = false;
+    while (future.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+      if (flags.abort) give_back = true;
+      if (flags.stop && !stop_seen) {
+        stop_seen = Clock::now();
+        spdlog::info("stop requested: finishing job {} first", job.job_id());
+      }
+      if (stop_seen && opt.drain_seconds > 0 &&
+          std::chrono::duration<double>(Clock::now() - *stop_seen).count() > opt.drain_seconds)
+        give_back = true;
+      if (give_back) break;
+    }
+    if (give_back) {
+      sim.detach();  // the process is about to exit; the lease goes back now
+      stop_heartbeat();
+      v1::FailRequest f;
+      f.set_job_id(job.job_id());
+      f.set_attempt(job.attempt());
+      f.set_worker(id);
+      f.set_reason("worker " + id + " stopping");
+      f.set_give_back(true);
+      f.set_retryable(true);
+      v1::FailReply fr;
+      const auto s = stub->Fail(proto::make_context(opt.channel, 5).get(), f, &fr);
+      spdlog::info("job {}: lease given back ({})", job.job_id(),
+                   s.ok() ? "ok" : s.error_message());
+      ++stats.given_back;
+      break;
+    }
+    sim.join();
+    Outcome out = future.get();
+    stop_heartbeat();
+    const double wall = std::chrono::duration<double>(Clock::now() - started).count();
+
+    // Report; retried while the coordinator is away (a restart must not lose a result).
+    for (int tries = 0;; ++tries) {
+      grpc::Status s;
+      if (out.ok) {
+        v1::CompleteRequest c;
+        c.set_job_id(job.job_id());
+        c.set_attempt(job.attempt());
+        c.set_worker(id);
+        c.set_wall_seconds(wall);
+        for (const auto& [k, v] : out.metrics) (*c.mutable_metrics())[k] = v;
+        v1::CompleteReply cr;
+        s = stub->Complete(proto::make_context(opt.channel, 10).get(), c, &cr);
+      } else {
+        v1::FailRequest f;
+        f.set_job_id(job.job_id());
+        f.set_attempt(job.attempt());
+        f.set_worker(id);
+        f.set_reason(out.reason);
+        f.set_retryable(out.retryable);
+        v1::FailReply fr;
+        s = stub->Fail(proto::make_context(opt.channel, 10).get(), f, &fr);
+      }
+      if (s.ok()) {
+        if (out.ok) {
+          ++stats.completed;
+          spdlog::info("job {} done in {:.2f} s", job.job_id(), wall);
+        } else {
+          ++stats.failed;
+          spdlog::warn("job {} failed: {}", job.job_id(), out.reason);
+        }
+        break;
+      }
+      if (s.error_code() == grpc::StatusCode::FAILED_PRECONDITION) {
+        ++stats.rejected;
+        spdlog::warn("job {}: coordinator refused the report: {}", job.job_id(), s.error_message());
+        break;
+      }
+      if (s.error_code() == grpc::StatusCode::UNAUTHENTICATED || flags.abort || tries > 200) {
+        spdlog::error("job {}: report not delivered: {}", job.job_id(), s.error_message());
+        break;
+      }
+      back_off(s, out.ok ? "complete" : "fail");
+      if (flags.stop) nap(0.5, StopFlags{});  // keep trying while draining
+    }
+    idle_since = Clock::now();
+  }
+  spdlog::info("worker {} stopping: {} done, {} failed, {} refused, {} given back", id,
+               stats.completed, stats.failed, stats.rejected, stats.given_back);
+  return stats;
+}
+
+}  // namespace demcal::worker

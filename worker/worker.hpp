@@ -1,0 +1,41 @@
+#pragma once
+// The stateless worker loop: lease a job, run its lab test with the core (heartbeats from
+// their own thread meanwhile), Complete or Fail it, and again. The coordinator away means
+// back-off and retry, never a lost result: a finished job's Complete is retried until the
+// coordinator answers (a stale lease is then refused by the coordinator, not by the worker).
+#include <atomic>
+#include <cstdint>
+#include <string>
+
+#include "proto/channel.hpp"
+
+namespace demcal::worker {
+
+struct WorkerOptions {
+  proto::ChannelOptions channel;
+  int threads = 2;            ///< simulation threads per job (unless the job says otherwise)
+  std::string id;             ///< default: host:pid
+  double max_backoff = 10.0;  ///< seconds between reconnection attempts, at most
+  int max_jobs = 0;           ///< stop after this many jobs (0 = no limit)
+  double idle_exit = 0.0;     ///< stop after this long without work (0 = never)
+  double drain_seconds = 0;   ///< after a stop request, give the lease back after this long
+                              ///< (0 = finish the job however long it takes)
+};
+
+/// Stop requests: `stop` = finish the current job and lease no more; `abort` = give the
+/// current lease back now.
+struct StopFlags {
+  std::atomic<bool> stop{false};
+  std::atomic<bool> abort{false};
+};
+
+struct WorkerStats {
+  int completed = 0, failed = 0, rejected = 0, given_back = 0;
+  bool unauthenticated = false;
+};
+
+/// Runs until stopped (or max_jobs / idle_exit). A job given back on abort leaves its
+/// simulation running in a detached thread: the caller should exit the process.
+WorkerStats run_worker(const WorkerOptions& options, StopFlags& flags);
+
+}  // namespace demcal::worker
