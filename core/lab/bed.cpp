@@ -2,11 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
 
 #include "core/common/rng.hpp"
+#include "core/io/vtk.hpp"
 #include "core/particles/insertion.hpp"
 #include "core/sim/step.hpp"
 #include "core/sim/time_step.hpp"
+#include "core/walls/servo.hpp"
 
 namespace demcal::lab {
 namespace {
@@ -20,6 +25,13 @@ double mean_particle_volume(const particles::SizeDistribution& sizes, Rng rng) {
 }
 
 }  // namespace
+
+double metrics_top(const sim::World& w) {
+  double top = 0.0;
+  for (std::size_t i = 0; i < w.particles.size(); ++i)
+    top = std::max(top, w.particles.x[i].z + w.particles.radius[i]);
+  return top;
+}
 
 sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
                           const RunOptions& options) {
@@ -95,4 +107,141 @@ double settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limit
   return w.time - t0;
 }
 
+}  // namespace demcal::lab
+
+namespace demcal::lab {
+
+double die_radius(const sim::World& world) {
+  return std::get<walls::Cylinder>(world.walls.at(1).shape).radius;
+}
+
+contact::ContactLawSpec stiffen_normal(const contact::ContactLawSpec& spec, double factor) {
+  contact::ContactLawSpec out = spec;
+  for (const auto& p : contact::model_params("normal", spec.normal.model))
+    if (p.unit == "N/m" || p.unit == "Pa")
+      if (auto it = out.normal.params.find(p.name); it != out.normal.params.end())
+        it->second *= factor;
+  return out;
+}
+
+contact::ContactLaw simulated_law(const MaterialModel& material,
+                                  const contact::ContactLawSpec& spec) {
+  return contact::scale(contact::ContactLaw::from_spec(spec, "wall_law"), material.factors());
+}
+
+std::size_t add_piston(sim::World& world, double z) {
+  world.walls.push_back(walls::make_wall(
+      "piston", walls::Disk{{0, 0, z}, {0, 0, -1}, die_radius(world)}, kWallPiston));
+  return world.walls.size() - 1;
+}
+
+namespace {
+double axial_position(const walls::Wall& w) {
+  if (const auto* d = std::get_if<walls::Disk>(&w.shape)) return d->centre.z;
+  if (const auto* p = std::get_if<walls::Plane>(&w.shape)) return p->point.z;
+  return w.displacement.z;
+}
+}  // namespace
+
+ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measured, Vec3 axis,
+                       double area, double target, const ServoSettings& s,
+                       const sim::HealthLimits& limits,
+                       const std::function<void(const sim::World&, double)>& record,
+                       int record_every) {
+  walls::StressServo servo;
+  servo.axis = axis;
+  servo.area = area;
+  servo.target = target;
+  servo.kp = s.kp;
+  servo.ki = s.ki;
+  servo.kd = s.kd;
+  servo.max_speed = s.max_speed;
+  // The measured wall faces the driven one (or is it): a compressive stress pushes it along
+  // -axis_measured, where axis_measured = axis for the driven wall itself and -axis otherwise.
+  const double sign = driven == measured ? 1.0 : -1.0;
+  auto stress_of = [&](const sim::World& w) {
+    return -dot(w.walls[measured].force, axis * sign) / area;
+  };
+  ServoPhase out;
+  const double t0 = world.time;
+  // The stress on a piston is carried by a few tens of contacts and rattles; the phase ends when
+  // the mean over a block of hold_time is within tolerance of the target.
+  double block_start = world.time, sum_s = 0.0, sum_z = 0.0;
+  long n_sum = 0;
+  run_checked(world, std::numeric_limits<long>::max() / 2, limits, [&](sim::World& w) {
+    const double stress = stress_of(w);
+    walls::Wall probe;
+    probe.force = w.walls[measured].force * sign;
+    servo.update(probe, w.dt);
+    w.walls[driven].velocity = probe.velocity;
+    if (record && w.step_count % record_every == 0) record(w, stress);
+    sum_s += stress;
+    sum_z += axial_position(w.walls[driven]);
+    ++n_sum;
+    if (w.time - block_start >= s.hold_time) {
+      out.stress = sum_s / static_cast<double>(n_sum);
+      out.position = sum_z / static_cast<double>(n_sum);
+      if (std::abs(out.stress - target) <= s.tolerance) {
+        out.reached = true;
+        return false;
+      }
+      block_start = w.time;
+      sum_s = sum_z = 0.0;
+      n_sum = 0;
+    }
+    return w.time - t0 < s.max_time;
+  });
+  if (!out.reached && n_sum > 0) {
+    out.stress = sum_s / static_cast<double>(n_sum);
+    out.position = sum_z / static_cast<double>(n_sum);
+  }
+  world.walls[driven].velocity = {};
+  out.time = world.time - t0;
+  if (std::getenv("DEMCAL_LAB_TRACE"))
+    std::fprintf(stderr, "servo phase target %g Pa: stress %g Pa at %g m after %g s (%s), dt %g\n",
+                 target, out.stress, out.position, out.time, out.reached ? "reached" : "timed out",
+                 world.dt);
+  return out;
+}
+
+}  // namespace demcal::lab
+
+namespace demcal::lab {
+void write_snapshot(const sim::World& world, const RunOptions& options, const std::string& name,
+                    LabOutput& out) {
+  if (options.snapshot_dir.empty()) return;
+  const std::string base = options.snapshot_dir + "/" + name;
+  io::write_particles_vtk(base + "_particles.vtk", world);
+  io::write_walls_vtk(base + "_walls.vtk", world, 2.0 * die_radius(world));
+  out.snapshots.push_back(base + "_particles.vtk");
+  out.snapshots.push_back(base + "_walls.vtk");
+}
+}  // namespace demcal::lab
+
+namespace demcal::lab {
+PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, double safety,
+                          const RunOptions& options,
+                          const std::function<void(sim::World&)>& set_laws) {
+  BedSpec spec;
+  spec.particles = particles;
+  spec.time_step_safety = safety;
+  PistonBed b;
+  b.world = make_die_world(material, spec, options);
+  sim::World& w = b.world;
+  if (set_laws) set_laws(w);
+  // The piston shares the bottom's law; add it (far above) so the time step covers its law.
+  b.radius = die_radius(w);
+  b.area = M_PI * b.radius * b.radius;
+  const double top = metrics_top(w);
+  b.limits = die_limits(w, b.radius, top);
+  b.piston = add_piston(w, 1e3 * top + 1.0);
+  w.dt = sim::recommended_time_step(w, safety);
+  settle(w, spec, b.limits);
+  b.h0 = metrics_top(w);
+  auto& disk = std::get<walls::Disk>(w.walls[b.piston].shape);
+  disk.centre.z = b.h0;
+  w.walls[b.piston].pivot = disk.centre;
+  b.limits = die_limits(w, b.radius, b.h0);
+  return b;
+}
 }  // namespace demcal::lab

@@ -35,6 +35,9 @@ enum WallMaterial : std::uint16_t {
 sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
                           const RunOptions& options);
 
+/// Height of the highest particle top (m), 0 for an empty world.
+double metrics_top(const sim::World& world);
+
 /// Steps until the bed is at rest (mean kinetic energy criterion of BedSpec) or max time; checks
 /// health every few hundred steps. Returns the simulated time spent.
 double settle(sim::World& world, const BedSpec& spec, const sim::HealthLimits& limits);
@@ -47,4 +50,72 @@ long run_checked(sim::World& world, long steps, const sim::HealthLimits& limits,
 /// Health limits for a die world: particles must stay within a box around the die.
 sim::HealthLimits die_limits(const sim::World& world, double die_radius, double height);
 
+// ---- Pistons and servo phases shared by confined_compression, tensile and wall_friction ----
+
+/// Radius of the die (wall 1 of make_die_world).
+double die_radius(const sim::World& world);
+
+/// The wall law spec with every stiffness of its normal slot (parameters in N/m or Pa: k1, kn,
+/// youngs_modulus) multiplied by `factor` (seed 000 §2.7.2: k_l,wall = 30 k_l).
+contact::ContactLawSpec stiffen_normal(const contact::ContactLawSpec& spec, double factor);
+/// The simulated (scaled) form of a law spec under the material's coarse-graining.
+contact::ContactLaw simulated_law(const MaterialModel& material,
+                                  const contact::ContactLawSpec& spec);
+
+/// Adds a piston (kWallPiston): a disk of the die's radius facing down (-z) with its face at
+/// height z; returns its index.
+std::size_t add_piston(sim::World& world, double z);
+
+/// Controller settings of a stress-servo piston (walls::StressServo), as exposed by the tests.
+struct ServoSettings {
+  double max_speed = 0.0;  ///< speed limit (m/s, simulated)
+  double kp = 0.0;         ///< m/s per Pa
+  double ki = 0.0;         ///< m/s per Pa s
+  double kd = 0.0;         ///< m/s per Pa/s
+  double tolerance = 0.0;  ///< |stress - target| (Pa) counted as reached
+  double hold_time = 0.0;  ///< (s) the stress must stay within tolerance
+  double max_time = 0.0;   ///< (s) per phase; the phase ends there reached or not
+};
+
+/// What a servo phase ended with: mean stress and wall position over the hold window.
+struct ServoPhase {
+  double stress = 0.0;    ///< (Pa, simulated)
+  double position = 0.0;  ///< wall's axial coordinate (m): piston face z or bottom z
+  double time = 0.0;      ///< simulated time spent (s)
+  bool reached = false;
+};
+
+/// Drives `driven` (a wall index) by a StressServo until the compressive stress read from wall
+/// `measured` holds `target` for hold_time (or max_time passes). `axis` is the direction in which
+/// the driven wall compresses the bed. `record(world, stress)` is called every `record_every`
+/// steps if given.
+ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measured, Vec3 axis,
+                       double area, double target, const ServoSettings& servo,
+                       const sim::HealthLimits& limits,
+                       const std::function<void(const sim::World&, double stress)>& record = {},
+                       int record_every = 50);
+
+}  // namespace demcal::lab
+
+namespace demcal::lab {
+/// Writes `<dir>/<name>_particles.vtk` and `<name>_walls.vtk` when options.snapshot_dir is set
+/// and records them in out.snapshots.
+void write_snapshot(const sim::World& world, const RunOptions& options, const std::string& name,
+                    LabOutput& out);
+}  // namespace demcal::lab
+
+namespace demcal::lab {
+/// A settled die bed with a piston resting at its top: the start of the piston tests.
+struct PistonBed {
+  sim::World world;
+  std::size_t piston = 0;
+  double radius = 0.0, area = 0.0;
+  double h0 = 0.0;  ///< settled bed height = initial piston position (m)
+  sim::HealthLimits limits;
+};
+/// Builds the die world, lets `set_laws` replace wall laws (e.g. stiff or adhesive piston and
+/// bottom), sets dt = safety * critical over all laws, settles, and adds the piston at the bed top.
+PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, double safety,
+                          const RunOptions& options,
+                          const std::function<void(sim::World&)>& set_laws);
 }  // namespace demcal::lab

@@ -2,6 +2,7 @@
 
 #include "core/common/error.hpp"
 #include "core/lab/packing.hpp"
+#include "core/lab/confined_compression.hpp"
 
 namespace demcal::lab {
 
@@ -17,8 +18,29 @@ LabTestInfo packing_info() {
       settings_docs<PackingSettings>()};
 }
 
+// confined_compression: seed 000 §2.7.2 (eq. 31-33), seed 001 §3.2.1 (eq. 19); runner in
+// confined_compression.cpp.
+LabTestInfo confined_compression_info() {
+  return {"confined_compression",
+          "bed in a cylindrical die loaded by a stress-servo piston to 15 kPa, unloaded to 0.5 kPa "
+          "and reloaded five times, then unloaded",
+          "seed 000 §2.7.2 (eq. 31-33); seed 001 §3.2.1 (eq. 19)",
+          {{"compressibility", "%", "(h0 - h1) / h0 at the first load (seed 000 eq. 31)"},
+           {"k_load", "MPa",
+            "mean reload bulk stiffness (sigma_max - sigma_min) h1 / (h_unloaded - h_loaded) "
+            "(seed 000 eq. 32)"},
+           {"k_unload", "MPa",
+            "mean unload bulk stiffness (sigma_max - sigma_min) h1 / (h_unloaded - h_loaded_before) "
+            "(seed 000 eq. 33)"},
+           {"final_solid_fraction", "-", "solid fraction after the final unload"},
+           {"confined_modulus", "MPa",
+            "E' = (sigma_max - sigma_min) / (eps_max - eps_min) of the last cycle, eps = "
+            "(h0 - h) / h0 (seed 001 eq. 19)"}},
+          settings_docs<ConfinedCompressionSettings>()};
+}
+
 const std::vector<LabTestInfo>& lab_catalog() {
-  static const std::vector<LabTestInfo> tests = {packing_info()};
+  static const std::vector<LabTestInfo> tests = {packing_info(), confined_compression_info()};
   return tests;
 }
 

@@ -1,0 +1,154 @@
+// tensile (seed 000 §2.7.3, eq. 34-35).
+// Phases: settle in the die with adhesive piston and bottom (the wall law stiffened by
+// wall_stiffness_factor, A_H times eq. 34, k2 times eq. 35) and a frictionless, non-cohesive die
+// wall; the piston (StressServo) consolidates to consolidation_stress and unloads to
+// unload_stress; then it is pulled up at constant speed. The tensile stress on the piston is
+// sigma_t = -F_z / A (F_z: the particles' force on it); the fracture is the peak of sigma_t over
+// the pull, and the tensile strength is that peak less the weight of the powder still stuck to
+// the piston at the end of the pull, over A (seed 000 §2.7.3, Fig. 10-11).
+#include "core/lab/tensile.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace demcal::lab {
+namespace {
+
+double real_radius_um(const MaterialModel& m) {
+  double r = 0.0;
+  if (const auto* mono = std::get_if<particles::Monodisperse>(&m.sizes)) r = mono->radius;
+  if (const auto* ln = std::get_if<particles::LogNormal>(&m.sizes)) r = ln->median_radius;
+  if (const auto* d = std::get_if<particles::DiscreteClasses>(&m.sizes)) {
+    double w = 0.0;
+    for (std::size_t k = 0; k < d->radii.size(); ++k) {
+      r += d->radii[k] * d->mass_fractions[k];
+      w += d->mass_fractions[k];
+    }
+    r /= w;
+  }
+  return r * m.size_scale * 1e6;
+}
+
+}  // namespace
+
+double wall_hamaker_ratio_eq34(double r) {
+  r = std::clamp(r, 5.0, 50.0);
+  return 10.0 + 90.0 * (r - 5.0) / 45.0;
+}
+double wall_k2_ratio_eq35(double r) {
+  r = std::clamp(r, 5.0, 50.0);
+  return 10.0 + 5.0 * (r - 5.0) / 45.0;
+}
+
+LabOutput run_tensile(const MaterialModel& material, const Settings& values,
+                      const RunOptions& options) {
+  const auto s = read_settings<TensileSettings>(values, "settings");
+  const double fs = material.factors().stress;
+  const double r_um = real_radius_um(material);
+  const double f_ah =
+      s.wall_hamaker_factor > 0.0 ? s.wall_hamaker_factor : wall_hamaker_ratio_eq34(r_um);
+  const double f_k2 = s.wall_k2_factor > 0.0 ? s.wall_k2_factor : wall_k2_ratio_eq35(r_um);
+
+  // Adhesive piston and bottom: eq. 34 on the Hamaker constant, eq. 35 on k2 (k2/k1 of the
+  // Luding law, bounded by its table), stiffness as in the compression test.
+  contact::ContactLawSpec adhesive = stiffen_normal(material.wall_law, s.wall_stiffness_factor);
+  if (adhesive.cohesion.model == "van_der_waals" && adhesive.cohesion.params.count("hamaker"))
+    adhesive.cohesion.params["hamaker"] *= f_ah;
+  if (adhesive.normal.model == "luding") {
+    const double k2 =
+        adhesive.normal.params.count("k2_ratio") ? adhesive.normal.params["k2_ratio"] : 5.0;
+    adhesive.normal.params["k2_ratio"] = std::min(1e4, k2 * f_k2);
+  }
+  // The die: frictionless and without cohesion, it only stabilises the sample.
+  contact::ContactLawSpec die = material.wall_law;
+  die.cohesion = {"none", {}};
+  die.rolling = {"none", {}};
+  die.tangential.params["mu_s"] = 0.0;
+  if (die.normal.model == "luding") die.normal.params["kc_ratio"] = 0.0;
+  const auto adhesive_law = simulated_law(material, adhesive);
+  const auto die_law = simulated_law(material, die);
+
+  PistonBed bed = make_piston_bed(material, static_cast<std::size_t>(s.particles),
+                                  s.time_step_safety, options, [&](sim::World& w) {
+                                    w.set_wall_law(kWallPiston, 0, adhesive_law);
+                                    w.set_wall_law(kWallBottom, 0, adhesive_law);
+                                    w.set_wall_law(kWallDie, 0, die_law);
+                                  });
+  sim::World& w = bed.world;
+  LabOutput out;
+  const ServoSettings servo =
+      make_servo(w, bed.h0, s.consolidation_stress * fs, s.servo_max_speed, s.servo_kp, s.servo_ki,
+                 s.servo_kd, s.servo_tolerance, s.hold_steps, s.max_phase_time);
+  auto phase = [&](double target_real) {
+    ServoSettings ps = servo;
+    ps.tolerance = std::max(servo.tolerance * target_real, 2e-3 * s.consolidation_stress) * fs;
+    return servo_phase(w, bed.piston, bed.piston, {0, 0, -1}, bed.area, target_real * fs, ps,
+                       bed.limits);
+  };
+  const ServoPhase consolidated = phase(s.consolidation_stress);
+  const ServoPhase unloaded = phase(s.unload_stress);
+  if (options.progress) options.progress(0.5);
+  write_snapshot(w, options, "consolidated", out);
+
+  // Pull-off at constant speed.
+  const auto& p = w.particles;
+  double d_mean = 0.0;
+  for (double r : p.radius) d_mean += 2.0 * r;
+  d_mean /= static_cast<double>(p.size());
+  const double v = s.pull_speed > 0.0 ? s.pull_speed : 0.1 * servo.max_speed;
+  const double travel = s.pull_distance * d_mean;
+  const double h_start = unloaded.position;
+  auto& piston = w.walls[bed.piston];
+  piston.velocity = {0, 0, v};
+  Series series{{"time_s", "displacement_m", "strain", "tensile_stress_kPa"}, {}};
+  double peak = -1e300, peak_strain = 0.0;
+  const long steps = std::lround(travel / (v * w.dt));
+  const long record_every = std::max<long>(1, steps / 2000);
+  // Smooth the force over a window of ~1 % of the pull so that a single rattling contact does not
+  // make the peak.
+  const long window = std::max<long>(1, steps / 100);
+  double acc = 0.0;
+  long n_acc = 0, k = 0;
+  std::vector<double> z_late;
+  run_checked(w, steps, bed.limits, [&](sim::World& world) {
+    const double z = std::get<walls::Disk>(world.walls[bed.piston].shape).centre.z;
+    acc += -world.walls[bed.piston].force.z / bed.area;
+    ++n_acc;
+    if (n_acc == window) {
+      const double sigma = acc / n_acc;
+      if (sigma > peak) {
+        peak = sigma;
+        peak_strain = (z - h_start) / h_start;
+      }
+      acc = 0.0;
+      n_acc = 0;
+    }
+    if (++k % record_every == 0)
+      series.rows.push_back({world.time, z - h_start, (z - h_start) / h_start,
+                             -world.walls[bed.piston].force.z / bed.area / fs / 1e3});
+    if (k == (steps * 3) / 4) {
+      z_late.resize(world.particles.size());
+      for (std::size_t i = 0; i < world.particles.size(); ++i) z_late[i] = world.particles.x[i].z;
+    }
+    return true;
+  });
+  piston.velocity = {};
+  // Powder stuck to the piston: the particles that followed it over the last quarter of the pull.
+  double stuck_mass = 0.0;
+  const double dz_piston = 0.25 * travel;
+  for (std::size_t i = 0; i < p.size() && !z_late.empty(); ++i)
+    if (p.x[i].z - z_late[i] > 0.5 * dz_piston) stuck_mass += p.mass[i];
+  const double stuck_stress = stuck_mass * norm(w.gravity) / bed.area;
+  write_snapshot(w, options, "pulled", out);
+
+  out.metrics["tensile_strength"] = (peak - stuck_stress) / fs / 1e3;  // kPa, real
+  out.series["tensile"] = std::move(series);
+  out.series["fracture"] = Series{
+      {"peak_stress_kPa", "peak_strain", "stuck_weight_stress_kPa", "consolidated_height_m",
+       "unloaded_height_m", "consolidation_reached", "wall_hamaker_factor", "wall_k2_factor"},
+      {{peak / fs / 1e3, peak_strain, stuck_stress / fs / 1e3, consolidated.position,
+        unloaded.position, consolidated.reached ? 1.0 : 0.0, f_ah, f_k2}}};
+  return out;
+}
+
+}  // namespace demcal::lab
