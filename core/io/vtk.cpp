@@ -82,6 +82,12 @@ void write_walls_vtk(const std::string& path, const sim::World& world, double ex
               polygons.push_back({a, b, b + 1, a + 1});
               wall_of_polygon.push_back(static_cast<int>(k));
             }
+          } else if constexpr (std::is_same_v<S, walls::Mesh>) {
+            points.insert(points.end(), s.vertices.begin(), s.vertices.end());
+            for (const auto& t : s.triangles) {
+              polygons.push_back({base + t[0], base + t[1], base + t[2]});
+              wall_of_polygon.push_back(static_cast<int>(k));
+            }
           } else {
             Vec3 u, w;
             basis(s.normal, u, w);

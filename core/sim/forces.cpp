@@ -131,18 +131,13 @@ void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&,
   const int threads = w.threads;
   std::vector<Vec3> part_force(threads), part_torque(threads);
 
+  const walls::Mesh* mesh = std::get_if<walls::Mesh>(&wall.shape);
+
 #pragma omp parallel num_threads(threads)
   {
     const int tid = omp_get_thread_num();
     Vec3 wf{}, wt{};
-#pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
-      double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
-      walls::WallGeometry g;
-      if (!walls::wall_geometry(wall.shape, p.x[i], p.radius[i], range, g)) {
-        for (int s = 0; s < kStride; ++s) h[s] = 0.0;
-        continue;
-      }
+    auto apply = [&](int i, const walls::WallGeometry& g, double* h) {
       contact::PairInput in;
       in.n = g.n;
       in.delta = g.delta;
@@ -160,6 +155,71 @@ void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&,
       p.torque[i] += out.torque_i;
       wf -= out.force;
       wt += cross(g.point - wall.pivot, -out.force) + out.torque_j;
+    };
+    if (!mesh) {
+      // Plane, cylinder, disk: at most one contact per particle, one history per particle.
+#pragma omp for schedule(static)
+      for (int i = 0; i < n; ++i) {
+        double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
+        walls::WallGeometry g;
+        if (!walls::wall_geometry(wall.shape, p.x[i], p.radius[i], range, g)) {
+          for (int s = 0; s < kStride; ++s) h[s] = 0.0;
+          continue;
+        }
+        apply(i, g, h);
+      }
+    } else {
+      // Mesh: up to kMaxContacts contacts per particle, each continuing the history slot whose
+      // last normal is nearest its own (within 45 deg), so a contact keeps its tangential spring
+      // while it slides across triangles of one surface or rolls round an edge (mesh.hpp).
+      // Slot layout: [law history (kStride) | last normal (3)]; a zero normal marks a free slot.
+      constexpr int kSlots = walls::Mesh::kMaxContacts;
+      constexpr int kSlot = kStride + 3;
+      constexpr double kSameContact = 0.7071;
+#pragma omp for schedule(static)
+      for (int i = 0; i < n; ++i) {
+        double* h = hist + static_cast<std::ptrdiff_t>(i) * kSlots * kSlot;
+        walls::WallGeometry g[kSlots];
+        const int found = walls::mesh_contacts(*mesh, p.x[i], p.radius[i], range, g);
+        bool used[kSlots] = {};
+        int slot_of[kSlots];
+        for (int c = 0; c < found; ++c) {
+          int best = -1;
+          double best_dot = kSameContact;
+          for (int s = 0; s < kSlots; ++s) {
+            if (used[s]) continue;
+            const double* hn = h + s * kSlot + kStride;
+            const double d = hn[0] * g[c].n.x + hn[1] * g[c].n.y + hn[2] * g[c].n.z;
+            if (d > best_dot) {
+              best_dot = d;
+              best = s;
+            }
+          }
+          slot_of[c] = best;
+          if (best >= 0) used[best] = true;
+        }
+        // New contacts take free slots (a slot not continued this step starts afresh).
+        for (int c = 0; c < found; ++c) {
+          if (slot_of[c] >= 0) continue;
+          for (int s = 0; s < kSlots; ++s)
+            if (!used[s]) {
+              slot_of[c] = s;
+              used[s] = true;
+              for (int k = 0; k < kStride; ++k) h[s * kSlot + k] = 0.0;
+              break;
+            }
+        }
+        for (int s = 0; s < kSlots; ++s)
+          if (!used[s])
+            for (int k = 0; k < kSlot; ++k) h[s * kSlot + k] = 0.0;
+        for (int c = 0; c < found; ++c) {
+          double* hs = h + slot_of[c] * kSlot;
+          hs[kStride] = g[c].n.x;
+          hs[kStride + 1] = g[c].n.y;
+          hs[kStride + 2] = g[c].n.z;
+          apply(i, g[c], hs);
+        }
+      }
     }
     part_force[tid] = wf;
     part_torque[tid] = wt;

@@ -96,8 +96,8 @@ void World::prepare() {
               composition(row[particles.material.empty() ? 0 : particles.material[0]]))
         throw InputError("walls." + w.name,
                          "all laws of one wall material must use the same models");
-    wall_strides_.push_back(
-        row[particles.material.empty() ? 0 : particles.material[0]].history_size());
+    wall_strides_.push_back(walls::history_stride(
+        w.shape, row[particles.material.empty() ? 0 : particles.material[0]].history_size()));
   }
   check_time_step(*this);
 

@@ -61,8 +61,10 @@ bool wall_geometry(const Shape& shape, const Vec3& x, double r, double range, Wa
           return plane_geometry(s, x, r, range, out);
         else if constexpr (std::is_same_v<S, Cylinder>)
           return cylinder_geometry(s, x, r, range, out);
-        else
+        else if constexpr (std::is_same_v<S, Disk>)
           return disk_geometry(s, x, r, range, out);
+        else
+          return mesh_contacts(s, x, r, range, &out) > 0;
       },
       shape);
 }
@@ -73,10 +75,15 @@ Wall make_wall(std::string name, Shape shape, std::uint16_t material) {
   w.pivot = std::visit(
       [](const auto& s) {
         using S = std::decay_t<decltype(s)>;
-        if constexpr (std::is_same_v<S, Disk>)
+        if constexpr (std::is_same_v<S, Disk>) {
           return s.centre;
-        else
+        } else if constexpr (std::is_same_v<S, Mesh>) {
+          Vec3 c{};
+          for (const auto& v : s.vertices) c += v;
+          return s.vertices.empty() ? c : c / static_cast<double>(s.vertices.size());
+        } else {
           return s.point;
+        }
       },
       shape);
   w.shape = std::move(shape);
@@ -107,9 +114,11 @@ void advance(Wall& wall, double dt) {
         } else if constexpr (std::is_same_v<S, Cylinder>) {
           move_point(s.point);
           turn(s.axis);
-        } else {
+        } else if constexpr (std::is_same_v<S, Disk>) {
           move_point(s.centre);
           turn(s.normal);
+        } else {
+          for (auto& v : s.vertices) move_point(v);
         }
       },
       wall.shape);

@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "core/common/vec3.hpp"
+#include "core/walls/mesh.hpp"
 
 namespace demcal::walls {
 
@@ -32,7 +33,8 @@ struct Disk {
   Vec3 normal;  ///< unit
   double radius = 0.0;
 };
-using Shape = std::variant<Plane, Cylinder, Disk>;
+/// Mesh (core/walls/mesh.hpp): triangles; a particle may touch it at several points at once.
+using Shape = std::variant<Plane, Cylinder, Disk, Mesh>;
 
 /// Where a sphere meets a wall. n points from the particle centre into the wall.
 struct WallGeometry {
@@ -57,11 +59,22 @@ struct Wall {
 };
 
 /// A wall at rest whose pivot is the shape's own reference point (plane point, cylinder axis
-/// point, disk centre).
+/// point, disk centre, mesh vertex centroid).
 Wall make_wall(std::string name, Shape shape, std::uint16_t material = 0);
 
+/// History slots a wall keeps per particle: 1, or Mesh::kMaxContacts for a mesh.
+inline int contact_slots(const Shape& shape) {
+  return std::holds_alternative<Mesh>(shape) ? Mesh::kMaxContacts : 1;
+}
+/// Doubles of history a wall keeps per particle for a contact law with `law_stride` doubles: a
+/// mesh slot adds the slot's last contact normal (3 doubles; zero = slot free).
+inline int history_stride(const Shape& shape, int law_stride) {
+  return std::holds_alternative<Mesh>(shape) ? Mesh::kMaxContacts * (law_stride + 3) : law_stride;
+}
+
 /// Nearest-point geometry of a sphere (centre x, radius r) against a shape; false when the gap
-/// exceeds `range` (or the sphere is beside a finite wall's extent).
+/// exceeds `range` (or the sphere is beside a finite wall's extent). For a mesh: its deepest
+/// contact (the force kernel uses all of them, mesh_contacts()).
 bool wall_geometry(const Shape& shape, const Vec3& x, double r, double range, WallGeometry& out);
 
 /// Moves a wall rigidly over dt: translation, then rotation about its pivot.
