@@ -2,6 +2,8 @@
 
 #include "core/common/error.hpp"
 #include "core/lab/packing.hpp"
+#include "core/lab/wall_friction.hpp"
+#include "core/lab/tensile.hpp"
 #include "core/lab/confined_compression.hpp"
 
 namespace demcal::lab {
@@ -39,8 +41,32 @@ LabTestInfo confined_compression_info() {
           settings_docs<ConfinedCompressionSettings>()};
 }
 
+// tensile: seed 000 §2.7.3 (eq. 34-35); runner in tensile.cpp.
+LabTestInfo tensile_info() {
+  return {"tensile",
+          "bed consolidated in the die by an adhesive piston (eq. 34-35), unloaded, and pulled "
+          "apart at constant slow speed inside a frictionless non-cohesive die wall",
+          "seed 000 §2.7.3 (eq. 34-35, Fig. 10-11)",
+          {{"tensile_strength", "kPa",
+            "peak tensile stress on the piston less the weight of the powder stuck to it, over "
+            "the piston area"}},
+          settings_docs<TensileSettings>()};
+}
+
+// wall_friction: seed 000 §2.7.5, §3.3.4; runner in wall_friction.cpp.
+LabTestInfo wall_friction_info() {
+  return {"wall_friction",
+          "bed pressed by the container against a piston that turns at constant normal stress "
+          "(1, 1.25, 1.5, 1.75, 2, 3 kPa); tau = 3 T / (2 pi R^3); regression through the origin",
+          "seed 000 §2.7.5, §3.3.4",
+          {{"wall_friction_angle", "deg",
+            "atan of the slope of the wall shear stress over the normal stress, fitted through "
+            "the origin"}},
+          settings_docs<WallFrictionSettings>()};
+}
+
 const std::vector<LabTestInfo>& lab_catalog() {
-  static const std::vector<LabTestInfo> tests = {packing_info(), confined_compression_info()};
+  static const std::vector<LabTestInfo> tests = {packing_info(), confined_compression_info(), tensile_info(), wall_friction_info()};
   return tests;
 }
 

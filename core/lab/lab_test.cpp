@@ -2,12 +2,16 @@
 
 #include "core/common/error.hpp"
 #include "core/lab/packing.hpp"
+#include "core/lab/wall_friction.hpp"
+#include "core/lab/tensile.hpp"
 #include "core/lab/confined_compression.hpp"
 
 namespace demcal::lab {
 
 LabRunner find_lab_runner(const std::string& name) {
   if (name == "packing") return run_packing;
+  if (name == "wall_friction") return run_wall_friction;
+  if (name == "tensile") return run_tensile;
   if (name == "confined_compression") return run_confined_compression;
   find_lab_info(name);  // throws with the known names
   throw InputError("test", "lab test '" + name + "' is catalogued but has no runner");

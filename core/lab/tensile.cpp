@@ -95,7 +95,7 @@ LabOutput run_tensile(const MaterialModel& material, const Settings& values,
   double d_mean = 0.0;
   for (double r : p.radius) d_mean += 2.0 * r;
   d_mean /= static_cast<double>(p.size());
-  const double v = s.pull_speed > 0.0 ? s.pull_speed : 0.1 * servo.max_speed;
+  const double v = s.pull_speed > 0.0 ? s.pull_speed : 0.5 * servo.max_speed;
   const double travel = s.pull_distance * d_mean;
   const double h_start = unloaded.position;
   auto& piston = w.walls[bed.piston];
