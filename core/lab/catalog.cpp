@@ -1,7 +1,10 @@
 #include "core/lab/catalog.hpp"
 
 #include "core/common/error.hpp"
+#include "core/lab/hopper.hpp"
 #include "core/lab/packing.hpp"
+#include "core/lab/rotating_drum.hpp"
+#include "core/lab/shear_cell.hpp"
 #include "core/lab/wall_friction.hpp"
 #include "core/lab/tensile.hpp"
 #include "core/lab/confined_compression.hpp"
@@ -65,8 +68,60 @@ LabTestInfo wall_friction_info() {
           settings_docs<WallFrictionSettings>()};
 }
 
+// shear_cell: seed 000 §2.7.4, Table 3, Fig. 12 and 23 (runner in shear_cell.cpp).
+LabTestInfo shear_cell_info() {
+  return {"shear_cell",
+          "FT4 standard shear test: vaned shear head (mesh) in a cylindrical vessel, normal stress "
+          "applied by the container; pre-shear at 3 kPa, then yield under torque control at 2, "
+          "1.75, 1.5, 1.25 and 1 kPa, each from the pre-sheared state; tau = 3 T / (2 pi R^3)",
+          "seed 000 §2.7.4 (Table 3, Fig. 12, Fig. 23)",
+          {{"pre_shear_stress", "kPa", "steady shear stress of the pre-shear at sigma_pre = 3 kPa"},
+           {"yield_locus_slope", "-", "slope of the least-squares yield locus"},
+           {"yield_locus_intercept", "kPa", "intercept (cohesion) of the yield locus"},
+           {"ffc", "-", "flow function sigma_1 / sigma_c from the Mohr circles (0 if inconsistent)"},
+           {"effective_friction_angle", "deg",
+            "angle of the origin line touching the consolidation circle (0 if inconsistent)"},
+           {"mohr_consistent", "0/1",
+            "0 when the pre-shear point lies above the yield locus (seed 000 Fig. 23b)"},
+           {"unconfined_yield_strength", "kPa", "sigma_c of the Mohr circle through the origin"},
+           {"major_consolidation_stress", "kPa",
+            "sigma_1 of the circle through the pre-shear point touching the locus"}},
+          settings_docs<ShearCellSettings>()};
+}
+
+// rotating_drum: seed 001 §3.2.2-3.2.3, eq. 20 (runner in rotating_drum.cpp).
+LabTestInfo rotating_drum_info() {
+  return {"rotating_drum",
+          "drum (D x W = 100 x 44 mm in the seed, scaled) 43 % full: dynamic angle of repose at "
+          "4 rpm from a line fitted to the projected free surface, and the area method at 4, 40, "
+          "80, 105 and 116 rpm from a raster of the projected bed",
+          "seed 001 §3.2.2-3.2.3 (eq. 20, Fig. 13)",
+          {{"dynamic_angle_of_repose", "deg", "free-surface angle at 4 rpm (image fit)"},
+           {"csa_occupied_4", "%", "occupied cross-sectional area at 4 rpm (eq. 20)"},
+           {"csa_occupied_40", "%", "occupied cross-sectional area at 40 rpm (eq. 20)"},
+           {"csa_occupied_80", "%", "occupied cross-sectional area at 80 rpm (eq. 20)"},
+           {"csa_occupied_105", "%", "occupied cross-sectional area at 105 rpm (eq. 20)"},
+           {"csa_occupied_116", "%", "occupied cross-sectional area at 116 rpm (eq. 20)"},
+           {"centrifuging_116", "0/1", "1 when the bed centrifuges at 116 rpm"}},
+          settings_docs<RotatingDrumSettings>()};
+}
+
+// hopper: seed 000 §2.7.6 (runner in hopper.cpp).
+LabTestInfo hopper_info() {
+  return {"hopper",
+          "wedge hopper slice with periodic front and back: fill and settle with the gate closed, "
+          "open it, discharge rate from the mass-time curve, arching, ratio to Beverloo's slot "
+          "law (hydraulic-diameter form) W = (4 sqrt 2 / pi) C rho_b sqrt(g) L (b - k d)^1.5 with C = 0.58, k = 1.5",
+          "seed 000 §2.7.6",
+          {{"discharge_rate", "kg/s", "slope of the discharged mass over time after start-up"},
+           {"arched", "0/1", "1 when no particle left for arch_time before the hopper emptied"},
+           {"beverloo_ratio", "-", "discharge_rate over Beverloo's slot-form rate"}},
+          settings_docs<HopperSettings>()};
+}
+
 const std::vector<LabTestInfo>& lab_catalog() {
-  static const std::vector<LabTestInfo> tests = {packing_info(), confined_compression_info(), tensile_info(), wall_friction_info()};
+  static const std::vector<LabTestInfo> tests = {packing_info(), confined_compression_info(), tensile_info(), wall_friction_info(), shear_cell_info(),
+                                                  rotating_drum_info(), hopper_info()};
   return tests;
 }
 

@@ -1,7 +1,10 @@
 #include "core/lab/lab_test.hpp"
 
 #include "core/common/error.hpp"
+#include "core/lab/hopper.hpp"
 #include "core/lab/packing.hpp"
+#include "core/lab/rotating_drum.hpp"
+#include "core/lab/shear_cell.hpp"
 #include "core/lab/wall_friction.hpp"
 #include "core/lab/tensile.hpp"
 #include "core/lab/confined_compression.hpp"
@@ -10,6 +13,9 @@ namespace demcal::lab {
 
 LabRunner find_lab_runner(const std::string& name) {
   if (name == "packing") return run_packing;
+  if (name == "shear_cell") return run_shear_cell;
+  if (name == "rotating_drum") return run_rotating_drum;
+  if (name == "hopper") return run_hopper;
   if (name == "wall_friction") return run_wall_friction;
   if (name == "tensile") return run_tensile;
   if (name == "confined_compression") return run_confined_compression;

@@ -22,6 +22,7 @@ struct LabOutput {
   std::map<std::string, double> metrics;  ///< by the names of the catalogue
   std::map<std::string, Series> series;
   std::vector<std::string> snapshots;  ///< VTK files written
+  std::vector<std::string> notes;      ///< plain statements about the result
 };
 
 struct RunOptions {

@@ -1,0 +1,190 @@
+// hopper (seed 000 §2.7.6): a wedge hopper slice with periodic front and back is filled with the
+// gate closed, the bed settles, the gate opens, and the discharged mass is recorded over time.
+//
+// Beverloo's law (C = 0.58, k = 1.5, the circular-orifice constants) in its slot form through the
+// hydraulic diameter: the circular law W = C rho_b sqrt(g) D^(5/2) written as
+// W = (4/pi) C rho_b sqrt(g) A sqrt(D_h) (A = pi D^2/4, D_h = D) holds for any orifice with its
+// area A and hydraulic diameter D_h = 4 A / perimeter, both shrunk by the empty annulus k d. A
+// slot of width b and length L >> b (here L is the periodic slice depth, no end walls) has
+// A = L (b - k d) and D_h = 2 (b - k d), so
+//   W_B = (4 sqrt(2) / pi) C rho_b sqrt(g) L (b - k d)^(3/2)   (= 1.04 rho_b sqrt(g) L (b-kd)^1.5,
+// close to the slot coefficient 1.03 of Myers and Sellers). rho_b is the bulk density of the
+// settled bed (measured: solid fraction in a box in the middle of the bed times the particle
+// density) and d the largest particle diameter.
+#include "core/lab/hopper.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/common/error.hpp"
+#include "core/common/rng.hpp"
+#include "core/io/vtk.hpp"
+#include "core/lab/bed.hpp"
+#include "core/metrics/bulk.hpp"
+#include "core/particles/insertion.hpp"
+#include "core/sim/step.hpp"
+#include "core/sim/time_step.hpp"
+
+namespace demcal::lab {
+
+namespace {
+constexpr double kBeverlooC = 0.58, kBeverlooK = 1.5;
+}
+
+LabOutput run_hopper(const MaterialModel& material, const Settings& values,
+                     const RunOptions& options) {
+  const auto s = read_settings<HopperSettings>(values, "settings");
+  sim::World w;
+  w.threads = options.threads;
+  const auto sizes = material.simulated_sizes();
+  const double density = material.simulated_density();
+  w.set_pair_law(0, 0, material.simulated_particle_law());
+  for (std::uint16_t m : {kWallDefault, kWallDie, kWallPiston, kWallBottom})
+    w.set_wall_law(m, 0, material.simulated_wall_law());
+  const double r_max = particles::max_radius(sizes);
+  const double d = 2.0 * r_max;
+  const double b = s.outlet * d, depth = s.depth * d;
+  const double theta = s.half_angle * M_PI / 180.0;
+
+  // Size the hopper for the bed: the wedge of height h holds (b + h tan) h depth of bulk; the
+  // particles (solid fraction ~0.6) should fill the wedge and a little of the bin above.
+  Rng rng(options.seed);
+  double solid = 0.0;
+  {
+    Rng r2(options.seed ^ 0x5eed);
+    for (int k = 0; k < 2000; ++k)
+      solid += 4.0 / 3.0 * M_PI * std::pow(particles::sample_radius(sizes, r2), 3);
+    solid *= s.particles / 2000.0;
+  }
+  const double area = solid / (0.6 * depth);  // x-z area of the settled bed
+  const double t = std::tan(theta);
+  // (b + h t) h = area  ->  h = (-b + sqrt(b^2 + 4 t area)) / (2 t)
+  const double h = std::max(4.0 * d, (-b + std::sqrt(b * b + 4.0 * t * area)) / (2.0 * t));
+  const double top = b + 2.0 * h * t;             // width at the top of the wedge
+  const double bin = 3.0 * area / top + 4.0 * d;  // room for the loose insertion
+  w.domain.lo = {-1e3, 0.0, -1e3};
+  w.domain.hi = {1e3, depth, 1e3};
+  w.domain.periodic = {false, true, false};
+  w.walls.push_back(walls::make_wall(
+      "hopper", walls::make_wedge_hopper(theta, b, h, bin, -2.0 * d, depth + 2.0 * d), kWallDie));
+  w.walls.push_back(walls::make_wall("gate", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
+
+  particles::InsertRequest req;
+  req.region = particles::BoxRegion{{-0.5 * top, 0.0, h}, {0.5 * top, depth, h + bin}};
+  req.sizes = sizes;
+  req.count = static_cast<std::size_t>(s.particles);
+  req.density = density;
+  // Spheres stay inside the region, so none overlaps a periodic image across y = 0 / depth.
+  particles::insert_random(w.particles, req, rng);
+  w.dt = sim::recommended_time_step(w, s.time_step_safety);
+
+  sim::HealthLimits limits;
+  limits.lo = {-top - bin, -1e3, -(h + bin) * 4.0 - 1.0};
+  limits.hi = {top + bin, 1e3, 2.0 * (h + bin)};
+  limits.max_kinetic_energy =
+      1e3 * w.particles.total_mass() * std::max(norm(w.gravity), 1.0) * (h + bin);
+
+  // 1. Fill and settle with the gate closed.
+  BedSpec settle_spec;
+  settle_spec.max_settle_time = 1.5;
+  settle(w, settle_spec, limits);
+
+  // Bulk density of the settled bed: a box in the middle of the wedge, two diameters from the
+  // walls (at its height the wedge is wider than the box).
+  const double z0 = 0.3 * h, z1 = std::min(0.9 * h, metrics::bed_top(w) - 2.0 * d);
+  const double half = 0.5 * (b + 2.0 * z0 * t) - 2.0 * d;
+  double phi = 0.6;
+  if (half > d && z1 > z0 + d)
+    phi = metrics::solid_fraction(w, {-half, 0.0, z0}, {half, depth, z1});
+  const double rho_b = phi * density;
+
+  LabOutput out;
+  if (!options.snapshot_dir.empty()) {
+    io::write_particles_vtk(options.snapshot_dir + "/hopper_settled_particles.vtk", w);
+    io::write_walls_vtk(options.snapshot_dir + "/hopper_walls.vtk", w, top);
+    out.snapshots = {options.snapshot_dir + "/hopper_settled_particles.vtk",
+                     options.snapshot_dir + "/hopper_walls.vtk"};
+  }
+
+  // 2. Open the gate (moved far away: no wall is removed, so the bed keeps its contact history).
+  std::get<walls::Plane>(w.walls[1].shape).point = {0, 0, -1e3};
+  w.walls[1].pivot = {0, 0, -1e3};
+
+  // Discharged particles (centre below z = -2 d) are parked, kinematic, on a lattice under the
+  // hopper, so they neither fall for ever nor touch anything.
+  const double total_mass = w.particles.total_mass();
+  const double park_z = -(h + bin) * 2.0;
+  const int per_row = std::max(1, static_cast<int>(top / (3.0 * r_max)));
+  const int per_col = std::max(1, static_cast<int>(depth / (3.0 * r_max)));
+  int parked = 0;
+  std::vector<char> gone(w.particles.size(), 0);
+  double discharged = 0.0, last_discharge = 0.0;
+  const double t0 = w.time;
+  Series curve{{"time", "discharged_mass"}, {}};
+  curve.rows.push_back({0.0, 0.0});
+  bool arched = false;
+  const long check = std::max<long>(1, std::lround(0.002 / w.dt));
+  auto each = [&](sim::World& world) {
+    if (world.step_count % check != 0) return true;
+    auto& p = world.particles;
+    bool any = false;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (gone[i] || p.x[i].z > -2.0 * d) continue;
+      gone[i] = 1;
+      any = true;
+      discharged += p.mass[i];
+      const int k = parked++;
+      p.x[i] = {-0.5 * top + 3.0 * r_max * (k % per_row + 0.5),
+                3.0 * r_max * ((k / per_row) % per_col + 0.5),
+                park_z - 3.0 * r_max * (k / (per_row * per_col))};
+      p.v[i] = {};
+      p.omega[i] = {};
+      p.set_motion(i, particles::Motion::kKinematic);
+    }
+    const double tt = world.time - t0;
+    if (any) {
+      last_discharge = tt;
+      curve.rows.push_back({tt, discharged});
+    }
+    if (discharged >= 0.999 * total_mass) return false;
+    if (tt - last_discharge > s.arch_time) {
+      arched = true;
+      return false;
+    }
+    if (options.progress) options.progress(std::min(1.0, tt / s.max_time));
+    return tt < s.max_time;
+  };
+  limits.lo.z = park_z - 3.0 * r_max * (s.particles / (per_row * per_col) + 2) - 1.0;
+  run_checked(w, std::lround(s.max_time / w.dt) + 1, limits, each);
+
+  // Discharge rate: least-squares slope of the mass-time curve between 15 % and 75 % of the
+  // discharged mass (after the start-up, before the hopper runs empty).
+  const double m_end = discharged;
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int n = 0;
+  for (const auto& row : curve.rows)
+    if (row[1] >= 0.15 * m_end && row[1] <= 0.75 * m_end) {
+      sx += row[0], sy += row[1], sxx += row[0] * row[0], sxy += row[0] * row[1];
+      ++n;
+    }
+  double rate = 0.0;
+  if (n >= 3 && n * sxx - sx * sx > 0.0)
+    rate = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  else if (curve.rows.size() >= 2 && curve.rows.back()[0] > 0.0)
+    rate = m_end / curve.rows.back()[0];
+
+  // Beverloo slot form (header comment).
+  const double g = norm(w.gravity);
+  const double opening = std::max(0.0, b - kBeverlooK * d);
+  const double beverloo = 4.0 * std::sqrt(2.0) / M_PI * kBeverlooC * rho_b * std::sqrt(g) * depth *
+                          std::pow(opening, 1.5);
+  out.metrics["discharge_rate"] = rate;
+  out.metrics["arched"] = arched ? 1.0 : 0.0;
+  out.metrics["beverloo_ratio"] = beverloo > 0.0 ? rate / beverloo : 0.0;
+  out.metrics["discharged_fraction"] = m_end / total_mass;
+  out.metrics["bulk_density"] = rho_b;
+  out.series["discharge"] = std::move(curve);
+  return out;
+}
+
+}  // namespace demcal::lab

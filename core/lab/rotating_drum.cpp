@@ -1,0 +1,236 @@
+// rotating_drum (seed 001 §3.2.2-3.2.3). The drum's axis is z and gravity is -y, so the cross
+// section is the x-y plane and the "photograph" is the projection of the particles along z.
+// The drum (inner cylinder) and both end plates rotate rigidly about the axis; their contact law
+// is the material's wall law (the granule-boundary law of seed 001 Table 3).
+//
+// Phases: insert in the drum, settle at rest, rotate at 4 rpm until the bed has turned to its
+// angle, then keep turning for angle_time while images are taken: dynamic_angle_of_repose is the
+// mean of the surface-fit angles. Then the area method: the speeds in ascending order, each for
+// area_time; csa_occupied_<rpm> (seed 001 eq. 20) is the mean occupied area of the images of the
+// second half of each speed. A bed whose particles all lie in a ring at the wall (none within
+// half a radius of the axis) and cover at least 90 % of the wall's circumference is centrifuging:
+// centrifuging_<rpm> = 1.
+#include "core/lab/rotating_drum.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/common/rng.hpp"
+#include "core/io/vtk.hpp"
+#include "core/lab/bed.hpp"
+#include "core/particles/insertion.hpp"
+#include "core/sim/step.hpp"
+#include "core/sim/time_step.hpp"
+
+namespace demcal::lab {
+namespace {
+
+constexpr double kSeedDrumDiameter = 0.100;  // seed 001 §3.2.2
+
+bool centrifuging(const sim::World& w, double radius) {
+  constexpr int kSectors = 36;
+  std::array<bool, kSectors> covered{};
+  const double d = 2.0 * *std::max_element(w.particles.radius.begin(), w.particles.radius.end());
+  for (std::size_t i = 0; i < w.particles.size(); ++i) {
+    const Vec3& x = w.particles.x[i];
+    const double rho = std::hypot(x.x, x.y);
+    if (rho < 0.5 * radius) return false;
+    if (rho > radius - 2.0 * d) {
+      const double phi = std::atan2(x.y, x.x) + M_PI;
+      covered[std::min(kSectors - 1, static_cast<int>(phi / (2.0 * M_PI) * kSectors))] = true;
+    }
+  }
+  return std::count(covered.begin(), covered.end(), true) >= 0.9 * kSectors;
+}
+
+}  // namespace
+
+DrumImage project_drum(const std::vector<Vec3>& x, const std::vector<double>& radius,
+                       double drum_radius, double pixel) {
+  DrumImage img;
+  img.radius = drum_radius;
+  img.pixel = pixel;
+  img.n = static_cast<int>(std::ceil(2.0 * drum_radius / pixel));
+  img.black.assign(static_cast<std::size_t>(img.n) * img.n, 0);
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const double r = radius[k];
+    const int i0 = std::max(0, static_cast<int>((x[k].x - r + drum_radius) / pixel));
+    const int i1 = std::min(img.n - 1, static_cast<int>((x[k].x + r + drum_radius) / pixel));
+    const int j0 = std::max(0, static_cast<int>((x[k].y - r + drum_radius) / pixel));
+    const int j1 = std::min(img.n - 1, static_cast<int>((x[k].y + r + drum_radius) / pixel));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const double px = -drum_radius + (i + 0.5) * pixel - x[k].x;
+        const double py = -drum_radius + (j + 0.5) * pixel - x[k].y;
+        if (px * px + py * py <= r * r) img.black[static_cast<std::size_t>(j) * img.n + i] = 1;
+      }
+  }
+  return img;
+}
+
+double DrumImage::occupied_percent() const {
+  // eq. 20: CSA_oc = 100 black area / CSA_drum, both counted in pixels of the drum circle.
+  long drum = 0, occupied = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double px = -radius + (i + 0.5) * pixel, py = -radius + (j + 0.5) * pixel;
+      if (px * px + py * py > radius * radius) continue;
+      ++drum;
+      occupied += at(i, j);
+    }
+  return drum ? 100.0 * occupied / drum : 0.0;
+}
+
+double DrumImage::surface_angle() const {
+  // The free surface: in each column, the top black pixel that has black below it (a lone
+  // particle in flight is not the surface).
+  std::vector<double> xs, ys;
+  for (int i = 0; i < n; ++i)
+    for (int j = n - 1; j >= 2; --j)
+      if (at(i, j) && at(i, j - 1) && at(i, j - 2)) {
+        xs.push_back(-radius + (i + 0.5) * pixel);
+        ys.push_back(-radius + (j + 0.5) * pixel);
+        break;
+      }
+  if (xs.size() < 4) return 0.0;
+  // The surface spans the chord between the two points where it meets the wall; fit its middle
+  // half, away from the toe and the shoulder.
+  const double lo = xs.front(), hi = xs.back();
+  const double a = lo + 0.25 * (hi - lo), b = lo + 0.75 * (hi - lo);
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int m = 0;
+  for (std::size_t k = 0; k < xs.size(); ++k)
+    if (xs[k] >= a && xs[k] <= b) {
+      sx += xs[k], sy += ys[k], sxx += xs[k] * xs[k], sxy += xs[k] * ys[k];
+      ++m;
+    }
+  if (m < 3 || m * sxx - sx * sx <= 0.0) return 0.0;
+  const double slope = (m * sxy - sx * sy) / (m * sxx - sx * sx);
+  return std::atan(std::abs(slope)) * 180.0 / M_PI;
+}
+
+LabOutput run_rotating_drum(const MaterialModel& material, const Settings& values,
+                            const RunOptions& options) {
+  const auto s = read_settings<RotatingDrumSettings>(values, "settings");
+  sim::World w;
+  w.threads = options.threads;
+  w.gravity = {0, -9.81, 0};
+  const auto sizes = material.simulated_sizes();
+  const double density = material.simulated_density();
+  w.set_pair_law(0, 0, material.simulated_particle_law());
+  for (std::uint16_t m : {kWallDefault, kWallDie, kWallPiston, kWallBottom})
+    w.set_wall_law(m, 0, material.simulated_wall_law());
+  const double r_max = particles::max_radius(sizes);
+
+  // Drum size from the particle count: fill * pi R^2 W = solid volume / 0.6, W = aspect 2R.
+  Rng rng(options.seed);
+  double solid = 0.0;
+  {
+    Rng r2(options.seed ^ 0x5eed);
+    for (int k = 0; k < 2000; ++k)
+      solid += 4.0 / 3.0 * M_PI * std::pow(particles::sample_radius(sizes, r2), 3);
+    solid *= s.particles / 2000.0;
+  }
+  const double radius =
+      std::max(6.0 * r_max, std::cbrt(solid / (0.6 * s.fill * M_PI * 2.0 * s.aspect)));
+  const double depth = std::max(2.0 * s.aspect * radius, 2.5 * r_max);
+  w.walls.push_back(walls::make_wall(
+      "drum", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius, 0.0, depth}, kWallDie));
+  w.walls.push_back(walls::make_wall("back", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
+  w.walls.push_back(
+      walls::make_wall("front", walls::Plane{{0, 0, depth}, {0, 0, -1}}, kWallPiston));
+  for (auto& wall : w.walls) wall.pivot = {0, 0, 0};
+
+  particles::InsertRequest req;
+  req.region = particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth};
+  req.sizes = sizes;
+  req.count = static_cast<std::size_t>(s.particles);
+  req.density = density;
+  particles::insert_random(w.particles, req, rng);
+  w.dt = sim::recommended_time_step(w, s.time_step_safety);
+
+  sim::HealthLimits limits;
+  limits.lo = {-1.5 * radius, -1.5 * radius, -radius};
+  limits.hi = {1.5 * radius, 1.5 * radius, depth + radius};
+  limits.max_kinetic_energy = 1e3 * w.particles.total_mass() * 9.81 * 2.0 * radius;
+
+  BedSpec settle_spec;
+  settle_spec.max_settle_time = 1.0;
+  settle(w, settle_spec, limits);
+
+  // Froude scaling: Fr = w^2 R / g of the seed's drum at the seed's rpm.
+  const double speed_factor =
+      s.speed_scale *
+      (s.froude_scaling > 0.5 ? std::sqrt(kSeedDrumDiameter / (2.0 * radius)) : 1.0);
+  auto set_speed = [&](double rpm) {
+    const double omega = rpm * speed_factor * 2.0 * M_PI / 60.0;
+    limits.max_kinetic_energy =
+        1e3 * w.particles.total_mass() * (9.81 * 2.0 * radius + omega * omega * radius * radius);
+    for (auto& wall : w.walls) wall.omega = {0, 0, omega};
+    return omega;
+  };
+  const double pixel = 0.25 * r_max;
+  auto image = [&] { return project_drum(w.particles.x, w.particles.radius, radius, pixel); };
+
+  LabOutput out;
+  Series angle_series{{"time", "angle_deg", "csa_occupied_percent"}, {}};
+  const double frame = 0.05;  // s between images
+  const long frame_steps = std::max<long>(1, std::lround(frame / w.dt));
+  auto run_for = [&](double seconds, const std::function<void()>& on_frame) {
+    const long frames = std::max<long>(1, std::lround(seconds / frame));
+    for (long f = 0; f < frames; ++f) {
+      run_checked(w, frame_steps, limits);
+      if (on_frame) on_frame();
+    }
+  };
+
+  // 4 rpm: first turn the bed up to its angle (60 deg of drum rotation at most), then measure.
+  const double w4 = set_speed(kDrumSpeeds[0]);
+  run_for(std::min(60.0 * M_PI / 180.0 / w4, 3.0), {});
+  double angle_sum = 0.0;
+  int angle_n = 0;
+  run_for(s.angle_time, [&] {
+    const DrumImage img = image();
+    const double a = img.surface_angle();
+    angle_series.rows.push_back({w.time, a, img.occupied_percent()});
+    if (angle_series.rows.size() * 2 > static_cast<std::size_t>(s.angle_time / frame)) {
+      angle_sum += a;
+      ++angle_n;
+    }
+  });
+  out.metrics["dynamic_angle_of_repose"] = angle_n ? angle_sum / angle_n : 0.0;
+  if (options.progress) options.progress(0.4);
+  if (!options.snapshot_dir.empty()) {
+    const std::string p = options.snapshot_dir + "/drum_4rpm_particles.vtk";
+    io::write_particles_vtk(p, w);
+    io::write_walls_vtk(options.snapshot_dir + "/drum_walls.vtk", w, radius);
+    out.snapshots = {p, options.snapshot_dir + "/drum_walls.vtk"};
+  }
+
+  Series area{{"rpm", "rpm_simulated", "csa_occupied_percent", "centrifuging"}, {}};
+  for (std::size_t k = 0; k < kDrumSpeeds.size(); ++k) {
+    const int rpm = kDrumSpeeds[k];
+    const double omega = set_speed(rpm);
+    double sum = 0.0;
+    int n = 0, frames = 0;
+    const int total = std::max(1, static_cast<int>(std::lround(s.area_time / frame)));
+    bool centri = true;
+    run_for(s.area_time, [&] {
+      if (++frames * 2 <= total && total > 1) return;
+      sum += image().occupied_percent();
+      ++n;
+      centri = centri && centrifuging(w, radius);
+    });
+    const double csa = n ? sum / n : 0.0;
+    out.metrics["csa_occupied_" + std::to_string(rpm)] = csa;
+    out.metrics["centrifuging_" + std::to_string(rpm)] = centri ? 1.0 : 0.0;
+    area.rows.push_back({double(rpm), omega * 60.0 / (2.0 * M_PI), csa, centri ? 1.0 : 0.0});
+    if (options.progress) options.progress(0.4 + 0.6 * (k + 1) / kDrumSpeeds.size());
+  }
+  out.metrics["drum_diameter"] = 2.0 * radius;
+  out.series["angle"] = std::move(angle_series);
+  out.series["area_method"] = std::move(area);
+  return out;
+}
+
+}  // namespace demcal::lab

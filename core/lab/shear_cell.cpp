@@ -1,0 +1,273 @@
+// shear_cell (seed 000 §2.7.4): the FT4 standard shear test.
+//
+// Set-up: a cylindrical vessel (inner cylinder, kWallDie) with a floor (kWallBottom) that is the
+// moving part of the container, and a shear head (kWallPiston) built as a mesh: a disk of the
+// vessel radius R with radial vanes of height h_v below it. As in the seed, the normal stress is
+// applied by the container: the floor is servo-controlled (walls::StressServo) to the target
+// normal stress measured on the floor, while the head only rotates about the vessel axis.
+//
+// Torque -> shear stress: the bed shears in the plane of the vane tips (a disk of radius R); for
+// a uniform shear stress tau over that disk the torque is
+//   T = int_0^R tau 2 pi r r dr = (2/3) pi R^3 tau,   so   tau = 3 T / (2 pi R^3).
+//
+// Phases: fill and settle; consolidate at sigma_pre = 3 kPa; pre-shear at constant tip speed for
+// pre_shear_travel diameters: pre_shear_stress is the mean tau of the last third (steady state).
+// Then, for every sigma_x of Table 3, starting again from the pre-sheared state (the seed's
+// restart files): re-consolidate at sigma_pre with the head at rest, reduce to sigma_x, and
+// drive the head by torque: the set torque ramps up, the head turns at
+//   omega = clamp(k (T_set - T), 0, omega_max)
+// and the bed has yielded once the tips have travelled one diameter; the yield shear stress is
+// the largest tau (mean over 0.2 d of tip travel) on the way. A least-squares line through the five
+// (measured sigma, tau) points is the yield locus; the Mohr circles follow (mohr_evaluation).
+#include "core/lab/shear_cell.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+#include "core/common/rng.hpp"
+#include "core/io/vtk.hpp"
+#include "core/lab/bed.hpp"
+#include "core/metrics/bulk.hpp"
+#include "core/particles/insertion.hpp"
+#include "core/sim/step.hpp"
+#include "core/sim/time_step.hpp"
+#include "core/walls/servo.hpp"
+
+namespace demcal::lab {
+
+MohrResult mohr_evaluation(double k, double c, double s_pre, double t_pre) {
+  MohrResult m;
+  const double phi = std::atan(k), sn = std::sin(phi), cs = std::cos(phi);
+  // Unconfined yield strength: the circle through the origin touching the locus.
+  m.sigma_c = 2.0 * c * (1.0 + sn) / cs;
+  // Consolidation circle: centre s, radius rho = s sin(phi) + c cos(phi) (touches the locus)
+  // and through the pre-shear point: (s_pre - s)^2 + t_pre^2 = rho^2, a quadratic in s.
+  // A circle touching the locus lies below it, so a pre-shear point above the locus has none
+  // (seed 000 Fig. 23b).
+  if (t_pre > k * s_pre + c) return m;
+  const double a = cs * cs, b = -2.0 * (s_pre + c * sn * cs),
+               cc = s_pre * s_pre + t_pre * t_pre - c * c * cs * cs;
+  const double disc = b * b - 4.0 * a * cc;
+  if (disc < 0.0 || a <= 0.0) return m;
+  const double s = (-b + std::sqrt(disc)) / (2.0 * a);  // the larger circle: sigma_1 > sigma_pre
+  const double rho = s * sn + c * cs;
+  if (rho <= 0.0 || s <= 0.0) return m;
+  m.consistent = true;
+  m.sigma_1 = s + rho;
+  m.ffc = m.sigma_c > 0.0 ? m.sigma_1 / m.sigma_c : std::numeric_limits<double>::infinity();
+  m.phi_e = std::asin(std::min(1.0, rho / s)) * 180.0 / M_PI;
+  return m;
+}
+
+namespace {
+
+enum Wall : std::size_t { kFloor = 0, kVessel = 1, kHead = 2 };
+
+struct Cell {
+  double radius = 0.0, d = 0.0;
+};
+
+double shear_stress(const sim::World& w, double radius) {
+  // Resisting torque of the bed on the head (the head turns about +z), T = (2/3) pi R^3 tau.
+  return 3.0 * (-w.walls[kHead].torque.z) / (2.0 * M_PI * radius * radius * radius);
+}
+
+}  // namespace
+
+LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
+                         const RunOptions& options) {
+  const auto s = read_settings<ShearCellSettings>(values, "settings");
+  sim::World w;
+  w.threads = options.threads;
+  const auto sizes = material.simulated_sizes();
+  const double density = material.simulated_density();
+  w.set_pair_law(0, 0, material.simulated_particle_law());
+  for (std::uint16_t m : {kWallDefault, kWallDie, kWallPiston, kWallBottom})
+    w.set_wall_law(m, 0, material.simulated_wall_law());
+  const double r_max = particles::max_radius(sizes);
+  const double d = 2.0 * r_max;
+
+  Rng rng(options.seed);
+  double solid = 0.0;
+  {
+    Rng r2(options.seed ^ 0x5eed);
+    for (int k = 0; k < 2000; ++k)
+      solid += 4.0 / 3.0 * M_PI * std::pow(particles::sample_radius(sizes, r2), 3);
+    solid *= s.particles / 2000.0;
+  }
+  // A settled bed (~0.6) about as high as the vessel is wide.
+  const double radius = std::max(4.0 * d, std::cbrt(solid / (0.6 * 2.0 * M_PI)));
+  const double h_v = s.vane_height * d;
+  const double fill_h = solid / (0.2 * M_PI * radius * radius);
+  w.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
+  w.walls.push_back(
+      walls::make_wall("vessel", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius}, kWallDie));
+  particles::InsertRequest req;
+  req.region = particles::CylinderRegion{{0, 0, 0}, radius, 0.0, fill_h};
+  req.sizes = sizes;
+  req.count = static_cast<std::size_t>(s.particles);
+  req.density = density;
+  particles::insert_random(w.particles, req, rng);
+  w.dt = sim::recommended_time_step(w, s.time_step_safety);
+  sim::HealthLimits limits = die_limits(w, radius, fill_h + h_v);
+  limits.lo.z = -fill_h;
+
+  BedSpec settle_spec;
+  settle_spec.max_settle_time = 1.0;
+  settle(w, settle_spec, limits);
+
+  // The head: its disk half a diameter above the bed top, vanes reaching into the bed's top.
+  const double top = metrics::bed_top(w);
+  const double head_z = top + 0.5 * d;
+  auto head = walls::make_wall("head",
+                               walls::make_vane_head({0, 0, head_z}, {0, 0, 1}, radius - 0.25 * d,
+                                                     h_v, static_cast<int>(s.vanes), 32),
+                               kWallPiston);
+  head.pivot = {0, 0, head_z};
+  w.walls.push_back(head);
+  const double r_head = radius - 0.25 * d;
+
+  const double area = M_PI * radius * radius;
+  const double sigma_pre = kShearPreKPa * 1e3 * s.stress_scale;
+  walls::StressServo servo;
+  servo.axis = {0, 0, 1};  // the floor pushes the bed up against the head
+  servo.area = area;
+  servo.max_speed = 0.5 * s.tip_speed;
+  servo.kp = servo.max_speed / sigma_pre;
+  servo.ki = servo.kp / 0.02;  // removes the steady error of a dilating / compacting bed in ~20 ms
+  auto floor_stress = [&](const sim::World& world) { return servo.stress(world.walls[kFloor]); };
+  auto servo_run = [&](sim::World& world, double target, double seconds,
+                       const std::function<bool(sim::World&)>& each) {
+    servo.target = target;
+    servo.reset();
+    const long steps = std::max<long>(1, std::lround(seconds / world.dt));
+    return run_checked(world, steps, limits, [&](sim::World& ww) {
+      servo.update(ww.walls[kFloor], ww.dt);
+      return each ? each(ww) : true;
+    });
+  };
+
+  LabOutput out;
+  Series pre{{"time", "normal_stress_kpa", "shear_stress_kpa", "tip_travel"}, {}};
+  // 1. Consolidate at sigma_pre with the head at rest (the bed rises into the vanes).
+  servo_run(w, sigma_pre, 4.0 * s.consolidation_time, {});
+  // 2. Pre-shear at constant tip speed until the tips have travelled pre_shear_travel diameters.
+  const double omega = s.tip_speed / r_head;
+  w.walls[kHead].omega = {0, 0, omega};
+  const double pre_time = s.pre_shear_travel * d / s.tip_speed;
+  const double t_pre0 = w.time;
+  double tau_sum = 0.0, sigma_sum = 0.0;
+  long tau_n = 0;
+  const long record = std::max<long>(1, std::lround(0.002 / w.dt));
+  servo_run(w, sigma_pre, pre_time, [&](sim::World& ww) {
+    const double t = ww.time - t_pre0;
+    if (t > 2.0 / 3.0 * pre_time) {
+      tau_sum += shear_stress(ww, r_head);
+      sigma_sum += floor_stress(ww);
+      ++tau_n;
+    }
+    if (ww.step_count % record == 0)
+      pre.rows.push_back(
+          {ww.time, floor_stress(ww) / 1e3, shear_stress(ww, r_head) / 1e3, t * s.tip_speed / d});
+    if (options.progress) options.progress(0.4 * t / pre_time);
+    return true;
+  });
+  const double tau_pre = tau_n ? tau_sum / tau_n : 0.0;
+  const double sigma_pre_measured = tau_n ? sigma_sum / tau_n : sigma_pre;
+  w.walls[kHead].omega = {};
+  if (!options.snapshot_dir.empty()) {
+    io::write_particles_vtk(options.snapshot_dir + "/shear_cell_preshear_particles.vtk", w);
+    io::write_walls_vtk(options.snapshot_dir + "/shear_cell_walls.vtk", w, radius);
+    out.snapshots = {options.snapshot_dir + "/shear_cell_preshear_particles.vtk",
+                     options.snapshot_dir + "/shear_cell_walls.vtk"};
+  }
+
+  // 3. Shear steps, each from the pre-sheared state.
+  const sim::World restart = w;
+  Series points{{"sigma_x_kpa", "sigma_measured_kpa", "yield_shear_stress_kpa"}, {}};
+  std::vector<double> xs, ys;
+  const double torque_pre = tau_pre * 2.0 * M_PI * std::pow(r_head, 3) / 3.0;
+  for (std::size_t k = 0; k < kShearNormalKPa.size(); ++k) {
+    sim::World v = restart;
+    const double sigma_x = kShearNormalKPa[k] * 1e3 * s.stress_scale;
+    servo_run(v, sigma_pre, s.consolidation_time, {});
+    servo_run(v, sigma_x, s.consolidation_time, {});
+    // Torque control.
+    const double t0 = v.time;
+    const double t_max = std::max(torque_pre, 1e-12) * 2.0;
+    const double gain = omega / (0.05 * std::max(torque_pre, 1e-12));
+    double angle = 0.0, tau_max = 0.0, sig_at_max = sigma_x;
+    // Torque and stress are means over the time the tips need for 0.2 d at full speed: the
+    // peak of a shorter mean would pick up contact noise instead of the bed's strength.
+    const long window = std::max<long>(1, std::lround(0.2 * d / s.tip_speed / v.dt));
+    std::deque<double> recent;
+    double recent_sum = 0.0, sig_sum = 0.0;
+    std::deque<double> recent_sig;
+    servo_run(v, sigma_x, 2.0 * s.torque_ramp_time + d / s.tip_speed, [&](sim::World& ww) {
+      const double t = ww.time - t0;
+      const double t_set = t_max * std::min(1.0, t / s.torque_ramp_time);
+      const double torque = -ww.walls[kHead].torque.z;
+      const double om = std::clamp(gain * (t_set - torque), 0.0, omega);
+      ww.walls[kHead].omega = {0, 0, om};
+      angle += om * ww.dt;
+      const double tau = shear_stress(ww, r_head);
+      recent.push_back(tau);
+      recent_sum += tau;
+      recent_sig.push_back(floor_stress(ww));
+      sig_sum += recent_sig.back();
+      if (static_cast<long>(recent.size()) > window) {
+        recent_sum -= recent.front();
+        recent.pop_front();
+        sig_sum -= recent_sig.front();
+        recent_sig.pop_front();
+      }
+      if (static_cast<long>(recent.size()) == window && recent_sum / window > tau_max) {
+        tau_max = recent_sum / window;
+        sig_at_max = sig_sum / window;
+      }
+      return angle * r_head < d;  // yielded: the tips have moved one diameter
+    });
+    points.rows.push_back({sigma_x / 1e3, sig_at_max / 1e3, tau_max / 1e3});
+    // The locus uses the normal stress measured on the floor at the yield point.
+    xs.push_back(sig_at_max / 1e3);
+    ys.push_back(tau_max / 1e3);
+    if (options.progress) options.progress(0.4 + 0.6 * (k + 1) / kShearNormalKPa.size());
+  }
+
+  // Yield locus: least squares tau = slope sigma + intercept (kPa).
+  const double n = static_cast<double>(xs.size());
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < xs.size(); ++i)
+    sx += xs[i], sy += ys[i], sxx += xs[i] * xs[i], sxy += xs[i] * ys[i];
+  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  const double intercept = (sy - slope * sx) / n;
+  const MohrResult mohr = mohr_evaluation(slope, intercept, sigma_pre / 1e3, tau_pre / 1e3);
+
+  out.metrics["pre_shear_stress"] = tau_pre / 1e3;
+  out.metrics["pre_shear_normal_stress"] = sigma_pre_measured / 1e3;
+  out.metrics["yield_locus_slope"] = slope;
+  out.metrics["yield_locus_intercept"] = intercept;
+  out.metrics["mohr_consistent"] = mohr.consistent ? 1.0 : 0.0;
+  out.metrics["unconfined_yield_strength"] = mohr.sigma_c;
+  out.metrics["major_consolidation_stress"] = mohr.sigma_1;
+  out.metrics["ffc"] = mohr.ffc;
+  out.metrics["effective_friction_angle"] = mohr.phi_e;
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    char name[64];
+    std::snprintf(name, sizeof name, "yield_shear_stress_%g", kShearNormalKPa[i]);
+    std::string key = name;
+    std::replace(key.begin(), key.end(), '.', 'p');  // yield_shear_stress_1p75
+    out.metrics[key] = ys[i];
+  }
+  if (!mohr.consistent)
+    out.notes.push_back(
+        "mohr_consistent = 0: the pre-shear point lies above the yield locus (seed 000 Fig. 23b), "
+        "so no Mohr circle through it touches the locus; ffc, major_consolidation_stress and "
+        "effective_friction_angle are 0 (undefined)");
+  out.series["pre_shear"] = std::move(pre);
+  out.series["yield_points"] = std::move(points);
+  return out;
+}
+
+}  // namespace demcal::lab
