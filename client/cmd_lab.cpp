@@ -4,11 +4,13 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "client/commands.hpp"
 #include "client/json_out.hpp"
 #include "core/io/csv.hpp"
 #include "core/lab/lab_spec.hpp"
+#include "core/lab/study.hpp"
 
 namespace demcal::cli {
 namespace {
@@ -47,6 +49,51 @@ void run_lab(const LabOptions& opt) {
   std::cout << j.dump(2) << "\n";
 }
 
+struct StudyOptions {
+  std::string spec, scale, particles, out_dir;
+  int threads = 0;
+};
+
+std::vector<double> parse_list(const std::string& text, const std::string& flag) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) try {
+      v.push_back(std::stod(item));
+    } catch (const std::exception&) {
+      throw InputError(flag, "expected comma-separated numbers, got '" + text + "'");
+    }
+  return v;
+}
+
+/// `demcal lab study SPEC.yaml --scale 1,2,4 | --particles 200,400,800`: the same test at each
+/// value, and how every metric moves (seed 001 App. B; seed 004 §3.1).
+void run_lab_study(const StudyOptions& opt) {
+  auto spec = lab::read_lab_run(io::YamlNode::load_file(opt.spec));
+  if (opt.threads > 0) spec.options.threads = opt.threads;
+  if (opt.scale.empty() == opt.particles.empty())
+    throw InputError("study", "give exactly one of --scale and --particles");
+  const bool by_scale = !opt.scale.empty();
+  const auto values =
+      by_scale ? parse_list(opt.scale, "--scale") : parse_list(opt.particles, "--particles");
+  const auto r =
+      lab::run_study(spec.test, spec.material, spec.settings, spec.options,
+                     by_scale ? lab::StudyAxis::kScaleFactor : lab::StudyAxis::kParticles, values);
+  nlohmann::json j;
+  j["test"] = spec.test;
+  j["axis"] = by_scale ? "scale_factor" : "particles";
+  for (const auto& run : r.runs)
+    j["runs"].push_back(
+        {{"value", run.value}, {"particles", run.particles}, {"metrics", run.metrics}});
+  j["relative_change"] = r.relative_change;
+  j["max_deviation_from_last"] = r.max_deviation_from_last;
+  if (!opt.out_dir.empty()) {
+    std::filesystem::create_directories(opt.out_dir);
+    std::ofstream(opt.out_dir + "/study.json") << j.dump(2) << "\n";
+  }
+  std::cout << j.dump(2) << "\n";
+}
+
 void list_labs() {
   for (const auto& t : lab::lab_catalog()) {
     std::cout << t.name << " — " << t.description << " (" << t.source << ")\n  metrics:\n";
@@ -74,6 +121,15 @@ void add_lab_command(CLI::App& app) {
                   "directory for metrics.json, series CSV and VTK snapshots");
   run->add_option("--threads", opt->threads, "override the spec's thread count");
   run->callback([opt] { run_lab(*opt); });
+  auto sopt = std::make_shared<StudyOptions>();
+  auto* study = lab->add_subcommand(
+      "study", "Run one lab test at several scale factors or particle counts; metric changes");
+  study->add_option("spec", sopt->spec, "lab-run YAML")->required()->check(CLI::ExistingFile);
+  study->add_option("--scale", sopt->scale, "scale factors, e.g. 1,2,4 (needs material.scaling)");
+  study->add_option("--particles", sopt->particles, "particle counts, e.g. 200,400,800");
+  study->add_option("--out", sopt->out_dir, "directory for study.json");
+  study->add_option("--threads", sopt->threads, "override the spec's thread count");
+  study->callback([sopt] { run_lab_study(*sopt); });
   lab->add_subcommand("list", "List the lab tests, their metrics and settings")
       ->callback(list_labs);
 }
