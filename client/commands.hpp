@@ -10,5 +10,9 @@ void add_models_command(CLI::App& app);
 void add_lab_command(CLI::App& app);
 void add_design_command(CLI::App& app);
 void add_analyze_command(CLI::App& app);
+void add_submit_command(CLI::App& app);
+void add_campaign_commands(CLI::App& app);  // list, status, watch, cancel
+void add_analysis_commands(CLI::App& app);  // effects, calibrate, export
+void add_run_command(CLI::App& app);
 
 }  // namespace demcal::cli

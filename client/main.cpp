@@ -13,6 +13,10 @@ int main(int argc, char** argv) {
   demcal::cli::add_lab_command(app);
   demcal::cli::add_design_command(app);
   demcal::cli::add_analyze_command(app);
+  demcal::cli::add_submit_command(app);
+  demcal::cli::add_campaign_commands(app);
+  demcal::cli::add_analysis_commands(app);
+  demcal::cli::add_run_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

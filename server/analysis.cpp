@@ -15,8 +15,8 @@ std::string metrics_to_json(const std::map<std::string, double>& metrics) {
 
 std::map<std::string, double> metrics_from_json(const std::string& json) {
   std::map<std::string, double> out;
-  for (const auto& [k, v] : nlohmann::json::parse(json).items())
-    out[k] = v.is_number() ? v.get<double>() : std::nan("");
+  const auto parsed = nlohmann::json::parse(json);  // items() refers to it: keep it alive
+  for (const auto& [k, v] : parsed.items()) out[k] = v.is_number() ? v.get<double>() : std::nan("");
   return out;
 }
 

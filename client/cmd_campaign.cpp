@@ -1,0 +1,82 @@
+// `demcal list | status ID | watch ID | cancel ID`: campaigns on a coordinator.
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+#include "client/commands.hpp"
+#include "client/service_client.hpp"
+
+namespace demcal::cli {
+namespace {
+
+void print_campaign_row(const v1::Campaign& c) {
+  std::cout << std::setw(5) << c.id() << "  " << std::left << std::setw(28) << c.name()
+            << std::setw(10) << state_name(c.state()) << std::right
+            << progress_line(c.progress(), 20) << "\n";
+}
+
+}  // namespace
+
+void add_campaign_commands(CLI::App& app) {
+  struct Options {
+    proto::ChannelOptions channel;
+    std::int64_t id = 0;
+    bool jobs = false;
+  };
+  auto o = std::make_shared<Options>();
+
+  auto* list = app.add_subcommand("list", "List the coordinator's campaigns");
+  add_connection_options(*list, o->channel);
+  list->callback([o] {
+    v1::ListReply reply;
+    check(campaign_stub(o->channel)
+              ->List(proto::make_context(o->channel, 30).get(), v1::ListRequest{}, &reply),
+          "list");
+    for (const auto& c : reply.campaigns()) print_campaign_row(c);
+  });
+
+  auto* status = app.add_subcommand("status", "A campaign's state and progress (--jobs: each job)");
+  add_connection_options(*status, o->channel);
+  status->add_option("id", o->id, "campaign id")->required();
+  status->add_flag("--jobs", o->jobs, "list every job with its state, attempt and metrics");
+  status->callback([o] {
+    auto stub = campaign_stub(o->channel);
+    v1::GetRequest req;
+    req.set_id(o->id);
+    v1::Campaign c;
+    check(stub->Get(proto::make_context(o->channel, 30).get(), req, &c), "status");
+    print_campaign_row(c);
+    if (!o->jobs) return;
+    v1::ResultsReply r;
+    check(stub->GetResults(proto::make_context(o->channel, 30).get(), req, &r), "results");
+    for (const auto& j : r.jobs()) {
+      std::cout << "  job " << j.job_id() << " " << j.kind() << " run " << j.std_order() << " "
+                << j.test() << " " << j.state() << " attempt " << j.attempt();
+      for (const auto& [k, v] : j.metrics()) std::cout << " " << k << "=" << v;
+      if (!j.error().empty()) std::cout << "  (" << j.error() << ")";
+      std::cout << "\n";
+    }
+  });
+
+  auto* watch = app.add_subcommand("watch", "Follow a campaign with a progress bar and ETA");
+  add_connection_options(*watch, o->channel);
+  watch->add_option("id", o->id, "campaign id")->required();
+  watch->callback([o] {
+    auto stub = campaign_stub(o->channel);
+    watch_campaign(*stub, o->channel, o->id, std::cerr);
+  });
+
+  auto* cancel = app.add_subcommand("cancel", "Cancel a campaign's queued and running jobs");
+  add_connection_options(*cancel, o->channel);
+  cancel->add_option("id", o->id, "campaign id")->required();
+  cancel->callback([o] {
+    v1::CancelRequest req;
+    req.set_id(o->id);
+    v1::Campaign c;
+    check(campaign_stub(o->channel)->Cancel(proto::make_context(o->channel, 30).get(), req, &c),
+          "cancel");
+    print_campaign_row(c);
+  });
+}
+
+}  // namespace demcal::cli

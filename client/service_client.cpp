@@ -1,0 +1,239 @@
+#include "client/service_client.hpp"
+
+#include <google/protobuf/util/json_util.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "core/common/error.hpp"
+
+namespace demcal::cli {
+namespace {
+
+std::string fmt(double v, int precision = 5) {
+  if (!std::isfinite(v)) return "n/a";
+  std::ostringstream s;
+  s << std::setprecision(precision) << v;
+  return s.str();
+}
+
+std::string duration(double s) {
+  if (s < 0 || !std::isfinite(s)) return "--:--";
+  const long t = std::lround(s);
+  std::ostringstream o;
+  if (t >= 3600) o << t / 3600 << ":";
+  o << std::setw(t >= 3600 ? 2 : 1) << std::setfill('0') << (t % 3600) / 60 << ":" << std::setw(2)
+    << std::setfill('0') << t % 60;
+  return o.str();
+}
+
+std::string to_json(const google::protobuf::Message& m) {
+  std::string out;
+  google::protobuf::util::JsonPrintOptions o;
+  o.add_whitespace = true;
+  o.preserve_proto_field_names = true;
+  o.always_print_primitive_fields = true;
+  (void)google::protobuf::util::MessageToJsonString(m, &out, o);
+  return out;
+}
+
+std::string csv_quote(const std::string& s) {
+  if (s.find_first_of(",\"") == std::string::npos) return s;
+  std::string q = "\"";
+  for (const char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+}  // namespace
+
+void add_connection_options(CLI::App& cmd, proto::ChannelOptions& o) {
+  o.address = "127.0.0.1:7311";
+  cmd.add_option("--coordinator", o.address, "host:port of demcal-server")
+      ->envname("DEMCAL_COORDINATOR")
+      ->capture_default_str();
+  cmd.add_option("--token", o.token, "bearer token")->envname("DEMCAL_TOKEN");
+  cmd.add_option("--tls-ca", o.tls_ca, "CA certificate (PEM) for a TLS coordinator");
+  cmd.add_flag("--insecure", o.insecure, "plain TCP (coordinator started with --insecure)");
+}
+
+std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const proto::ChannelOptions& o) {
+  return v1::CampaignService::NewStub(proto::make_channel(o));
+}
+
+void check(const grpc::Status& s, const std::string& what) {
+  if (s.ok()) return;
+  if (s.error_code() == grpc::StatusCode::INVALID_ARGUMENT) throw InputError("", s.error_message());
+  static const char* names[] = {"OK",
+                                "CANCELLED",
+                                "UNKNOWN",
+                                "INVALID_ARGUMENT",
+                                "DEADLINE_EXCEEDED",
+                                "NOT_FOUND",
+                                "ALREADY_EXISTS",
+                                "PERMISSION_DENIED",
+                                "RESOURCE_EXHAUSTED",
+                                "FAILED_PRECONDITION",
+                                "ABORTED",
+                                "OUT_OF_RANGE",
+                                "UNIMPLEMENTED",
+                                "INTERNAL",
+                                "UNAVAILABLE",
+                                "DATA_LOSS",
+                                "UNAUTHENTICATED"};
+  const int c = static_cast<int>(s.error_code());
+  throw std::runtime_error(what + ": " + (c >= 0 && c <= 16 ? names[c] : "?") + ": " +
+                           s.error_message());
+}
+
+std::string state_name(v1::CampaignState s) {
+  switch (s) {
+    case v1::RUNNING:
+      return "running";
+    case v1::DONE:
+      return "done";
+    case v1::CANCELLED:
+      return "cancelled";
+    default:
+      return "?";
+  }
+}
+
+void print_design_summary(std::ostream& out, const v1::DesignSummary& d) {
+  out << "design: " << d.description() << "\n  " << d.runs() << " runs, " << d.jobs()
+      << " jobs, resolution " << d.resolution();
+  if (!d.generators().empty()) out << ", generators " << d.generators();
+  out << "\n  factors:\n";
+  for (const auto& f : d.factor_letters()) out << "    " << f << "\n";
+  if (d.defining_relation_size()) {
+    out << "  defining relation: I";
+    for (const auto& w : d.defining_relation()) out << " = " << w;
+    out << "\n";
+  }
+  if (d.main_effect_alias_chains_size()) {
+    out << "  main effects aliased with 2FIs:\n";
+    for (const auto& c : d.main_effect_alias_chains()) out << "    " << c << "\n";
+  }
+  if (d.two_factor_alias_chains_size()) {
+    out << "  2FI alias chains (" << d.two_factor_alias_chains_size() << "):\n";
+    for (const auto& c : d.two_factor_alias_chains()) out << "    " << c << "\n";
+  }
+  out << "  clear 2FIs: " << d.clear_two_factor_interactions_size();
+  if (d.clear_two_factor_interactions_size()) {
+    out << " (";
+    for (int i = 0; i < d.clear_two_factor_interactions_size(); ++i)
+      out << (i ? " " : "") << d.clear_two_factor_interactions(i);
+    out << ")";
+  }
+  out << "\n";
+}
+
+std::string progress_line(const v1::Progress& p, int width) {
+  const double total = std::max<double>(1, double(p.total() - p.cancelled()));
+  const double finished = double(p.done() + p.failed());
+  const int filled = static_cast<int>(std::lround(width * finished / total));
+  std::ostringstream s;
+  s << "[" << std::string(std::size_t(filled), '#') << std::string(std::size_t(width - filled), '.')
+    << "] " << p.done() + p.failed() << "/" << p.total() - p.cancelled() << " done";
+  if (p.failed()) s << " (" << p.failed() << " failed)";
+  s << ", " << p.leased() << " running, elapsed " << duration(p.elapsed_seconds()) << ", ETA "
+    << duration(p.eta_seconds());
+  return s.str();
+}
+
+v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const proto::ChannelOptions& o,
+                            std::int64_t id, std::ostream& out) {
+  const bool tty = isatty(STDERR_FILENO) && &out == &std::cerr;
+  v1::Progress last;
+  for (int reconnects = 0;; ++reconnects) {
+    auto ctx = proto::make_context(o, 7 * 24 * 3600.0);
+    v1::WatchRequest req;
+    req.set_id(id);
+    auto reader = stub.Watch(ctx.get(), req);
+    v1::Progress p;
+    while (reader->Read(&p)) {
+      last = p;
+      out << (tty ? "\r" : "") << progress_line(p) << (tty ? "   " : "\n") << std::flush;
+    }
+    const auto s = reader->Finish();
+    if (s.ok()) break;
+    if (s.error_code() != grpc::StatusCode::UNAVAILABLE || reconnects > 100) check(s, "watch");
+    std::this_thread::sleep_for(std::chrono::seconds(1));  // coordinator restarting
+  }
+  if (tty) out << "\n";
+  return last;
+}
+
+void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::string& format) {
+  if (format == "json") {
+    out << to_json(e) << "\n";
+    return;
+  }
+  if (format == "csv") {
+    out << "metric,chain,effect,active_me,active_sme,pse,me,sme\n";
+    for (const auto& m : e.metrics())
+      for (const auto& x : m.effects())
+        out << csv_quote(m.metric()) << "," << csv_quote(x.chain()) << "," << std::setprecision(10)
+            << x.effect() << "," << x.active_me() << "," << x.active_sme() << "," << m.pse() << ","
+            << m.me() << "," << m.sme() << "\n";
+    return;
+  }
+  out << "factors:\n";
+  for (const auto& f : e.factor_letters()) out << "  " << f << "\n";
+  for (const auto& m : e.metrics()) {
+    out << "\n== " << m.metric() << " (" << m.runs_used() << " of " << m.runs_total()
+        << " runs) ==\n";
+    if (m.effects_size() == 0) {
+      for (const auto& n : m.notes()) out << "  " << n << "\n";
+      continue;
+    }
+    out << "  Lenth: PSE " << fmt(m.pse()) << ", ME " << fmt(m.me()) << ", SME " << fmt(m.sme())
+        << " (t with " << fmt(m.lenth_df(), 3) << " df);  ** > SME, * > ME\n";
+    out << "  " << std::setw(13) << "effect"
+        << "  sig  alias chain\n";
+    for (const auto& x : m.effects())
+      out << "  " << std::setw(13) << fmt(x.effect()) << "  "
+          << (x.active_sme()  ? "** "
+              : x.active_me() ? "*  "
+                              : "   ")
+          << "  " << x.chain() << "\n";
+    out << "  mean " << fmt(m.intercept()) << ", R^2 " << fmt(m.r_squared(), 4);
+    if (m.curvature_available())
+      out << ", curvature p = " << fmt(m.curvature_p(), 3)
+          << (m.curvature_significant() ? " (significant)" : " (not significant)");
+    out << "\n";
+  }
+}
+
+void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std::string& format) {
+  if (format == "json") {
+    out << to_json(c) << "\n";
+    return;
+  }
+  out << "proposed parameter set (objective " << fmt(c.objective(), 4) << "):\n";
+  for (int i = 0; i < c.factor_paths_size(); ++i)
+    out << "  " << std::left << std::setw(40) << c.factor_paths(i) << std::right << " = "
+        << fmt(c.proposed_values(i), 6) << "\n";
+  out << "\n  " << std::left << std::setw(36) << "metric" << std::right << std::setw(12)
+      << "measured" << std::setw(12) << "predicted" << std::setw(12) << "simulated" << std::setw(10)
+      << "dev %"
+      << "  reach [min, max]\n";
+  for (const auto& m : c.metrics()) {
+    out << "  " << std::left << std::setw(36) << m.metric() << std::right << std::setw(12)
+        << fmt(m.target()) << std::setw(12) << fmt(m.predicted()) << std::setw(12)
+        << (m.simulated_available() ? fmt(m.simulated()) : "-") << std::setw(10)
+        << fmt(100 * m.relative_error(), 3) << "  [" << fmt(m.envelope_min()) << ", "
+        << fmt(m.envelope_max()) << "]\n";
+    if (!m.statement().empty()) out << "      " << m.statement() << "\n";
+  }
+  out << "  verification: " << c.verification_state();
+  if (c.verification_jobs_size()) out << " (" << c.verification_jobs_size() << " jobs)";
+  out << "\n";
+}
+
+}  // namespace demcal::cli

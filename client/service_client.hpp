@@ -1,0 +1,33 @@
+#pragma once
+// What the service subcommands share: connection flags, status -> error mapping, and the
+// printing of design summaries, progress, effect tables and calibrations.
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <ostream>
+#include <string>
+
+#include "demcal/v1/campaign.grpc.pb.h"
+#include "proto/channel.hpp"
+
+namespace demcal::cli {
+
+/// --coordinator (DEMCAL_COORDINATOR), --token (DEMCAL_TOKEN), --tls-ca, --insecure.
+void add_connection_options(CLI::App& cmd, proto::ChannelOptions& options);
+
+std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const proto::ChannelOptions& options);
+
+/// Throws for a failed call: InputError for INVALID_ARGUMENT (the message names the field),
+/// std::runtime_error "<what>: <CODE>: <message>" otherwise.
+void check(const grpc::Status& status, const std::string& what);
+
+void print_design_summary(std::ostream& out, const v1::DesignSummary& d);
+std::string progress_line(const v1::Progress& p, int width = 30);
+/// Streams Watch and draws a progress bar on `out` until the campaign is no longer running.
+v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const proto::ChannelOptions& o,
+                            std::int64_t id, std::ostream& out);
+/// table | csv | json
+void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::string& format);
+void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std::string& format);
+std::string state_name(v1::CampaignState s);
+
+}  // namespace demcal::cli

@@ -1,0 +1,175 @@
+#include "client/spec_yaml.hpp"
+
+#include <google/protobuf/util/json_util.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+
+#include "core/common/error.hpp"
+
+namespace demcal::cli {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+struct Place {
+  std::string path;  ///< as the user wrote it
+  int line = 0;
+};
+
+class Converter {
+ public:
+  explicit Converter(std::string file) : file_(std::move(file)) {}
+  std::map<std::string, Place> places;  ///< proto JSON path -> user path and line
+
+  Json convert(const YAML::Node& n, const std::string& path, const std::string& user_path) {
+    places[path] = {user_path, n.Mark().line + 1};
+    switch (n.Type()) {
+      case YAML::NodeType::Map: {
+        Json j = Json::object();
+        const bool slot = is_slot(path);
+        Json params = Json::object();
+        int index = 0;
+        for (const auto& kv : n) {
+          const std::string key = kv.first.as<std::string>();
+          const std::string child = path.empty() ? key : path + "." + key;
+          const std::string user_child = user_path.empty() ? key : user_path + "." + key;
+          if (slot && key != "model" && key != "params") {
+            // Parameters sit next to `model` in the YAML; in the proto they are a map.
+            const std::string p = path + ".params[" + std::to_string(index++) + "]";
+            places[p + ".value"] = {user_child, kv.second.Mark().line + 1};
+            places[p + ".key"] = {user_child, kv.first.Mark().line + 1};
+            params[key] = convert(kv.second, child, user_child);
+            continue;
+          }
+          j[key] = convert(kv.second, child, user_child);
+        }
+        if (!params.empty()) j["params"] = params;
+        return j;
+      }
+      case YAML::NodeType::Sequence: {
+        Json j = Json::array();
+        for (std::size_t i = 0; i < n.size(); ++i) {
+          const std::string s = "[" + std::to_string(i) + "]";
+          j.push_back(convert(n[i], path + s, user_path + s));
+        }
+        return j;
+      }
+      case YAML::NodeType::Scalar: {
+        const std::string s = n.Scalar();
+        if (n.Tag() == "!") return s;  // quoted: a string
+        if (s == "true" || s == "false") return s == "true";
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(s, &used);
+          if (used == s.size()) {
+            if (s.find_first_of(".eE") == std::string::npos && std::abs(v) < 9e15)
+              return static_cast<std::int64_t>(v);
+            return v;
+          }
+        } catch (const std::exception&) {
+        }
+        return s;
+      }
+      default:
+        return nullptr;
+    }
+  }
+
+ private:
+  static bool is_slot(const std::string& path) {
+    static const std::regex re(
+        R"(material\.(particle_law|wall_law)\.(normal|cohesion|tangential|rolling))");
+    return std::regex_match(path, re);
+  }
+  std::string file_;
+};
+
+/// "(factors[0]) sclae: Cannot find field." or "(factors[0].low): invalid value ..."
+std::pair<std::string, std::string> split_status(const std::string& text) {
+  if (text.size() > 1 && text[0] == '(') {
+    const auto close = text.find(')');
+    if (close != std::string::npos) {
+      std::string path = text.substr(1, close - 1);
+      std::string rest = text.substr(close + 1);
+      if (rest.rfind(": ", 0) == 0) return {path, rest.substr(2)};
+      if (!rest.empty() && rest[0] == ' ') {
+        const auto colon = rest.find(": ");
+        if (colon != std::string::npos) {
+          const std::string field = rest.substr(1, colon - 1);
+          return {path.empty() ? field : path + "." + field, rest.substr(colon + 2)};
+        }
+      }
+    }
+  }
+  return {"", text};
+}
+
+}  // namespace
+
+std::string SpecFile::locate(const std::string& message) const {
+  if (message.rfind("spec.", 0) != 0) return message;
+  const auto colon = message.find(": ");
+  if (colon == std::string::npos) return message;
+  std::string probe = message.substr(5, colon - 5);
+  // "material.particle_law.normal.params.k1" is written "material.particle_law.normal.k1".
+  const auto params = probe.find(".params.");
+  if (params != std::string::npos) probe.erase(params, 7);
+  while (!probe.empty() && !lines.count(probe)) {
+    const auto cut = probe.find_last_of(".[");
+    probe = cut == std::string::npos ? "" : probe.substr(0, cut);
+  }
+  const int line = probe.empty() ? 0 : lines.at(probe);
+  return name + (line ? ":" + std::to_string(line) : "") + ": " + message.substr(5);
+}
+
+SpecFile parse_campaign_spec(const std::string& yaml, const std::string& name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml);
+  } catch (const YAML::Exception& e) {
+    throw InputError(name + ":" + std::to_string(e.mark.line + 1), e.msg);
+  }
+  if (!root.IsMap()) throw InputError(name, "a campaign spec is a map (name, material, ...)");
+  Converter c(name);
+  const Json json = c.convert(root, "", "");
+  SpecFile file;
+  file.name = name;
+  for (const auto& [proto_path, place] : c.places) {
+    file.lines[proto_path] = place.line;
+    file.lines[place.path] = place.line;
+  }
+  v1::CampaignSpec& spec = file.spec;
+  google::protobuf::util::JsonParseOptions o;
+  o.case_insensitive_enum_parsing = true;  // `scale: log`, `type: fractional_factorial`
+  const auto status = google::protobuf::util::JsonStringToMessage(json.dump(), &spec, o);
+  if (!status.ok()) {
+    auto [path, what] = split_status(std::string(status.message()));
+    // The deepest known place at or above the path gives the line.
+    std::string probe = path;
+    while (!probe.empty() && !c.places.count(probe)) {
+      const auto cut = probe.find_last_of(".[");
+      probe = cut == std::string::npos ? "" : probe.substr(0, cut);
+    }
+    const Place place = c.places.count(probe) ? c.places[probe] : Place{"", 1};
+    std::string user = place.path;
+    if (probe != path) user += path.substr(probe.size());
+    throw InputError(name + ":" + std::to_string(place.line) + ": " + (user.empty() ? path : user),
+                     what);
+  }
+  return file;
+}
+
+SpecFile read_campaign_spec(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot open file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return parse_campaign_spec(s.str(), path);
+}
+
+}  // namespace demcal::cli
