@@ -1,0 +1,27 @@
+#pragma once
+// Small materials for the lab-test tests (issue 4): soft Luding spheres of 1 mm radius so that a
+// few hundred particles run in seconds.
+#include "core/lab/lab_test.hpp"
+
+namespace demcal::lab::testing {
+
+inline MaterialModel soft_luding(double youngs = 1e7, double k2_ratio = 5.0, double kc_ratio = 0.0,
+                                 double hamaker = 0.0, double mu_wall = 0.3) {
+  MaterialModel m;
+  m.particle_law.normal = {"luding",
+                           {{"youngs_modulus", youngs},
+                            {"k2_ratio", k2_ratio},
+                            {"kc_ratio", kc_ratio},
+                            {"phi_f", 0.05},
+                            {"restitution", 0.3}}};
+  if (hamaker > 0.0)
+    m.particle_law.cohesion = {"van_der_waals", {{"hamaker", hamaker}, {"d_max", 1e-5}}};
+  m.particle_law.tangential = {"history", {{"mu_s", 0.3}}};
+  m.wall_law = m.particle_law;
+  m.wall_law.tangential.params["mu_s"] = mu_wall;
+  m.sizes = particles::Monodisperse{1e-3};
+  m.density = 1500.0;
+  return m;
+}
+
+}  // namespace demcal::lab::testing

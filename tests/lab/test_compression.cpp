@@ -1,0 +1,77 @@
+// confined_compression (seed 000 §2.7.2): bulk stiffnesses rise with Young's modulus and with
+// k2/k1 (seed 000 Fig. 20-21), unload stiffer than load (§3.2.2.1); blow-ups are typed failures.
+#include <gtest/gtest.h>
+
+#include "core/common/error.hpp"
+#include "core/lab/bed.hpp"
+#include "lab_test_util.hpp"
+
+namespace demcal::lab {
+namespace {
+
+Settings small() {
+  return {{"particles", 120}, {"cycles", 1}, {"wall_stiffness_factor", 1}};
+}
+
+void expect_rising(const std::vector<LabOutput>& runs, const char* what) {
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const auto& m = runs[i].metrics;
+    EXPECT_GT(m.at("k_unload"), m.at("k_load")) << what << " level " << i;
+    EXPECT_GT(m.at("compressibility"), 0.0);
+    EXPECT_GT(m.at("final_solid_fraction"), 0.5);
+    EXPECT_LT(m.at("final_solid_fraction"), 0.75);
+    EXPECT_GT(m.at("confined_modulus"), 0.0);
+    if (i > 0) {
+      EXPECT_GT(m.at("k_load"), runs[i - 1].metrics.at("k_load")) << what << " level " << i;
+      EXPECT_GT(m.at("k_unload"), runs[i - 1].metrics.at("k_unload")) << what << " level " << i;
+    }
+  }
+}
+
+TEST(ConfinedCompression, StiffnessesRiseWithYoungsModulus) {
+  std::vector<LabOutput> runs;
+  for (double y : {3e6, 1e7, 3e7})
+    runs.push_back(run_lab_test("confined_compression", testing::soft_luding(y), small(), {}));
+  expect_rising(runs, "Y");
+  // The stress-strain series covers the load, the cycle and the final unload.
+  const auto& s = runs[0].series.at("stress_strain");
+  ASSERT_GT(s.rows.size(), 10u);
+  EXPECT_EQ(s.rows.back()[3], 4.0);  // phases: load, unload, reload, final unload
+}
+
+TEST(ConfinedCompression, StiffnessesRiseWithK2Ratio) {
+  std::vector<LabOutput> runs;
+  for (double f : {2.0, 5.0, 15.0})
+    runs.push_back(run_lab_test("confined_compression", testing::soft_luding(1e7, f), small(), {}));
+  expect_rising(runs, "k2/k1");
+}
+
+TEST(ConfinedCompression, AbsurdPistonStiffnessIsATypedFailure) {
+  // A piston law made 1e6 times stiffer after the time step was chosen: the next step re-checks
+  // the stability limit and fails with kUnstableTimeStep, naming both numbers.
+  const auto m = testing::soft_luding();
+  PistonBed bed = make_piston_bed(m, 150, 0.2, {}, {});
+  bed.world.set_wall_law(kWallPiston, 0, simulated_law(m, stiffen_normal(m.wall_law, 1e6)));
+  try {
+    servo_phase(bed.world, bed.piston, bed.piston, {0, 0, -1}, bed.area, 1000.0,
+                ServoSettings{0.01, 1e-5, 0, 0, 10.0, 1e-3, 1e-2}, bed.limits);
+    FAIL() << "expected a SimulationFailure";
+  } catch (const SimulationFailure& e) {
+    EXPECT_EQ(e.reason(), SimulationFailure::Reason::kUnstableTimeStep) << e.what();
+  }
+}
+
+TEST(ConfinedCompression, AbsurdTimeStepIsATypedFailure) {
+  // A piston bed stepped at 50 times its critical time step blows up: a typed failure.
+  PistonBed bed = make_piston_bed(testing::soft_luding(), 150, 0.2, {}, {});
+  bed.world.dt *= 250.0;
+  try {
+    servo_phase(bed.world, bed.piston, bed.piston, {0, 0, -1}, bed.area, 1000.0,
+                ServoSettings{0.01, 1e-5, 0, 0, 10.0, 0.5, 1.0}, bed.limits);
+    FAIL() << "expected a SimulationFailure";
+  } catch (const SimulationFailure& e) {
+    EXPECT_NE(std::string(to_string(e.reason())), "") << e.what();
+  }
+}
+}  // namespace
+}  // namespace demcal::lab

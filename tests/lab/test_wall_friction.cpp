@@ -1,0 +1,39 @@
+// wall_friction (seed 000 §2.7.5, §3.3.4): the angle rises with the particle-wall friction
+// coefficient, and a two-point calibration reproduces a target angle.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/lab/wall_friction.hpp"
+#include "lab_test_util.hpp"
+
+namespace demcal::lab {
+namespace {
+
+double angle(double mu_wall) {
+  const Settings s = {{"particles", 120}, {"wall_stiffness_factor", 1}};
+  return run_lab_test("wall_friction", testing::soft_luding(1e7, 5.0, 0.0, 0.0, mu_wall), s, {})
+      .metrics.at("wall_friction_angle");
+}
+
+TEST(WallFriction, TorqueToShearStressAndRegression) {
+  // tau = 3 T / (2 pi R^3): a uniform 1 Pa on a unit disk gives T = 2 pi / 3.
+  EXPECT_NEAR(shear_stress_from_torque(2.0 * M_PI / 3.0, 1.0), 1.0, 1e-12);
+  EXPECT_DOUBLE_EQ(slope_through_origin({1, 2, 3}, {0.5, 1.0, 1.5}), 0.5);
+  EXPECT_DOUBLE_EQ(two_point_calibration(0.1, 6.0, 0.2, 12.0, 9.0), 0.15);
+}
+
+TEST(WallFriction, RisesWithWallFrictionAndTwoPointCalibrationHitsTarget) {
+  const double a = angle(0.1), b = angle(0.2), c = angle(0.4);
+  EXPECT_GT(b, a);
+  EXPECT_GT(c, b);
+  EXPECT_GT(a, 0.0);
+  EXPECT_LT(c, 45.0);
+  // Seed 000 §3.3.4: two bracketing runs, linear interpolation to the target, one verification run.
+  const double target = 0.5 * (a + c);
+  const double mu = two_point_calibration(0.1, a, 0.4, c, target);
+  EXPECT_NEAR(angle(mu), target, 0.15 * target);
+}
+
+}  // namespace
+}  // namespace demcal::lab
