@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Run time of each issue-4 lab test (packing, confined_compression, tensile, wall_friction) at
+# Run time of each lab test (packing, confined_compression, tensile, wall_friction; shear_cell,
+# rotating_drum, hopper) at
 # 2,000 and 10,000 particles: bench/lab.sh [BUILD_DIR] [COUNTS] [THREADS]
 #   e.g. bench/lab.sh build 2000,10000 2
 # Soft Luding spheres of 1 mm radius (the material of tests/lab), seed-000 defaults otherwise
@@ -27,12 +28,14 @@ YAML
 COH="cohesion: {model: van_der_waals, hamaker: 1.0e-18, d_max: 1.0e-5}"
 printf "%-22s %10s %12s  %s\n" test particles wall_time_s metrics
 for n in ${COUNTS//,/ }; do
-  for test in packing confined_compression tensile wall_friction; do
+  for test in packing confined_compression tensile wall_friction shear_cell rotating_drum hopper; do
     case $test in
       packing) settings="{particles: $n}"; mat=$(material 0 "") ;;
       confined_compression) settings="{particles: $n, cycles: 1, wall_stiffness_factor: 3}"; mat=$(material 0 "") ;;
       tensile) settings="{particles: $n, wall_stiffness_factor: 3, wall_hamaker_factor: 10, wall_k2_factor: 1, pull_distance: 1}"; mat=$(material 0.5 "$COH") ;;
       wall_friction) settings="{particles: $n, wall_stiffness_factor: 3}"; mat=$(material 0 "") ;;
+      # Issue 5 (lab tests II): defaults of each test's settings table.
+      shear_cell|rotating_drum|hopper) settings="{particles: $n}"; mat=$(material 0 "") ;;
     esac
     spec="$TMP/$test-$n.yaml"
     printf "test: %s\nsettings: %s\nseed: 1\nthreads: %s\n%s\n" "$test" "$settings" "$THREADS" "$mat" > "$spec"

@@ -16,8 +16,8 @@
 // restart files): re-consolidate at sigma_pre with the head at rest, reduce to sigma_x, and
 // drive the head by torque: the set torque ramps up, the head turns at
 //   omega = clamp(k (T_set - T), 0, omega_max)
-// and the bed has yielded once the tips have travelled one diameter; the yield shear stress is
-// the largest tau (mean over 0.2 d of tip travel) on the way. A least-squares line through the five
+// and the bed has yielded once the tips have travelled 1.5 diameters; the yield shear stress is
+// the largest tau (mean over 0.5 d of tip travel) on the way. A least-squares line through the five
 // (measured sigma, tau) points is the yield locus; the Mohr circles follow (mohr_evaluation).
 #include "core/lab/shear_cell.hpp"
 
@@ -198,13 +198,13 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
     const double t_max = std::max(torque_pre, 1e-12) * 2.0;
     const double gain = omega / (0.05 * std::max(torque_pre, 1e-12));
     double angle = 0.0, tau_max = 0.0, sig_at_max = sigma_x;
-    // Torque and stress are means over the time the tips need for 0.2 d at full speed: the
+    // Torque and stress are means over the time the tips need for 0.5 d at full speed: the
     // peak of a shorter mean would pick up contact noise instead of the bed's strength.
-    const long window = std::max<long>(1, std::lround(0.2 * d / s.tip_speed / v.dt));
+    const long window = std::max<long>(1, std::lround(0.5 * d / s.tip_speed / v.dt));
     std::deque<double> recent;
     double recent_sum = 0.0, sig_sum = 0.0;
     std::deque<double> recent_sig;
-    servo_run(v, sigma_x, 2.0 * s.torque_ramp_time + d / s.tip_speed, [&](sim::World& ww) {
+    servo_run(v, sigma_x, 2.0 * s.torque_ramp_time + 1.5 * d / s.tip_speed, [&](sim::World& ww) {
       const double t = ww.time - t0;
       const double t_set = t_max * std::min(1.0, t / s.torque_ramp_time);
       const double torque = -ww.walls[kHead].torque.z;
@@ -226,7 +226,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
         tau_max = recent_sum / window;
         sig_at_max = sig_sum / window;
       }
-      return angle * r_head < d;  // yielded: the tips have moved one diameter
+      return angle * r_head < 1.5 * d;  // yielded: the tips have moved 1.5 diameters
     });
     points.rows.push_back({sigma_x / 1e3, sig_at_max / 1e3, tau_max / 1e3});
     // The locus uses the normal stress measured on the floor at the yield point.

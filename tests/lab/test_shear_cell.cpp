@@ -1,0 +1,73 @@
+// shear_cell (seed 000 §2.7.4): the pre-shear stress and the yield locus slope rise with mu_s;
+// the intercept rises with the Hamaker constant; the yield shear stress rises with sigma_x;
+// the Mohr evaluation on hand-made loci (consistent, and Fig. 23b).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/lab/lab_test.hpp"
+#include "core/lab/shear_cell.hpp"
+
+namespace demcal::lab {
+namespace {
+
+MaterialModel powder(double mu_s, double hamaker) {
+  MaterialModel m;
+  m.particle_law.normal = {"hertz",
+                           {{"youngs_modulus", 5e6}, {"poisson_ratio", 0.3}, {"restitution", 0.3}}};
+  m.particle_law.tangential = {"history", {{"mu_s", mu_s}}};
+  m.particle_law.cohesion = {"van_der_waals", {{"hamaker", hamaker}, {"d_max", 1e-5}}};
+  m.wall_law = m.particle_law;
+  m.sizes = particles::Monodisperse{0.001};
+  m.density = 2500;
+  return m;
+}
+
+const Settings kFast = {{"particles", 250},
+                        {"pre_shear_travel", 3},
+                        {"torque_ramp_time", 0.15},
+                        {"consolidation_time", 0.03}};
+
+TEST(LabShearCell, MohrEvaluationOfAConsistentAndAnInconsistentLocus) {
+  // tau = 0.6 sigma + 0.2 with the pre-shear point on a circle touching it.
+  const double k = 0.6, c = 0.2, phi = std::atan(k);
+  const double s = 4.0, rho = s * std::sin(phi) + c * std::cos(phi);
+  // A point of that circle left of its tangent point (at 150 deg from the sigma axis).
+  const double s_pre = s - std::sqrt(0.75) * rho, t_pre = 0.5 * rho;
+  const MohrResult m = mohr_evaluation(k, c, s_pre, t_pre);
+  ASSERT_TRUE(m.consistent);
+  // The returned circle (centre s1 = sigma_1 / (1 + sin phi_e), radius sigma_1 - s1) passes
+  // through the pre-shear point and touches the locus.
+  const double sin_e = std::sin(m.phi_e * M_PI / 180.0);
+  const double s1 = m.sigma_1 / (1.0 + sin_e), r1 = m.sigma_1 - s1;
+  EXPECT_NEAR((s_pre - s1) * (s_pre - s1) + t_pre * t_pre, r1 * r1, 1e-9);
+  EXPECT_NEAR(s1 * std::sin(phi) + c * std::cos(phi), r1, 1e-9);
+  EXPECT_GE(m.sigma_1, s + rho - 1e-9);  // the larger of the two circles
+  EXPECT_NEAR(m.sigma_c, 2.0 * c * (1.0 + std::sin(phi)) / std::cos(phi), 1e-12);
+  EXPECT_NEAR(m.ffc, m.sigma_1 / m.sigma_c, 1e-12);
+  // Fig. 23b: the pre-shear point above the locus.
+  EXPECT_FALSE(mohr_evaluation(k, c, 3.0, k * 3.0 + c + 0.1).consistent);
+}
+
+TEST(LabShearCell, PreShearStressAndSlopeRiseWithFrictionAndYieldStressWithSigmaX) {
+  RunOptions opt;
+  const auto low = run_lab_test("shear_cell", powder(0.1, 1e-20), kFast, opt).metrics;
+  const auto high = run_lab_test("shear_cell", powder(0.7, 1e-20), kFast, opt).metrics;
+  EXPECT_GT(high.at("pre_shear_stress"), 1.2 * low.at("pre_shear_stress"));
+  EXPECT_GT(high.at("yield_locus_slope"), low.at("yield_locus_slope"));
+  for (const auto* m : {&low, &high}) {
+    EXPECT_GT(m->at("yield_shear_stress_2"), m->at("yield_shear_stress_1"));
+    EXPECT_GT(m->at("yield_locus_slope"), 0.0);
+    EXPECT_NEAR(m->at("pre_shear_normal_stress"), 3.0, 0.3);
+  }
+}
+
+TEST(LabShearCell, InterceptRisesWithHamakerConstant) {
+  RunOptions opt;
+  const auto weak = run_lab_test("shear_cell", powder(0.4, 1e-20), kFast, opt).metrics;
+  const auto strong = run_lab_test("shear_cell", powder(0.4, 1e-17), kFast, opt).metrics;
+  EXPECT_GT(strong.at("yield_locus_intercept"), weak.at("yield_locus_intercept") + 0.2);
+}
+
+}  // namespace
+}  // namespace demcal::lab
