@@ -5,7 +5,7 @@
 #   e.g. bench/lab.sh build 2000,10000 2
 # Soft Luding spheres of 1 mm radius (the material of tests/lab), seed-000 defaults otherwise
 # except wall_stiffness_factor 3 and one compression cycle (state them when you quote numbers).
-# Not part of ctest: the 10,000-particle runs take long.
+# Not part of ctest: the 10,000-particle runs take long. TESTS="packing tensile" runs a subset.
 set -euo pipefail
 BUILD=${1:-build}
 COUNTS=${2:-2000,10000}
@@ -28,7 +28,7 @@ YAML
 COH="cohesion: {model: van_der_waals, hamaker: 1.0e-18, d_max: 1.0e-5}"
 printf "%-22s %10s %12s  %s\n" test particles wall_time_s metrics
 for n in ${COUNTS//,/ }; do
-  for test in packing confined_compression tensile wall_friction shear_cell rotating_drum hopper; do
+  for test in ${TESTS:-packing confined_compression tensile wall_friction shear_cell rotating_drum hopper}; do
     case $test in
       packing) settings="{particles: $n}"; mat=$(material 0 "") ;;
       confined_compression) settings="{particles: $n, cycles: 1, wall_stiffness_factor: 3}"; mat=$(material 0 "") ;;
