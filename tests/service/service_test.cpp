@@ -1,0 +1,405 @@
+// Fault tests of the service with real processes, real gRPC on loopback and real SQLite files:
+// a worker SIGKILLed mid-job, workers racing, the coordinator SIGKILLed and restarted, a late
+// Complete from an expired lease, invalid specs, missing or wrong tokens, and the CLI end to
+// end. Leases and heartbeats are short (flags); every wait is bounded.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <set>
+
+#include "client/spec_yaml.hpp"
+#include "core/common/error.hpp"
+#include "demcal/v1/campaign.grpc.pb.h"
+#include "demcal/v1/worker.grpc.pb.h"
+#include "proto/channel.hpp"
+#include "tests/service/process.hpp"
+
+namespace demcal::test {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kToken = "test-token-123";
+
+/// A packing campaign of 2^2 runs (+ centre points) at `particles` particles.
+std::string tiny_spec(int particles, int centre = 0, const std::string& extra_factor = "") {
+  return R"(
+name: tiny
+material:
+  particle_law:
+    normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 0.0005}}
+  density: 2500
+tests:
+  - test: packing
+    settings: {particles: )" +
+         std::to_string(particles) + R"(}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
+  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
+)" + extra_factor +
+         R"(design: {type: full_factorial, centre_points: )" + std::to_string(centre) + R"(}
+measurements:
+  - {metric: solid_fraction, value: 0.6, uncertainty: 0.02}
+)";
+}
+
+class Service : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("demcal_service_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    workers_.clear();
+    server_.reset();
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  /// Starts (or restarts on the same port and file) the coordinator.
+  void start_server(double lease = 1.5, double heartbeat = 0.3, int port = 0) {
+    const std::string port_file = path("port");
+    fs::remove(port_file);
+    server_ = std::make_unique<Process>(
+        std::vector<std::string>{DEMCAL_SERVER_BIN, "--listen", "127.0.0.1:" + std::to_string(port),
+                                 "--db", path("c.db"), "--token", kToken, "--lease",
+                                 std::to_string(lease), "--heartbeat", std::to_string(heartbeat),
+                                 "--reaper-interval", "0.1", "--port-file", port_file},
+        path("server.log"));
+    ASSERT_TRUE(wait_until([&] { return fs::exists(port_file); }, 20)) << server_->log();
+    std::ifstream(port_file) >> port_;
+    channel_.address = "127.0.0.1:" + std::to_string(port_);
+    channel_.token = kToken;
+    campaigns_ = v1::CampaignService::NewStub(proto::make_channel(channel_));
+    workers_stub_ = v1::WorkerService::NewStub(proto::make_channel(channel_));
+  }
+
+  Process& start_worker(const std::string& id, const std::string& token = kToken) {
+    workers_.push_back(std::make_unique<Process>(
+        std::vector<std::string>{DEMCAL_WORKER_BIN, "--coordinator", channel_.address, "--token",
+                                 token, "--threads", "1", "--id", id, "--max-backoff", "0.5"},
+        path(id + ".log")));
+    return *workers_.back();
+  }
+
+  std::unique_ptr<grpc::ClientContext> ctx(double seconds = 30) {
+    return proto::make_context(channel_, seconds);
+  }
+
+  grpc::Status submit(const std::string& yaml, std::int64_t* id = nullptr) {
+    v1::SubmitRequest req;
+    *req.mutable_spec() = cli::parse_campaign_spec(yaml, "spec.yaml").spec;
+    v1::SubmitReply reply;
+    const auto s = campaigns_->Submit(ctx().get(), req, &reply);
+    if (id) *id = reply.id();
+    return s;
+  }
+
+  v1::ResultsReply results(std::int64_t id) {
+    v1::GetRequest req;
+    req.set_id(id);
+    v1::ResultsReply r;
+    EXPECT_TRUE(campaigns_->GetResults(ctx().get(), req, &r).ok());
+    return r;
+  }
+
+  bool campaign_done(std::int64_t id) {
+    v1::GetRequest req;
+    req.set_id(id);
+    v1::Campaign c;
+    return campaigns_->Get(ctx(5).get(), req, &c).ok() && c.state() == v1::DONE;
+  }
+
+  /// Rows of the results table per job, read from the SQLite file itself.
+  std::map<std::int64_t, int> stored_results() {
+    sqlite3* db = nullptr;
+    std::map<std::int64_t, int> out;
+    if (sqlite3_open_v2(path("c.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK)
+      return out;
+    sqlite3_stmt* st = nullptr;
+    sqlite3_prepare_v2(db, "SELECT job_id, COUNT(*) FROM results GROUP BY job_id", -1, &st,
+                       nullptr);
+    while (sqlite3_step(st) == SQLITE_ROW)
+      out[sqlite3_column_int64(st, 0)] = sqlite3_column_int(st, 1);
+    sqlite3_finalize(st);
+    sqlite3_close(db);
+    return out;
+  }
+
+  fs::path dir_;
+  int port_ = 0;
+  proto::ChannelOptions channel_;
+  std::unique_ptr<Process> server_;
+  std::vector<std::unique_ptr<Process>> workers_;
+  std::unique_ptr<v1::CampaignService::Stub> campaigns_;
+  std::unique_ptr<v1::WorkerService::Stub> workers_stub_;
+};
+
+TEST_F(Service, MissingOrWrongTokenIsUnauthenticated) {
+  start_server();
+  proto::ChannelOptions bad = channel_;
+  for (const std::string token : {"", "wrong-token"}) {
+    bad.token = token;
+    auto stub = v1::CampaignService::NewStub(proto::make_channel(bad));
+    v1::ListReply reply;
+    const auto s = stub->List(proto::make_context(bad, 10).get(), {}, &reply);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::UNAUTHENTICATED) << token;
+    auto wstub = v1::WorkerService::NewStub(proto::make_channel(bad));
+    v1::LeaseReply lease;
+    EXPECT_EQ(wstub->Lease(proto::make_context(bad, 10).get(), {}, &lease).error_code(),
+              grpc::StatusCode::UNAUTHENTICATED);
+  }
+  v1::ListReply ok;
+  EXPECT_TRUE(campaigns_->List(ctx().get(), {}, &ok).ok());
+  // A worker with a wrong token stops with exit code 2 instead of retrying forever.
+  auto& w = start_worker("intruder", "nope");
+  EXPECT_EQ(w.wait_exit(20), 2) << w.log();
+}
+
+TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
+  start_server();
+  struct Case {
+    std::string yaml, field;
+  };
+  const std::vector<Case> cases = {
+      {tiny_spec(30, 0, "  - {path: particle_law.normal.nope, low: 1, high: 2}\n"),
+       "spec.factors[2].path"},
+      {tiny_spec(30, 0, "  - {path: particle_law.normal.poisson_ratio, low: 0.1, high: 0.7}\n"),
+       "spec.factors[2].high"},
+      {tiny_spec(30, 0, "  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.7}\n"),
+       "spec.factors[2].path"},
+      {[] {
+         auto s = tiny_spec(30);
+         s.replace(s.find("test: packing"), 13, "test: packingg");
+         return s;
+       }(),
+       "spec.tests[0].test"},
+      {[] {
+         auto s = tiny_spec(30);
+         s.replace(s.find("metric: solid_fraction"), 22, "metric: porosity");
+         return s;
+       }(),
+       "spec.measurements[0].metric"},
+      {[] {
+         auto s = tiny_spec(30);
+         s.replace(s.find("particles: 30"), 13, "particles: 3");
+         return s;
+       }(),
+       "spec.tests[0].settings.particles"},
+  };
+  for (const auto& c : cases) {
+    const auto s = submit(c.yaml);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << c.field;
+    EXPECT_NE(s.error_message().find(c.field), std::string::npos)
+        << c.field << " not in: " << s.error_message();
+  }
+  // Mistakes the JSON parser catches name the field and the YAML line before anything is sent.
+  std::string typo = tiny_spec(30);
+  typo.replace(typo.find("low: 0.2"), 8, "lwo: 0.2");
+  try {
+    cli::parse_campaign_spec(typo, "spec.yaml");
+    ADD_FAILURE() << "typo accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("spec.yaml:14: factors[1].lwo"), std::string::npos)
+        << e.what();
+  }
+  std::string bad_scale = tiny_spec(30);
+  bad_scale.replace(bad_scale.find("high: 0.6}"), 10, "high: 0.6, scale: lg}");
+  try {
+    cli::parse_campaign_spec(bad_scale, "spec.yaml");
+    ADD_FAILURE() << "bad enum accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("factors[1].scale"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
+  start_server(/*lease=*/1.0, /*heartbeat=*/0.2);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  v1::LeaseRequest lr;
+  lr.set_worker("slow");
+  v1::LeaseReply first;
+  ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &first).ok());
+  ASSERT_TRUE(first.has_job());
+  const auto job = first.job().job_id();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1600));  // lease lapses, reaper runs
+  v1::CompleteRequest late;
+  late.set_job_id(job);
+  late.set_attempt(1);
+  late.set_worker("slow");
+  (*late.mutable_metrics())["solid_fraction"] = 0.1;
+  (*late.mutable_metrics())["coordination_number"] = 1.0;
+  v1::CompleteReply cr;
+  EXPECT_EQ(workers_stub_->Complete(ctx().get(), late, &cr).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  v1::HeartbeatRequest hb;
+  hb.set_job_id(job);
+  hb.set_attempt(1);
+  v1::HeartbeatReply hr;
+  EXPECT_EQ(workers_stub_->Heartbeat(ctx().get(), hb, &hr).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  // The job is handed out again, with the next attempt number.
+  lr.set_worker("fast");
+  v1::LeaseReply second;
+  ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &second).ok());
+  ASSERT_EQ(second.job().job_id(), job);
+  EXPECT_EQ(second.job().attempt(), 2);
+  EXPECT_EQ(workers_stub_->Complete(ctx().get(), late, &cr).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  v1::CompleteRequest good = late;
+  good.set_attempt(2);
+  good.set_worker("fast");
+  (*good.mutable_metrics())["solid_fraction"] = 0.58;
+  EXPECT_TRUE(workers_stub_->Complete(ctx().get(), good, &cr).ok());
+  EXPECT_EQ(workers_stub_->Complete(ctx().get(), good, &cr).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);  // once only
+  EXPECT_EQ(stored_results().at(job), 1);
+  const auto after = results(id);
+  for (const auto& j : after.jobs())
+    if (j.job_id() == job) {
+      EXPECT_EQ(j.state(), "done");
+      EXPECT_EQ(j.attempt(), 2);
+      EXPECT_EQ(j.worker(), "fast");
+      EXPECT_DOUBLE_EQ(j.metrics().at("solid_fraction"), 0.58);
+    }
+}
+
+TEST_F(Service, WorkersRacingNeverShareAJob) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30, /*centre=*/4), &id).ok());  // 8 jobs
+  std::mutex m;
+  std::multiset<std::int64_t> leased;
+  std::vector<std::thread> racers;
+  for (int t = 0; t < 6; ++t)
+    racers.emplace_back([&, t] {
+      auto stub = v1::WorkerService::NewStub(proto::make_channel(channel_));
+      for (int k = 0; k < 4; ++k) {
+        v1::LeaseRequest lr;
+        lr.set_worker("racer" + std::to_string(t));
+        v1::LeaseReply r;
+        if (stub->Lease(proto::make_context(channel_, 10).get(), lr, &r).ok() && r.has_job()) {
+          std::lock_guard lock(m);
+          leased.insert(r.job().job_id());
+        }
+      }
+    });
+  for (auto& r : racers) r.join();
+  EXPECT_EQ(leased.size(), 8u);
+  for (const auto j : leased) EXPECT_EQ(leased.count(j), 1u) << "job " << j << " leased twice";
+
+  // Two real workers finish a second campaign between them.
+  std::int64_t id2 = 0;
+  ASSERT_TRUE(submit(tiny_spec(30, 2), &id2).ok());
+  v1::CancelRequest cancel;
+  cancel.set_id(id);
+  v1::Campaign c;
+  ASSERT_TRUE(campaigns_->Cancel(ctx().get(), cancel, &c).ok());
+  start_worker("w1");
+  start_worker("w2");
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id2); }, 90)) << workers_[0]->log();
+  const auto r = results(id2);
+  const auto stored = stored_results();
+  for (const auto& j : r.jobs()) {
+    EXPECT_EQ(j.state(), "done");
+    EXPECT_EQ(j.attempt(), 1) << "job " << j.job_id();
+    EXPECT_EQ(stored.at(j.job_id()), 1);
+  }
+}
+
+TEST_F(Service, WorkerKilledMidJobLeasedAgainAndStoredOnce) {
+  start_server(/*lease=*/1.5, /*heartbeat=*/0.3);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(400), &id).ok());  // 4 jobs of ~1 s
+  auto& victim = start_worker("victim");
+  std::int64_t killed_job = 0;
+  ASSERT_TRUE(wait_until(
+      [&] {
+        const auto now = results(id);
+        for (const auto& j : now.jobs())
+          if (j.state() == "leased") killed_job = j.job_id();
+        return killed_job != 0;
+      },
+      30));
+  victim.signal(SIGKILL);
+  EXPECT_EQ(victim.wait_exit(10), 128 + SIGKILL);
+  start_worker("rescuer");
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 120)) << workers_.back()->log();
+  const auto stored = stored_results();
+  const auto r = results(id);
+  for (const auto& j : r.jobs()) {
+    EXPECT_EQ(j.state(), "done") << j.error();
+    EXPECT_EQ(stored.at(j.job_id()), 1);
+    if (j.job_id() == killed_job) {
+      EXPECT_GE(j.attempt(), 2);
+      EXPECT_EQ(j.worker(), "rescuer");
+    }
+  }
+  EXPECT_NE(server_->log().find("expired"), std::string::npos);
+}
+
+TEST_F(Service, CoordinatorKilledAndRestartedCampaignCompletesNothingLostOrDuplicated) {
+  start_server(/*lease=*/3, /*heartbeat=*/0.3);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(200, 2), &id).ok());  // 6 jobs
+  start_worker("w");
+  ASSERT_TRUE(wait_until(
+      [&] {
+        int done = 0;
+        const auto now = results(id);
+        for (const auto& j : now.jobs()) done += j.state() == "done";
+        return done >= 2;
+      },
+      60));
+  const int port = port_;
+  server_->signal(SIGKILL);
+  EXPECT_EQ(server_->wait_exit(10), 128 + SIGKILL);
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));  // the worker is now backing off
+  start_server(3, 0.3, port);
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 120)) << workers_[0]->log();
+  const auto r = results(id);
+  const auto stored = stored_results();
+  EXPECT_EQ(r.jobs_size(), 6);
+  EXPECT_EQ(stored.size(), 6u);
+  for (const auto& j : r.jobs()) {
+    EXPECT_EQ(j.state(), "done") << j.error();
+    EXPECT_EQ(stored.at(j.job_id()), 1);
+    EXPECT_EQ(j.metrics().size(), 2u);
+  }
+  EXPECT_NE(server_->log().find("resuming campaign"), std::string::npos);
+}
+
+TEST_F(Service, CliRunsACampaignEndToEnd) {
+  const std::string spec = path("tiny.yaml");
+  std::ofstream(spec) << tiny_spec(200, 1);  // (60 particles: packing could not insert them all)
+  Process run({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1"},
+              path("run.log"));
+  ASSERT_EQ(run.wait_exit(150), 0) << run.log();
+  const std::string out = run.log();
+  EXPECT_NE(out.find("resolution full factorial"), std::string::npos) << out;
+  EXPECT_NE(out.find("== packing.solid_fraction (5 of 5 runs) =="), std::string::npos) << out;
+  EXPECT_NE(out.find("alias chain"), std::string::npos);
+  EXPECT_NE(out.find("proposed parameter set"), std::string::npos);
+  EXPECT_NE(out.find("verification: done (1 jobs)"), std::string::npos) << out;
+  EXPECT_TRUE(fs::exists(path("work/campaign.db")));
+  // A bad spec is refused before anything runs, naming the file, line and field.
+  std::string bad = tiny_spec(60);
+  bad.replace(bad.find("density: 2500"), 13, "densty: 2500");
+  std::ofstream(path("bad.yaml")) << bad;
+  Process refused({DEMCAL_CLI_BIN, "run", path("bad.yaml"), "--workdir", path("work2")},
+                  path("bad.log"));
+  EXPECT_EQ(refused.wait_exit(30), 2);
+  EXPECT_NE(refused.log().find("bad.yaml:8: material.densty"), std::string::npos) << refused.log();
+}
+
+}  // namespace
+}  // namespace demcal::test

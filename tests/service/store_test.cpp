@@ -1,0 +1,137 @@
+// The coordinator's store on :memory: and on a real file: migrations, WAL, the lease state
+// machine, exactly-once results, the retry cap, give-back and cancellation.
+#include "server/store.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace demcal::server {
+namespace {
+
+std::vector<NewJob> jobs(int n) {
+  std::vector<NewJob> out;
+  for (int i = 0; i < n; ++i) out.push_back({i + 1, n - i, "packing", "design", "{}"});
+  return out;
+}
+
+TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("demcal_store_" + std::to_string(::getpid()) + ".db");
+  std::filesystem::remove(path);
+  {
+    Store s(path.string());
+    EXPECT_EQ(s.journal_mode(), "wal");
+    EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
+    s.create_campaign("c", "{}", "{}", jobs(3), 0.0);
+    ASSERT_TRUE(s.lease("w", 1.0));
+  }
+  {
+    Store s(path.string());  // migrations are not re-run; the lease survived
+    EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
+    ASSERT_EQ(s.campaigns().size(), 1u);
+    const auto c = s.counts(1);
+    EXPECT_EQ(c.leased, 1);
+    EXPECT_EQ(c.queued, 2);
+  }
+  std::filesystem::remove(path);
+  std::filesystem::remove(path.string() + "-wal");
+  std::filesystem::remove(path.string() + "-shm");
+}
+
+TEST(Store, LeasesInRunOrderAndStoresAResultExactlyOnce) {
+  Store s(":memory:");
+  const auto id = s.create_campaign("c", "{}", "{}", jobs(2), 0.0);
+  const auto a = s.lease("w1", 1.0);
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->run_order, 1);  // std_order 2 runs first
+  EXPECT_EQ(a->attempt, 1);
+  EXPECT_TRUE(s.complete(a->id, 1, "w1", R"({"x":1})", 0.5, 2.0));
+  EXPECT_FALSE(s.complete(a->id, 1, "w1", R"({"x":2})", 0.5, 2.1));  // a repeat is refused
+  EXPECT_EQ(s.result_count(a->id), 1);
+  EXPECT_EQ(*s.job(a->id)->metrics_json, R"({"x":1})");
+  EXPECT_EQ(s.campaign(id)->state, "running");
+  const auto b = s.lease("w2", 3.0);
+  ASSERT_TRUE(b);
+  EXPECT_FALSE(s.lease("w3", 3.0));  // nothing left
+  EXPECT_TRUE(s.complete(b->id, 1, "w2", "{}", 0.5, 4.0));
+  EXPECT_EQ(s.campaign(id)->state, "done");
+}
+
+TEST(Store, LateCompleteOfAnExpiredLeaseIsRefusedAndTheNewLeaseWins) {
+  Store s(":memory:", {10.0, 3});
+  s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  const auto a = s.lease("w1", 0.0);
+  EXPECT_TRUE(s.heartbeat(a->id, 1, 5.0));  // deadline now 15
+  EXPECT_EQ(s.reap(14.0), 0);
+  EXPECT_EQ(s.reap(16.0), 1);  // expired: back to the queue
+  EXPECT_FALSE(s.complete(a->id, 1, "w1", "{}", 1.0, 16.5));
+  EXPECT_FALSE(s.heartbeat(a->id, 1, 16.5));
+  const auto b = s.lease("w2", 17.0);
+  ASSERT_TRUE(b);
+  EXPECT_EQ(b->id, a->id);
+  EXPECT_EQ(b->attempt, 2);
+  EXPECT_FALSE(s.complete(a->id, 1, "w1", "{}", 1.0, 18.0));  // stale attempt number
+  EXPECT_TRUE(s.complete(b->id, 2, "w2", "{}", 1.0, 18.0));
+  EXPECT_EQ(s.result_count(a->id), 1);
+}
+
+TEST(Store, ExpiredBeforeTheReaperRunsIsAlsoRefused) {
+  Store s(":memory:", {10.0, 3});
+  s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  const auto a = s.lease("w1", 0.0);
+  EXPECT_FALSE(s.complete(a->id, 1, "w1", "{}", 1.0, 10.5));
+  EXPECT_EQ(s.result_count(a->id), 0);
+}
+
+TEST(Store, RetryCapFailsTheJobAndGiveBackDoesNotCount) {
+  Store s(":memory:", {10.0, 2});
+  const auto id = s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  auto a = s.lease("w", 0.0);
+  EXPECT_TRUE(s.fail(a->id, 1, "stopping", true, true, 1.0));  // given back
+  a = s.lease("w", 2.0);
+  EXPECT_EQ(a->attempt, 2);
+  EXPECT_TRUE(s.fail(a->id, 2, "io error", true, false, 3.0));  // counted: 1 of 2
+  EXPECT_EQ(s.job(a->id)->state, "queued");
+  a = s.lease("w", 4.0);
+  EXPECT_EQ(s.reap(20.0), 1);  // counted: 2 of 2 -> failed
+  EXPECT_EQ(s.job(a->id)->state, "failed");
+  EXPECT_NE(s.job(a->id)->error.find("expired"), std::string::npos);
+  EXPECT_EQ(s.campaign(id)->state, "done");
+}
+
+TEST(Store, SimulationFailureFailsAtOnce) {
+  Store s(":memory:");
+  s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  const auto a = s.lease("w", 0.0);
+  EXPECT_TRUE(s.fail(a->id, 1, "simulation failed (not finite)", false, false, 1.0));
+  EXPECT_EQ(s.job(a->id)->state, "failed");
+  EXPECT_FALSE(s.lease("w", 2.0));
+}
+
+TEST(Store, CancelStopsLeasingAndRefusesResults) {
+  Store s(":memory:");
+  const auto id = s.create_campaign("c", "{}", "{}", jobs(3), 0.0);
+  const auto a = s.lease("w", 0.0);
+  EXPECT_TRUE(s.cancel(id, 1.0));
+  EXPECT_FALSE(s.cancel(999, 1.0));
+  EXPECT_FALSE(s.lease("w", 2.0));
+  EXPECT_FALSE(s.complete(a->id, 1, "w", "{}", 1.0, 2.0));
+  EXPECT_EQ(s.counts(id).cancelled, 3);
+  EXPECT_EQ(s.campaign(id)->state, "cancelled");
+}
+
+TEST(Store, VerificationJobsReopenADoneCampaign) {
+  Store s(":memory:");
+  const auto id = s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  const auto a = s.lease("w", 0.0);
+  s.complete(a->id, 1, "w", "{}", 1.0, 1.0);
+  EXPECT_EQ(s.campaign(id)->state, "done");
+  const auto ids = s.add_jobs(id, {{0, 1, "packing", "verify", "{}"}});
+  ASSERT_EQ(ids.size(), 1u);
+  EXPECT_EQ(s.campaign(id)->state, "running");
+  EXPECT_EQ(s.counts(id, "verify").queued, 1);
+}
+
+}  // namespace
+}  // namespace demcal::server
