@@ -27,8 +27,8 @@ struct NormalResult {
   double fn = 0.0;        ///< normal force incl. damping, without the cohesion slot (N)
   double f_adhesive = 0;  ///< attraction built into the normal law (Luding k_c delta), added back
                           ///< for the Coulomb criterion as seed 000 eq. 18 does (N)
-  double k_ref = 0.0;    ///< the stiffness tangential and rolling stiffness ratios refer to (N/m)
-  double gamma_n = 0.0;  ///< normal damping coefficient (kg/s)
+  double k_ref = 0.0;     ///< the stiffness tangential and rolling stiffness ratios refer to (N/m)
+  double gamma_n = 0.0;   ///< normal damping coefficient (kg/s)
 };
 
 struct PairOutput {

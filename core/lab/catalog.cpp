@@ -1,13 +1,13 @@
 #include "core/lab/catalog.hpp"
 
 #include "core/common/error.hpp"
+#include "core/lab/confined_compression.hpp"
 #include "core/lab/hopper.hpp"
 #include "core/lab/packing.hpp"
 #include "core/lab/rotating_drum.hpp"
 #include "core/lab/shear_cell.hpp"
-#include "core/lab/wall_friction.hpp"
 #include "core/lab/tensile.hpp"
-#include "core/lab/confined_compression.hpp"
+#include "core/lab/wall_friction.hpp"
 
 namespace demcal::lab {
 
@@ -26,22 +26,23 @@ LabTestInfo packing_info() {
 // confined_compression: seed 000 §2.7.2 (eq. 31-33), seed 001 §3.2.1 (eq. 19); runner in
 // confined_compression.cpp.
 LabTestInfo confined_compression_info() {
-  return {"confined_compression",
-          "bed in a cylindrical die loaded by a stress-servo piston to 15 kPa, unloaded to 0.5 kPa "
-          "and reloaded five times, then unloaded",
-          "seed 000 §2.7.2 (eq. 31-33); seed 001 §3.2.1 (eq. 19)",
-          {{"compressibility", "%", "(h0 - h1) / h0 at the first load (seed 000 eq. 31)"},
-           {"k_load", "MPa",
-            "mean reload bulk stiffness (sigma_max - sigma_min) h1 / (h_unloaded - h_loaded) "
-            "(seed 000 eq. 32)"},
-           {"k_unload", "MPa",
-            "mean unload bulk stiffness (sigma_max - sigma_min) h1 / (h_unloaded - h_loaded_before) "
-            "(seed 000 eq. 33)"},
-           {"final_solid_fraction", "-", "solid fraction after the final unload"},
-           {"confined_modulus", "MPa",
-            "E' = (sigma_max - sigma_min) / (eps_max - eps_min) of the last cycle, eps = "
-            "(h0 - h) / h0 (seed 001 eq. 19)"}},
-          settings_docs<ConfinedCompressionSettings>()};
+  return {
+      "confined_compression",
+      "bed in a cylindrical die loaded by a stress-servo piston to 15 kPa, unloaded to 0.5 kPa "
+      "and reloaded five times, then unloaded",
+      "seed 000 §2.7.2 (eq. 31-33); seed 001 §3.2.1 (eq. 19)",
+      {{"compressibility", "%", "(h0 - h1) / h0 at the first load (seed 000 eq. 31)"},
+       {"k_load", "MPa",
+        "mean reload bulk stiffness (sigma_max - sigma_min) h1 / (h_unloaded - h_loaded) "
+        "(seed 000 eq. 32)"},
+       {"k_unload", "MPa",
+        "mean unload bulk stiffness (sigma_max - sigma_min) h1 / (h_unloaded - h_loaded_before) "
+        "(seed 000 eq. 33)"},
+       {"final_solid_fraction", "-", "solid fraction after the final unload"},
+       {"confined_modulus", "MPa",
+        "E' = (sigma_max - sigma_min) / (eps_max - eps_min) of the last cycle, eps = "
+        "(h0 - h) / h0 (seed 001 eq. 19)"}},
+      settings_docs<ConfinedCompressionSettings>()};
 }
 
 // tensile: seed 000 §2.7.3 (eq. 34-35); runner in tensile.cpp.
@@ -70,23 +71,24 @@ LabTestInfo wall_friction_info() {
 
 // shear_cell: seed 000 §2.7.4, Table 3, Fig. 12 and 23 (runner in shear_cell.cpp).
 LabTestInfo shear_cell_info() {
-  return {"shear_cell",
-          "FT4 standard shear test: vaned shear head (mesh) in a cylindrical vessel, normal stress "
-          "applied by the container; pre-shear at 3 kPa, then yield under torque control at 2, "
-          "1.75, 1.5, 1.25 and 1 kPa, each from the pre-sheared state; tau = 3 T / (2 pi R^3)",
-          "seed 000 §2.7.4 (Table 3, Fig. 12, Fig. 23)",
-          {{"pre_shear_stress", "kPa", "steady shear stress of the pre-shear at sigma_pre = 3 kPa"},
-           {"yield_locus_slope", "-", "slope of the least-squares yield locus"},
-           {"yield_locus_intercept", "kPa", "intercept (cohesion) of the yield locus"},
-           {"ffc", "-", "flow function sigma_1 / sigma_c from the Mohr circles (0 if inconsistent)"},
-           {"effective_friction_angle", "deg",
-            "angle of the origin line touching the consolidation circle (0 if inconsistent)"},
-           {"mohr_consistent", "0/1",
-            "0 when the pre-shear point lies above the yield locus (seed 000 Fig. 23b)"},
-           {"unconfined_yield_strength", "kPa", "sigma_c of the Mohr circle through the origin"},
-           {"major_consolidation_stress", "kPa",
-            "sigma_1 of the circle through the pre-shear point touching the locus"}},
-          settings_docs<ShearCellSettings>()};
+  return {
+      "shear_cell",
+      "FT4 standard shear test: vaned shear head (mesh) in a cylindrical vessel, normal stress "
+      "applied by the container; pre-shear at 3 kPa, then yield under torque control at 2, "
+      "1.75, 1.5, 1.25 and 1 kPa, each from the pre-sheared state; tau = 3 T / (2 pi R^3)",
+      "seed 000 §2.7.4 (Table 3, Fig. 12, Fig. 23)",
+      {{"pre_shear_stress", "kPa", "steady shear stress of the pre-shear at sigma_pre = 3 kPa"},
+       {"yield_locus_slope", "-", "slope of the least-squares yield locus"},
+       {"yield_locus_intercept", "kPa", "intercept (cohesion) of the yield locus"},
+       {"ffc", "-", "flow function sigma_1 / sigma_c from the Mohr circles (0 if inconsistent)"},
+       {"effective_friction_angle", "deg",
+        "angle of the origin line touching the consolidation circle (0 if inconsistent)"},
+       {"mohr_consistent", "0/1",
+        "0 when the pre-shear point lies above the yield locus (seed 000 Fig. 23b)"},
+       {"unconfined_yield_strength", "kPa", "sigma_c of the Mohr circle through the origin"},
+       {"major_consolidation_stress", "kPa",
+        "sigma_1 of the circle through the pre-shear point touching the locus"}},
+      settings_docs<ShearCellSettings>()};
 }
 
 // rotating_drum: seed 001 §3.2.2-3.2.3, eq. 20 (runner in rotating_drum.cpp).
@@ -111,7 +113,8 @@ LabTestInfo hopper_info() {
   return {"hopper",
           "wedge hopper slice with periodic front and back: fill and settle with the gate closed, "
           "open it, discharge rate from the mass-time curve, arching, ratio to Beverloo's slot "
-          "law (hydraulic-diameter form) W = (4 sqrt 2 / pi) C rho_b sqrt(g) L (b - k d)^1.5 with C = 0.58, k = 1.5",
+          "law (hydraulic-diameter form) W = (4 sqrt 2 / pi) C rho_b sqrt(g) L (b - k d)^1.5 with "
+          "C = 0.58, k = 1.5",
           "seed 000 §2.7.6",
           {{"discharge_rate", "kg/s", "slope of the discharged mass over time after start-up"},
            {"arched", "0/1", "1 when no particle left for arch_time before the hopper emptied"},
@@ -120,8 +123,9 @@ LabTestInfo hopper_info() {
 }
 
 const std::vector<LabTestInfo>& lab_catalog() {
-  static const std::vector<LabTestInfo> tests = {packing_info(), confined_compression_info(), tensile_info(), wall_friction_info(), shear_cell_info(),
-                                                  rotating_drum_info(), hopper_info()};
+  static const std::vector<LabTestInfo> tests = {
+      packing_info(),    confined_compression_info(), tensile_info(), wall_friction_info(),
+      shear_cell_info(), rotating_drum_info(),        hopper_info()};
   return tests;
 }
 

@@ -1,13 +1,13 @@
 #include "core/lab/lab_test.hpp"
 
 #include "core/common/error.hpp"
+#include "core/lab/confined_compression.hpp"
 #include "core/lab/hopper.hpp"
 #include "core/lab/packing.hpp"
 #include "core/lab/rotating_drum.hpp"
 #include "core/lab/shear_cell.hpp"
-#include "core/lab/wall_friction.hpp"
 #include "core/lab/tensile.hpp"
-#include "core/lab/confined_compression.hpp"
+#include "core/lab/wall_friction.hpp"
 
 namespace demcal::lab {
 
