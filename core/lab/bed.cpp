@@ -14,17 +14,7 @@
 #include "core/walls/servo.hpp"
 
 namespace demcal::lab {
-namespace {
-
-double mean_particle_volume(const particles::SizeDistribution& sizes, Rng rng) {
-  double v = 0.0;
-  constexpr int kSamples = 2000;
-  for (int k = 0; k < kSamples; ++k)
-    v += 4.0 / 3.0 * M_PI * std::pow(particles::sample_radius(sizes, rng), 3);
-  return v / kSamples;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 double metrics_top(const sim::World& w) {
   double top = 0.0;
@@ -33,20 +23,35 @@ double metrics_top(const sim::World& w) {
   return top;
 }
 
-sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
-                          const RunOptions& options) {
+sim::World make_material_world(const MaterialModel& material, const RunOptions& options) {
   sim::World w;
   w.threads = options.threads;
-  const auto sizes = material.simulated_sizes();
-  const double density = material.simulated_density();
   w.set_pair_law(0, 0, material.simulated_particle_law());
   const auto wall_law = material.simulated_wall_law();
   for (std::uint16_t m : {kWallDefault, kWallDie, kWallPiston, kWallBottom})
     w.set_wall_law(m, 0, wall_law);
+  return w;
+}
+
+double expected_solid_volume(const particles::SizeDistribution& sizes, double count,
+                             std::uint64_t seed) {
+  constexpr int kSamples = 2000;
+  Rng rng(seed ^ 0x5eed);
+  double solid = 0.0;
+  for (int k = 0; k < kSamples; ++k)
+    solid += 4.0 / 3.0 * M_PI * std::pow(particles::sample_radius(sizes, rng), 3);
+  return solid * (count / kSamples);
+}
+
+sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
+                          const RunOptions& options) {
+  sim::World w = make_material_world(material, options);
+  const auto sizes = material.simulated_sizes();
+  const double density = material.simulated_density();
 
   Rng rng(options.seed);
   const double solid =
-      static_cast<double>(spec.particles) * mean_particle_volume(sizes, Rng(options.seed ^ 0x5eed));
+      expected_solid_volume(sizes, static_cast<double>(spec.particles), options.seed);
   // A settled bed of solid fraction ~0.6 as high as it is wide: pi R^2 2R 0.6 = solid volume.
   const double radius =
       spec.die_radius > 0.0 ? spec.die_radius : std::cbrt(solid / (0.6 * 2.0 * M_PI));

@@ -30,6 +30,15 @@ enum WallMaterial : std::uint16_t {
   kWallBottom = 3
 };
 
+/// A world with the material's simulated particle-particle law and its particle-wall law for
+/// every lab wall material; the lab tests add their walls and particles.
+sim::World make_material_world(const MaterialModel& material, const RunOptions& options);
+
+/// Expected solid volume of `count` particles of the distribution (mean of 2,000 seeded samples),
+/// for sizing a die, drum or hopper to its bed.
+double expected_solid_volume(const particles::SizeDistribution& sizes, double count,
+                             std::uint64_t seed);
+
 /// A world with the material's simulated laws, a floor (kWallBottom) and a die (kWallDie, an
 /// inner cylinder about the z axis), and the particles inserted at random without overlap.
 sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,

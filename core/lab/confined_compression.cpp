@@ -54,7 +54,7 @@ LabOutput run_confined_compression(const MaterialModel& material, const Settings
   sim::World& w = bed.world;
   LabOutput out;
   write_snapshot(w, options, "settled", out);
-  const double s_max = s.max_stress * fs, s_min = s.min_stress * fs;
+  const double s_max = s.max_stress * fs;
   ServoSettings servo = make_servo(w, bed.h0, s_max, s.servo_max_speed, s.servo_kp, s.servo_ki,
                                    s.servo_kd, s.servo_tolerance, s.hold_steps, s.max_phase_time);
   Series series{{"time_s", "height_m", "stress_kPa", "phase"}, {}};

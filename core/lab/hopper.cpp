@@ -34,13 +34,9 @@ constexpr double kBeverlooC = 0.58, kBeverlooK = 1.5;
 LabOutput run_hopper(const MaterialModel& material, const Settings& values,
                      const RunOptions& options) {
   const auto s = read_settings<HopperSettings>(values, "settings");
-  sim::World w;
-  w.threads = options.threads;
+  sim::World w = make_material_world(material, options);
   const auto sizes = material.simulated_sizes();
   const double density = material.simulated_density();
-  w.set_pair_law(0, 0, material.simulated_particle_law());
-  for (std::uint16_t m : {kWallDefault, kWallDie, kWallPiston, kWallBottom})
-    w.set_wall_law(m, 0, material.simulated_wall_law());
   const double r_max = particles::max_radius(sizes);
   const double d = 2.0 * r_max;
   const double b = s.outlet * d, depth = s.depth * d;
@@ -49,13 +45,7 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
   // Size the hopper for the bed: the wedge of height h holds (b + h tan) h depth of bulk; the
   // particles (solid fraction ~0.6) should fill the wedge and a little of the bin above.
   Rng rng(options.seed);
-  double solid = 0.0;
-  {
-    Rng r2(options.seed ^ 0x5eed);
-    for (int k = 0; k < 2000; ++k)
-      solid += 4.0 / 3.0 * M_PI * std::pow(particles::sample_radius(sizes, r2), 3);
-    solid *= s.particles / 2000.0;
-  }
+  const double solid = expected_solid_volume(sizes, s.particles, options.seed);
   const double area = solid / (0.6 * depth);  // x-z area of the settled bed
   const double t = std::tan(theta);
   // (b + h t) h = area  ->  h = (-b + sqrt(b^2 + 4 t area)) / (2 t)

@@ -112,25 +112,15 @@ double DrumImage::surface_angle() const {
 LabOutput run_rotating_drum(const MaterialModel& material, const Settings& values,
                             const RunOptions& options) {
   const auto s = read_settings<RotatingDrumSettings>(values, "settings");
-  sim::World w;
-  w.threads = options.threads;
+  sim::World w = make_material_world(material, options);
   w.gravity = {0, -9.81, 0};
   const auto sizes = material.simulated_sizes();
   const double density = material.simulated_density();
-  w.set_pair_law(0, 0, material.simulated_particle_law());
-  for (std::uint16_t m : {kWallDefault, kWallDie, kWallPiston, kWallBottom})
-    w.set_wall_law(m, 0, material.simulated_wall_law());
   const double r_max = particles::max_radius(sizes);
 
   // Drum size from the particle count: fill * pi R^2 W = solid volume / 0.6, W = aspect 2R.
   Rng rng(options.seed);
-  double solid = 0.0;
-  {
-    Rng r2(options.seed ^ 0x5eed);
-    for (int k = 0; k < 2000; ++k)
-      solid += 4.0 / 3.0 * M_PI * std::pow(particles::sample_radius(sizes, r2), 3);
-    solid *= s.particles / 2000.0;
-  }
+  const double solid = expected_solid_volume(sizes, s.particles, options.seed);
   const double radius =
       std::max(6.0 * r_max, std::cbrt(solid / (0.6 * s.fill * M_PI * 2.0 * s.aspect)));
   const double depth = std::max(2.0 * s.aspect * radius, 2.5 * r_max);

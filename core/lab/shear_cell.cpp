@@ -78,24 +78,14 @@ double shear_stress(const sim::World& w, double radius) {
 LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
                          const RunOptions& options) {
   const auto s = read_settings<ShearCellSettings>(values, "settings");
-  sim::World w;
-  w.threads = options.threads;
+  sim::World w = make_material_world(material, options);
   const auto sizes = material.simulated_sizes();
   const double density = material.simulated_density();
-  w.set_pair_law(0, 0, material.simulated_particle_law());
-  for (std::uint16_t m : {kWallDefault, kWallDie, kWallPiston, kWallBottom})
-    w.set_wall_law(m, 0, material.simulated_wall_law());
   const double r_max = particles::max_radius(sizes);
   const double d = 2.0 * r_max;
 
   Rng rng(options.seed);
-  double solid = 0.0;
-  {
-    Rng r2(options.seed ^ 0x5eed);
-    for (int k = 0; k < 2000; ++k)
-      solid += 4.0 / 3.0 * M_PI * std::pow(particles::sample_radius(sizes, r2), 3);
-    solid *= s.particles / 2000.0;
-  }
+  const double solid = expected_solid_volume(sizes, s.particles, options.seed);
   // A settled bed (~0.6) about as high as the vessel is wide.
   const double radius = std::max(4.0 * d, std::cbrt(solid / (0.6 * 2.0 * M_PI)));
   const double h_v = s.vane_height * d;
