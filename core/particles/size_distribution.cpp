@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 #include "core/common/error.hpp"
 
@@ -71,32 +72,34 @@ double sample_radius(const SizeDistribution& dist, Rng& rng) {
       dist);
 }
 
-double max_radius(const SizeDistribution& dist) {
+namespace {
+
+/// Smallest and largest radius a distribution can produce (the truncation bounds for log-normal).
+std::pair<double, double> radius_bounds(const SizeDistribution& dist) {
   return std::visit(
-      [](const auto& d) -> double {
+      [](const auto& d) -> std::pair<double, double> {
         using D = std::decay_t<decltype(d)>;
-        if constexpr (std::is_same_v<D, Monodisperse>)
-          return d.radius;
-        else if constexpr (std::is_same_v<D, DiscreteClasses>)
-          return *std::max_element(d.radii.begin(), d.radii.end());
-        else
-          return d.median_radius * std::pow(d.sigma_g, d.truncate_k);
+        if constexpr (std::is_same_v<D, Monodisperse>) {
+          return {d.radius, d.radius};
+        } else if constexpr (std::is_same_v<D, DiscreteClasses>) {
+          const auto [lo, hi] = std::minmax_element(d.radii.begin(), d.radii.end());
+          return {*lo, *hi};
+        } else {
+          const double spread = std::pow(d.sigma_g, d.truncate_k);
+          return {d.median_radius / spread, d.median_radius * spread};
+        }
       },
       dist);
 }
 
+}  // namespace
+
+double max_radius(const SizeDistribution& dist) {
+  return radius_bounds(dist).second;
+}
+
 double min_radius(const SizeDistribution& dist) {
-  return std::visit(
-      [](const auto& d) -> double {
-        using D = std::decay_t<decltype(d)>;
-        if constexpr (std::is_same_v<D, Monodisperse>)
-          return d.radius;
-        else if constexpr (std::is_same_v<D, DiscreteClasses>)
-          return *std::min_element(d.radii.begin(), d.radii.end());
-        else
-          return d.median_radius / std::pow(d.sigma_g, d.truncate_k);
-      },
-      dist);
+  return radius_bounds(dist).first;
 }
 
 }  // namespace demcal::particles
