@@ -75,6 +75,11 @@ lab::MaterialModel to_material_model(const v1::Material& m, const std::string& w
     model.scaling = contact::scaling_law_from_name(law, where + ".scaling.law");
     model.scale_factor = m.scaling().factor() > 0 ? m.scaling().factor() : 1.0;
   }
+  if (m.has_shape()) {
+    std::map<std::string, double> params(m.shape().params().begin(), m.shape().params().end());
+    model.shape = particles::make_shape_spec(m.shape().kind().empty() ? "sphere" : m.shape().kind(),
+                                             params, where + ".shape.params");
+  }
   try {
     model.validate();
   } catch (const InputError& e) {

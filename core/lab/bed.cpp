@@ -43,11 +43,22 @@ double expected_solid_volume(const particles::SizeDistribution& sizes, double co
   return solid * (count / kSamples);
 }
 
+particles::InsertRequest material_insert_request(const MaterialModel& material,
+                                                 const particles::Region& region,
+                                                 std::size_t count) {
+  particles::InsertRequest req;
+  req.region = region;
+  req.sizes = material.simulated_sizes();
+  req.count = count;
+  req.density = material.simulated_density();
+  req.shape = material.clump_template();
+  return req;
+}
+
 sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
                           const RunOptions& options) {
   sim::World w = make_material_world(material, options);
   const auto sizes = material.simulated_sizes();
-  const double density = material.simulated_density();
 
   Rng rng(options.seed);
   const double solid =
@@ -55,19 +66,19 @@ sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
   // A settled bed of solid fraction ~0.6 as high as it is wide: pi R^2 2R 0.6 = solid volume.
   const double radius =
       spec.die_radius > 0.0 ? spec.die_radius : std::cbrt(solid / (0.6 * 2.0 * M_PI));
-  const double r_max = particles::max_radius(sizes);
-  const double height = spec.insert_height > 0.0
-                            ? spec.insert_height
-                            : std::max(solid / (0.25 * M_PI * radius * radius), 4.0 * r_max);
+  // Clumps are inserted by their bounding spheres: the loose column is taller by their volume.
+  particles::InsertRequest req = material_insert_request(material, {}, spec.particles);
+  const double bound = req.shape ? req.shape->bounding_radius : 1.0;
+  const double r_max = particles::max_radius(sizes) * bound;
+  const double height =
+      spec.insert_height > 0.0
+          ? spec.insert_height
+          : std::max(bound * bound * bound * solid / (0.25 * M_PI * radius * radius), 4.0 * r_max);
 
   w.walls.push_back(walls::make_wall("bottom", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
   w.walls.push_back(
       walls::make_wall("die", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius}, kWallDie));
-  particles::InsertRequest req;
   req.region = particles::CylinderRegion{{0, 0, 0}, radius, 0.0, height};
-  req.sizes = sizes;
-  req.count = spec.particles;
-  req.density = density;
   particles::insert_random(w.particles, req, rng);
   w.dt = sim::recommended_time_step(w, spec.time_step_safety);
   return w;

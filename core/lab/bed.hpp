@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "core/lab/lab_test.hpp"
+#include "core/particles/insertion.hpp"
 #include "core/sim/health.hpp"
 #include "core/sim/world.hpp"
 
@@ -33,6 +34,12 @@ enum WallMaterial : std::uint16_t {
 /// A world with the material's simulated particle-particle law and its particle-wall law for
 /// every lab wall material; the lab tests add their walls and particles.
 sim::World make_material_world(const MaterialModel& material, const RunOptions& options);
+
+/// An insertion request for `count` particles of the material (its simulated sizes and density,
+/// and its clump shape if not spherical) into `region`.
+particles::InsertRequest material_insert_request(const MaterialModel& material,
+                                                 const particles::Region& region,
+                                                 std::size_t count);
 
 /// Expected solid volume of `count` particles of the distribution (mean of 2,000 seeded samples),
 /// for sizing a die, drum or hopper to its bed.

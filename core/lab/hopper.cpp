@@ -59,11 +59,9 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
       "hopper", walls::make_wedge_hopper(theta, b, h, bin, -2.0 * d, depth + 2.0 * d), kWallDie));
   w.walls.push_back(walls::make_wall("gate", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
 
-  particles::InsertRequest req;
-  req.region = particles::BoxRegion{{-0.5 * top, 0.0, h}, {0.5 * top, depth, h + bin}};
-  req.sizes = sizes;
-  req.count = static_cast<std::size_t>(s.particles);
-  req.density = density;
+  particles::InsertRequest req = material_insert_request(
+      material, particles::BoxRegion{{-0.5 * top, 0.0, h}, {0.5 * top, depth, h + bin}},
+      static_cast<std::size_t>(s.particles));
   // Spheres stay inside the region, so none overlaps a periodic image across y = 0 / depth.
   particles::insert_random(w.particles, req, rng);
   w.dt = sim::recommended_time_step(w, s.time_step_safety);
@@ -120,16 +118,13 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
     bool any = false;
     for (std::size_t i = 0; i < p.size(); ++i) {
       if (gone[i] || p.x[i].z > -2.0 * d) continue;
-      gone[i] = 1;
       any = true;
-      discharged += p.mass[i];
       const int k = parked++;
-      p.x[i] = {-0.5 * top + 3.0 * r_max * (k % per_row + 0.5),
-                3.0 * r_max * ((k / per_row) % per_col + 0.5),
-                park_z - 3.0 * r_max * (k / (per_row * per_col))};
-      p.v[i] = {};
-      p.omega[i] = {};
-      p.set_motion(i, particles::Motion::kKinematic);
+      discharged += p.park(i,
+                           {-0.5 * top + 3.0 * r_max * (k % per_row + 0.5),
+                            3.0 * r_max * ((k / per_row) % per_col + 0.5),
+                            park_z - 3.0 * r_max * (k / (per_row * per_col))},
+                           gone);
     }
     const double tt = world.time - t0;
     if (any) {

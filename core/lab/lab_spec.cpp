@@ -6,7 +6,7 @@
 namespace demcal::lab {
 
 MaterialModel read_material(const io::YamlNode& n) {
-  n.expect_only({"particle_law", "wall_law", "sizes", "size_scale", "density", "scaling"});
+  n.expect_only({"particle_law", "wall_law", "sizes", "size_scale", "density", "scaling", "shape"});
   MaterialModel m;
   m.particle_law = io::read_contact_law_spec(n["particle_law"]);
   m.wall_law = n.has("wall_law") ? io::read_contact_law_spec(n["wall_law"]) : m.particle_law;
@@ -17,6 +17,17 @@ MaterialModel read_material(const io::YamlNode& n) {
     s->expect_only({"law", "factor"});
     m.scaling = contact::scaling_law_from_name((*s)["law"].as_string(), s->where() + ".law");
     m.scale_factor = s->number("factor", 1.0);
+  }
+  if (auto s = n.child("shape")) {
+    std::map<std::string, double> params;
+    for (const auto& key : s->keys())
+      if (key != "kind") params[key] = (*s)[key].as_number();
+    try {
+      m.shape = particles::make_shape_spec((*s)["kind"].as_string(), params, "shape");
+    } catch (const InputError& e) {
+      const std::string key = e.where().substr(std::string("shape.").size());
+      (*s)[key].fail(e.message());
+    }
   }
   try {
     m.validate();

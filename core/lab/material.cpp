@@ -67,6 +67,13 @@ double* size_field(MaterialModel& m, const std::string& path) {
   return nullptr;
 }
 
+double* shape_field(particles::ShapeSpec& shape, const std::string& path) {
+  if (path.rfind("shape.", 0) != 0) return nullptr;
+  for (const auto& info : particles::ShapeSpec::table())
+    if (path.substr(6) == info.name) return &(shape.*info.field);
+  return nullptr;
+}
+
 }  // namespace
 
 contact::ScaleFactors MaterialModel::factors() const {
@@ -101,6 +108,11 @@ double MaterialModel::simulated_density() const {
   return density * factors().density;
 }
 
+std::optional<particles::ClumpTemplate> MaterialModel::clump_template() const {
+  if (shape.kind == particles::ShapeKind::kSphere) return std::nullopt;
+  return particles::make_template(shape);
+}
+
 void MaterialModel::validate() const {
   contact::ContactLaw::from_spec(particle_law, "particle_law");
   contact::ContactLaw::from_spec(wall_law, "wall_law");
@@ -117,6 +129,10 @@ std::vector<ParameterInfo> parameters(const MaterialModel& model) {
   out.push_back({"density", "kg/m^3", 1e-3, 1e6});
   radius_params(out, model.sizes);
   out.push_back({"scaling.factor", "-", 1e-6, 1e6});
+  const auto shape_now = shape_values(model.shape);
+  for (const auto& info : particles::ShapeSpec::table())
+    if (shape_now.count(std::string(info.name)))
+      out.push_back({"shape." + std::string(info.name), std::string(info.unit), info.lo, info.hi});
   return out;
 }
 
@@ -135,6 +151,8 @@ void set_parameter(MaterialModel& model, const std::string& path, double value) 
         model.density = value;
       } else if (path == "scaling.factor") {
         model.scale_factor = value;
+      } else if (double* f = shape_field(model.shape, path)) {
+        *f = value;
       } else {
         *size_field(model, path) = value;
       }
@@ -159,6 +177,7 @@ double get_parameter(const MaterialModel& model, const std::string& path) {
   if (path == "scaling.factor") return model.scale_factor;
   MaterialModel copy = model;
   if (double* f = size_field(copy, path)) return *f;
+  if (double* f = shape_field(copy.shape, path)) return *f;
   throw InputError(path, "not a parameter of this material model");
 }
 

@@ -9,11 +9,14 @@
 //   density
 //   sizes.radius | sizes.median_radius | sizes.sigma_g | sizes.scale   (scale multiplies every
 //   radius) scaling.factor
+//   shape.<param>                 e.g. shape.aspect_ratio (particles::ShapeSpec, per shape kind)
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/contact/contact_law.hpp"
 #include "core/contact/scaling.hpp"
+#include "core/particles/clump_shape.hpp"
 #include "core/particles/size_distribution.hpp"
 
 namespace demcal::lab {
@@ -27,6 +30,9 @@ struct MaterialModel {
   double density = 1500.0;  ///< real particle density (kg/m^3)
   contact::ScalingLaw scaling = contact::ScalingLaw::kNone;
   double scale_factor = 1.0;
+  /// Particle shape: spheres, or rigid multisphere clumps whose volume-equivalent radius
+  /// follows `sizes` (so mass and volume do not change with the shape).
+  particles::ShapeSpec shape;
 
   /// The simulated laws, radii and density after coarse-graining (seed 000 eq. 24-30 or
   /// seed 001 eq. 15-18).
@@ -34,6 +40,8 @@ struct MaterialModel {
   contact::ContactLaw simulated_wall_law() const;
   particles::SizeDistribution simulated_sizes() const;
   double simulated_density() const;
+  /// The clump template of a non-spherical shape; none for spheres.
+  std::optional<particles::ClumpTemplate> clump_template() const;
   contact::ScaleFactors factors() const;
   /// Checks both laws and the distribution; errors name the path.
   void validate() const;

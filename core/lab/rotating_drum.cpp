@@ -115,7 +115,6 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   sim::World w = make_material_world(material, options);
   w.gravity = {0, -9.81, 0};
   const auto sizes = material.simulated_sizes();
-  const double density = material.simulated_density();
   const double r_max = particles::max_radius(sizes);
 
   // Drum size from the particle count: fill * pi R^2 W = solid volume / 0.6, W = aspect 2R.
@@ -131,11 +130,9 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
       walls::make_wall("front", walls::Plane{{0, 0, depth}, {0, 0, -1}}, kWallPiston));
   for (auto& wall : w.walls) wall.pivot = {0, 0, 0};
 
-  particles::InsertRequest req;
-  req.region = particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth};
-  req.sizes = sizes;
-  req.count = static_cast<std::size_t>(s.particles);
-  req.density = density;
+  particles::InsertRequest req =
+      material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth},
+                              static_cast<std::size_t>(s.particles));
   particles::insert_random(w.particles, req, rng);
   w.dt = sim::recommended_time_step(w, s.time_step_safety);
 

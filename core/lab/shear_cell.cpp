@@ -80,7 +80,6 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   const auto s = read_settings<ShearCellSettings>(values, "settings");
   sim::World w = make_material_world(material, options);
   const auto sizes = material.simulated_sizes();
-  const double density = material.simulated_density();
   const double r_max = particles::max_radius(sizes);
   const double d = 2.0 * r_max;
 
@@ -93,11 +92,9 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   w.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
   w.walls.push_back(
       walls::make_wall("vessel", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius}, kWallDie));
-  particles::InsertRequest req;
-  req.region = particles::CylinderRegion{{0, 0, 0}, radius, 0.0, fill_h};
-  req.sizes = sizes;
-  req.count = static_cast<std::size_t>(s.particles);
-  req.density = density;
+  particles::InsertRequest req =
+      material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, fill_h},
+                              static_cast<std::size_t>(s.particles));
   particles::insert_random(w.particles, req, rng);
   w.dt = sim::recommended_time_step(w, s.time_step_safety);
   sim::HealthLimits limits = die_limits(w, radius, fill_h + h_v);

@@ -38,7 +38,7 @@ double solid_fraction(const sim::World& w, const Vec3& lo, const Vec3& hi) {
   for (std::size_t i = 0; i < p.size(); ++i) {
     const Vec3& x = p.x[i];
     if (x.x >= lo.x && x.x < hi.x && x.y >= lo.y && x.y < hi.y && x.z >= lo.z && x.z < hi.z)
-      solid += 4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3);
+      solid += p.solid_volume(i);
   }
   const Vec3 d = hi - lo;
   return solid / (d.x * d.y * d.z);
@@ -78,7 +78,7 @@ double solid_fraction(const sim::World& w, const SamplingCylinder& region) {
     if (rho - r >= region.radius || c.z + r <= region.z_lo || c.z - r >= region.z_hi) continue;
     int inside = 0;
     for (const Vec3& q : pts) inside += region.contains(c + q * r);
-    solid += 4.0 / 3.0 * M_PI * r * r * r * inside / static_cast<double>(pts.size());
+    solid += p.solid_volume(i) * inside / static_cast<double>(pts.size());
   }
   return solid / region.volume();
 }

@@ -10,6 +10,8 @@ double coordination_number(const sim::World& world);
 std::size_t contact_count(const sim::World& world);
 /// Height of the highest particle top along +z (m).
 double bed_top(const sim::World& world);
+/// Solid volumes are ParticleStore::solid_volume: a clump member's share of its clump's union, so
+/// overlapping members are not counted twice.
 /// Solid fraction in an axis-aligned sampling box: volume of the spheres whose centres lie inside,
 /// over the box volume (unbiased for a box well inside the bed, away from the walls).
 double solid_fraction(const sim::World& world, const Vec3& lo, const Vec3& hi);

@@ -83,7 +83,7 @@ Grid make_grid(const std::vector<Vec3>& x, const Domain& domain, double cell,
 
 void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& radius,
                        const Domain& domain, double reach, int threads,
-                       std::vector<double>& history, int stride) {
+                       std::vector<double>& history, int stride, const std::int32_t* body) {
   const int n = static_cast<int>(x.size());
   double r_max = 0.0;
   for (double r : radius) r_max = std::max(r_max, r);
@@ -115,7 +115,7 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
     for (int s = 0; s < nc; ++s)
       for (int k = cell_start_[cells[s]]; k < cell_start_[cells[s] + 1]; ++k) {
         const int j = cell_items_[k];
-        if (j <= i) continue;
+        if (j <= i || (body && body[i] >= 0 && body[i] == body[j])) continue;
         const double cut = radius[i] + radius[j] + reach;
         if (norm2(domain.separation(x[i], x[j])) < cut * cut) visit(j);
       }

@@ -2,6 +2,7 @@
 // Half Verlet list (each pair once, j > i) built on a cell grid, with a skin. Rows are sorted by j
 // so the per-contact history of the old list can be carried to the new one by merging rows
 // (the explicit history-mapping step of DEM-Engine, keyed by the ordered pair (i, j)).
+#include <cstdint>
 #include <vector>
 
 #include "core/common/domain.hpp"
@@ -16,9 +17,11 @@ class VerletList {
 
   /// Rebuilds the list for pairs with |x_j - x_i| < r_i + r_j + reach, where reach = interaction
   /// range beyond contact + skin. Carries `history` (stride doubles per pair) from the old list.
-  /// Positions must already be wrapped into the periodic box.
+  /// Positions must already be wrapped into the periodic box. With `body` (one entry per
+  /// particle, -1 = none), pairs of two members of one rigid clump are left out.
   void build(const std::vector<Vec3>& x, const std::vector<double>& radius, const Domain& domain,
-             double reach, int threads, std::vector<double>& history, int stride);
+             double reach, int threads, std::vector<double>& history, int stride,
+             const std::int32_t* body = nullptr);
 
   /// True when some particle has moved more than half the skin since the last build, the
   /// displacement after which a pair outside the list could have come into range.

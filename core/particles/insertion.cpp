@@ -72,24 +72,53 @@ bool random_centre(const Region& region, double r, Rng& rng, Vec3& out) {
       region);
 }
 
+/// A uniformly random orientation (Shoemake 1992, three uniforms).
+Quat random_orientation(Rng& rng) {
+  const double u1 = rng.uniform(), u2 = 2.0 * M_PI * rng.uniform(), u3 = 2.0 * M_PI * rng.uniform();
+  const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
+  return Quat{a * std::sin(u2), a * std::cos(u2), b * std::sin(u3), b * std::cos(u3)}.normalized();
+}
+
 }  // namespace
 
 void insert_random(ParticleStore& store, const InsertRequest& req, Rng& rng) {
   validate(req.sizes, "sizes");
-  const double r_max = max_radius(req.sizes);
+  const ClumpTemplate* shape = req.shape ? &*req.shape : nullptr;
+  double largest_member = 1.0, bounding = 1.0;
+  if (shape) {
+    largest_member = *std::max_element(shape->radii.begin(), shape->radii.end());
+    bounding = shape->bounding_radius;
+  }
+  const double r_max = max_radius(req.sizes) * largest_member;
   PlacementGrid grid(2.0 * r_max + req.gap);
   for (std::size_t i = 0; i < store.size(); ++i) grid.add(i, store.x[i]);
-  store.reserve(store.size() + req.count);
+  store.reserve(store.size() + req.count * (shape ? shape->size() : 1));
+  std::vector<Vec3> members;
   for (std::size_t placed = 0; placed < req.count; ++placed) {
     const double r = sample_radius(req.sizes, rng);
     bool ok = false;
     for (std::size_t attempt = 0; attempt < req.max_attempts_per_particle && !ok; ++attempt) {
       Vec3 c;
-      if (!random_centre(req.region, r + req.gap, rng, c))
+      if (!random_centre(req.region, r * bounding + req.gap, rng, c))
         throw InputError("insertion.region",
                          "region too small for a particle of radius " + std::to_string(r));
-      if (grid.overlaps(store, c, r, req.gap)) continue;
-      grid.add(store.add_sphere(c, r, req.density, req.material), c);
+      if (!shape) {
+        if (grid.overlaps(store, c, r, req.gap)) continue;
+        grid.add(store.add_sphere(c, r, req.density, req.material), c);
+        ok = true;
+        continue;
+      }
+      const Quat q = random_orientation(rng);
+      members.clear();
+      bool free = true;
+      for (std::size_t k = 0; k < shape->size() && free; ++k) {
+        members.push_back(c + q.rotate(shape->offsets[k] * r));
+        free = !grid.overlaps(store, members.back(), shape->radii[k] * r, req.gap);
+      }
+      if (!free) continue;
+      const std::size_t b = store.add_clump(c, q, *shape, r, req.density, req.material);
+      for (std::size_t k = 0; k < shape->size(); ++k)
+        grid.add(store.clumps.first[b] + k, members[k]);
       ok = true;
     }
     if (!ok)

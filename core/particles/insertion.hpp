@@ -1,6 +1,7 @@
 #pragma once
 // Placing particles without overlap: random sequential insertion into a region, and lattices.
 #include <cstdint>
+#include <optional>
 #include <variant>
 
 #include "core/common/rng.hpp"
@@ -27,11 +28,15 @@ struct InsertRequest {
   double density = 0.0;  ///< (kg/m^3)
   std::uint16_t material = 0;
   double gap = 0.0;  ///< extra clearance kept between spheres and to the region border (m)
+  /// Rigid clumps of this shape instead of spheres: the sampled radius is the clump's
+  /// volume-equivalent radius, the orientation uniformly random.
+  std::optional<ClumpTemplate> shape;
   std::size_t max_attempts_per_particle = 2000;
 };
 
-/// Random sequential insertion: each new sphere is placed at a uniformly random position inside
-/// the region where it overlaps neither the region border nor any sphere already in `store`.
+/// Random sequential insertion: each new sphere (or clump) is placed at a uniformly random
+/// position inside the region where it overlaps neither the region border (a clump: its
+/// bounding sphere) nor any sphere already in `store`.
 /// Throws InputError when the region cannot take `count` spheres (too dense for random insertion).
 void insert_random(ParticleStore& store, const InsertRequest& request, Rng& rng);
 

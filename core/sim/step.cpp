@@ -1,5 +1,6 @@
 #include "core/sim/step.hpp"
 
+#include "core/integrate/rigid_body.hpp"
 #include "core/integrate/velocity_verlet.hpp"
 #include "core/sim/forces.hpp"
 
@@ -14,8 +15,10 @@ void step(World& w) {
   }
   const double half = 0.5 * w.dt;
 
-  // 1. First half kick with the forces of the last step, then drift (velocity Verlet).
+  // 1. First half kick with the forces of the last step, then drift (velocity Verlet); rigid
+  //    clumps kick, drift and turn as bodies and place their member spheres.
   integrate::kick_drift(w.particles, w.dt, w.threads);
+  integrate::clump_kick_drift(w.particles, w.domain, w.dt, w.threads);
 
   // 2. Walls move with their prescribed or controlled velocities.
   for (auto& wall : w.walls) walls::advance(wall, w.dt);
@@ -26,7 +29,7 @@ void step(World& w) {
     for (auto& x : w.particles.x) w.domain.wrap(x);
     w.list.build(w.particles.x, w.particles.radius, w.domain,
                  w.interaction_range() + w.effective_skin(), w.threads, w.pair_history,
-                 w.pair_stride());
+                 w.pair_stride(), w.clump_bodies());
   }
 
   // 4. Forces: gravity and particle-particle contacts, then particle-wall contacts (which also
@@ -34,8 +37,9 @@ void step(World& w) {
   compute_pair_forces(w);
   compute_wall_forces(w);
 
-  // 5. Second half kick with the new forces.
+  // 5. Second half kick with the new forces (clumps: with the sums over their members).
   integrate::kick(w.particles, half, w.threads);
+  integrate::clump_kick(w.particles, half, w.threads);
 
   w.time += w.dt;
   ++w.step_count;

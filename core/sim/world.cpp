@@ -110,7 +110,7 @@ void World::prepare() {
   list = neighbour::VerletList{};
   pair_history.clear();
   list.build(particles.x, particles.radius, domain, interaction_range() + skin_, threads,
-             pair_history, pair_stride_);
+             pair_history, pair_stride_, clump_bodies());
   wall_history.assign(walls.size(), {});
   for (std::size_t w = 0; w < walls.size(); ++w)
     wall_history[w].assign(particles.size() * wall_strides_[w], 0.0);

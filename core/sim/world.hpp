@@ -57,6 +57,10 @@ class World {
   int pair_stride() const { return pair_stride_; }
   int wall_stride(std::size_t wall) const { return wall_strides_[wall]; }
   double effective_skin() const { return skin_; }
+  /// The body of each particle for the neighbour list, or null when there are no clumps.
+  const std::int32_t* clump_bodies() const {
+    return particles.clumps.size() ? particles.body.data() : nullptr;
+  }
 
  private:
   void grow_law_tables(int n);
