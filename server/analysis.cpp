@@ -52,6 +52,7 @@ CalibrationOutcome calibrate_plan(const CampaignPlan& plan, const Eigen::MatrixX
   for (const auto& f : plan.factors) problem.factors.push_back(f.factor);
   CalibrationOutcome out;
   for (const auto& t : plan.targets) {
+    if (t.holdout) continue;
     Eigen::Index col = -1;
     for (std::size_t c = 0; c < plan.responses.size(); ++c)
       if (plan.responses[c] == t.response) col = Eigen::Index(c);

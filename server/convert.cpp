@@ -203,8 +203,8 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
       throw InputError(where + ".value", "must be finite and non-zero (errors are relative)");
     if (m.uncertainty() < 0) throw InputError(where + ".uncertainty", "must be >= 0");
     if (m.weight() < 0) throw InputError(where + ".weight", "must be >= 0");
-    Target t{matches.front(), m.value(), m.weight() > 0 ? m.weight() : 1.0, std::nullopt,
-             m.source()};
+    Target t{matches.front(), m.value(),  m.weight() > 0 ? m.weight() : 1.0,
+             std::nullopt,    m.source(), m.holdout()};
     if (m.uncertainty() > 0) t.uncertainty = m.uncertainty();
     plan.targets.push_back(t);
   }
@@ -230,23 +230,31 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
   return plan;
 }
 
-std::vector<NewJob> verification_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
-                                      const Eigen::VectorXd& natural) {
+std::vector<NewJob> jobs_at(const v1::CampaignSpec& spec, const v1::Material& material,
+                            const std::map<std::string, double>& parameters, int std_order,
+                            const std::string& kind) {
   std::vector<NewJob> jobs;
   int order = 0;
   for (const auto& t : spec.tests()) {
     v1::JobSpec job;
     job.set_test(t.test());
     *job.mutable_settings() = t.settings();
-    *job.mutable_material() = spec.material();
+    *job.mutable_material() = material;
     *job.mutable_parameters() = spec.fixed();
-    for (std::size_t f = 0; f < plan.factors.size(); ++f)
-      (*job.mutable_parameters())[plan.factors[f].path] = natural(Eigen::Index(f));
+    for (const auto& [path, value] : parameters) (*job.mutable_parameters())[path] = value;
     job.set_seed(job_seed(t, 1));
     job.set_threads(t.threads());
-    jobs.push_back({0, ++order, t.test(), "verify", to_json(job)});
+    jobs.push_back({std_order, ++order, t.test(), kind, to_json(job)});
   }
   return jobs;
+}
+
+std::vector<NewJob> verification_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
+                                      const Eigen::VectorXd& natural) {
+  std::map<std::string, double> parameters;
+  for (std::size_t f = 0; f < plan.factors.size(); ++f)
+    parameters[plan.factors[f].path] = natural(Eigen::Index(f));
+  return jobs_at(spec, spec.material(), parameters, 0, "verify");
 }
 
 std::vector<std::string> factor_legend(const CampaignPlan& plan) {

@@ -1,6 +1,7 @@
 #pragma once
 // The coordinator's edge: proto messages in, domain values out, and back. Nothing else in
 // server/ reads a proto field for domain logic.
+#include <map>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,12 @@ namespace demcal::server {
 /// Factor paths must exist in the material's parameter table (lab::parameters) with bounds
 /// inside the valid range; tests, settings and measured metrics must exist in the catalogue.
 CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs);
+
+/// Jobs that simulate each test of the spec with `material` at one parameter set (the spec's
+/// fixed parameters, then `parameters`), as design row `std_order` of job kind `kind`.
+std::vector<NewJob> jobs_at(const v1::CampaignSpec& spec, const v1::Material& material,
+                            const std::map<std::string, double>& parameters, int std_order,
+                            const std::string& kind);
 
 /// Jobs that simulate each test at one parameter set (verification of a calibration).
 std::vector<NewJob> verification_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,

@@ -31,6 +31,7 @@ std::string plan_to_json(const CampaignPlan& plan) {
     nlohmann::json tj = {
         {"response", t.response}, {"value", t.value}, {"weight", t.weight}, {"source", t.source}};
     if (t.uncertainty) tj["uncertainty"] = *t.uncertainty;
+    if (t.holdout) tj["holdout"] = true;
     j["targets"].push_back(tj);
   }
   return j.dump();
@@ -64,6 +65,7 @@ CampaignPlan plan_from_json(const std::string& text) {
     for (const auto& t : j.at("targets")) {
       Target tg{t.at("response"), t.at("value"), t.at("weight"), std::nullopt, t.at("source")};
       if (t.contains("uncertainty")) tg.uncertainty = t.at("uncertainty").get<double>();
+      tg.holdout = t.value("holdout", false);
       p.targets.push_back(tg);
     }
   return p;

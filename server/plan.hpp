@@ -22,6 +22,7 @@ struct Target {
   double value = 0.0, weight = 1.0;
   std::optional<double> uncertainty;
   std::string source;
+  bool holdout = false;  ///< kept out of calibrations (reported by the diagnosis)
 };
 
 struct CampaignPlan {

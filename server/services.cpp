@@ -9,6 +9,7 @@
 #include "server/analysis.hpp"
 #include "server/auth.hpp"
 #include "server/convert.hpp"
+#include "server/diagnosis.hpp"
 
 namespace demcal::server {
 
@@ -228,6 +229,23 @@ grpc::Status CampaignServiceImpl::Calibrate(grpc::ServerContext* ctx,
     return grpc::Status::OK;
   } catch (const InputError& e) {
     return invalid(e);
+  } catch (const std::exception& e) {
+    return internal(e);
+  }
+}
+
+grpc::Status CampaignServiceImpl::Diagnose(grpc::ServerContext* ctx, const v1::DiagnoseRequest* req,
+                                           v1::DiagnoseReply* reply) {
+  DEMCAL_AUTHORIZE(ctx);
+  const auto row = store_.campaign(req->id());
+  if (!row) return not_found(req->id());
+  try {
+    // One diagnosis step at a time: two concurrent calls must not queue the same runs twice.
+    std::lock_guard lock(diagnose_mutex_);
+    *reply = diagnose_campaign(store_, *row, req->seed());
+    return grpc::Status::OK;
+  } catch (const InputError& e) {
+    return {grpc::StatusCode::FAILED_PRECONDITION, e.what()};
   } catch (const std::exception& e) {
     return internal(e);
   }

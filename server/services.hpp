@@ -3,6 +3,7 @@
 // the edge (convert.hpp) and call the store and the analysis; invalid input is answered with
 // INVALID_ARGUMENT naming the field, a stale lease with FAILED_PRECONDITION.
 #include <atomic>
+#include <mutex>
 #include <string>
 
 #include "demcal/v1/campaign.grpc.pb.h"
@@ -36,12 +37,15 @@ class CampaignServiceImpl final : public v1::CampaignService::Service {
                           v1::EffectsReply*) override;
   grpc::Status Calibrate(grpc::ServerContext*, const v1::CalibrateRequest*,
                          v1::CalibrateReply*) override;
+  grpc::Status Diagnose(grpc::ServerContext*, const v1::DiagnoseRequest*,
+                        v1::DiagnoseReply*) override;
   grpc::Status Export(grpc::ServerContext*, const v1::ExportRequest*, v1::ExportReply*) override;
 
  private:
   Store& store_;
   ServiceConfig config_;
   const std::atomic<bool>& stopping_;
+  std::mutex diagnose_mutex_;
 };
 
 class WorkerServiceImpl final : public v1::WorkerService::Service {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace demcal::metrics {
@@ -20,9 +22,45 @@ std::size_t contact_count(const sim::World& w) {
   return contacts;
 }
 
+namespace {
+
+/// The body of each sphere for contact counting: its clump, or (a lone sphere) a body of its own
+/// numbered after the clumps.
+std::int64_t body_id(const particles::ParticleStore& p, std::size_t i) {
+  return p.body[i] >= 0 ? p.body[i] : static_cast<std::int64_t>(p.clumps.size() + i);
+}
+
+/// The distinct touching pairs of bodies (a < b), sorted; several touching member pairs of the
+/// same two bodies count once, members of one body never.
+std::vector<std::pair<std::int64_t, std::int64_t>> body_contacts(const sim::World& w) {
+  const auto& p = w.particles;
+  std::vector<std::pair<std::int64_t, std::int64_t>> pairs;
+  if (w.list.row_start.size() != p.size() + 1) return pairs;
+  const int n = static_cast<int>(p.size());
+  for (int i = 0; i < n; ++i)
+    for (int k = w.list.row_start[i]; k < w.list.row_start[i + 1]; ++k) {
+      const int j = w.list.nbr[k];
+      const double reach = p.radius[i] + p.radius[j];
+      if (norm2(w.domain.separation(p.x[i], p.x[j])) >= reach * reach) continue;
+      const std::int64_t a = body_id(p, i), b = body_id(p, j);
+      if (a != b) pairs.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  return pairs;
+}
+
+}  // namespace
+
 double coordination_number(const sim::World& w) {
-  if (w.particles.size() == 0) return 0.0;
-  return 2.0 * static_cast<double>(contact_count(w)) / static_cast<double>(w.particles.size());
+  const auto& p = w.particles;
+  std::size_t lone = 0;
+  for (auto b : p.body) lone += b < 0;
+  const std::size_t bodies = p.clumps.size() + lone;
+  if (bodies == 0) return 0.0;
+  // Sphere-only worlds: every sphere its own body, each listed pair once, so this is
+  // 2 contact_count / N as before.
+  return 2.0 * static_cast<double>(body_contacts(w).size()) / static_cast<double>(bodies);
 }
 
 double bed_top(const sim::World& w) {
@@ -85,22 +123,22 @@ double solid_fraction(const sim::World& w, const SamplingCylinder& region) {
 
 double coordination_number(const sim::World& w, const SamplingCylinder& region) {
   const auto& p = w.particles;
-  const int n = static_cast<int>(p.size());
-  std::vector<int> contacts(n, 0);
   if (w.list.row_start.size() != p.size() + 1) return 0.0;
-  for (int i = 0; i < n; ++i)
-    for (int k = w.list.row_start[i]; k < w.list.row_start[i + 1]; ++k) {
-      const int j = w.list.nbr[k];
-      const double reach = p.radius[i] + p.radius[j];
-      if (norm2(w.domain.separation(p.x[i], p.x[j])) < reach * reach) {
-        ++contacts[i];
-        ++contacts[j];
-      }
-    }
+  const std::size_t n_ids = p.clumps.size() + p.size();
+  std::vector<int> contacts(n_ids, 0);
+  for (const auto& [a, b] : body_contacts(w)) {
+    ++contacts[a];
+    ++contacts[b];
+  }
   long sum = 0, counted = 0;
-  for (int i = 0; i < n; ++i)
-    if (region.contains(p.x[i])) {
-      sum += contacts[i];
+  for (std::size_t b = 0; b < p.clumps.size(); ++b)
+    if (region.contains(p.clumps.x[b])) {
+      sum += contacts[b];
+      ++counted;
+    }
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.body[i] < 0 && region.contains(p.x[i])) {
+      sum += contacts[static_cast<std::size_t>(body_id(p, i))];
       ++counted;
     }
   return counted ? static_cast<double>(sum) / static_cast<double>(counted) : 0.0;

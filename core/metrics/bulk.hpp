@@ -4,9 +4,14 @@
 
 namespace demcal::metrics {
 
-/// Mean number of touching neighbours per particle (pairs with overlap > 0, walls excluded).
+/// Mean number of touching neighbours per body (walls excluded). A body is a rigid clump or a
+/// lone sphere; its neighbours are the distinct other bodies with which any of its spheres
+/// overlaps (overlap > 0), so two clumps touching at several member pairs count one contact and
+/// the members of one clump never count each other. The mean is over all bodies. For spheres only
+/// it is 2 contact_count / N.
 double coordination_number(const sim::World& world);
-/// Number of touching particle pairs.
+/// Number of touching sphere pairs (overlap > 0): for clumps, member pairs, so two clumps touching
+/// at two member pairs count 2 (members of one clump are never listed, so never counted).
 std::size_t contact_count(const sim::World& world);
 /// Height of the highest particle top along +z (m).
 double bed_top(const sim::World& world);
@@ -29,7 +34,9 @@ struct SamplingCylinder {
 /// integrated with a fixed set of 552 points filling each sphere (accurate to about 1 %), over the
 /// cylinder volume.
 double solid_fraction(const sim::World& world, const SamplingCylinder& region);
-/// Mean number of particle contacts (overlap > 0) of the particles whose centres lie in `region`.
+/// Mean number of contacts per body, as coordination_number(world), over the bodies whose centre
+/// lies in `region`: a clump's centre of mass (Clumps::x), a lone sphere's centre. The contacts
+/// are counted whole, also with bodies outside the region.
 double coordination_number(const sim::World& world, const SamplingCylinder& region);
 
 }  // namespace demcal::metrics

@@ -1,0 +1,157 @@
+// `demcal diagnose CAMPAIGN`: what the calibrated model gets wrong and why (docs/diagnosis.md).
+// CAMPAIGN is a campaign id on a coordinator, or a spec YAML run on the embedded default (its
+// design is run first if the work directory has no campaign of that name). The diagnosis
+// advances as its simulations finish; this command drives it to the end and prints the report
+// as tables, or as JSON with --format json.
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "client/commands.hpp"
+#include "client/embedded.hpp"
+
+namespace demcal::cli {
+namespace {
+
+struct DiagnoseOptions {
+  proto::ChannelOptions channel;
+  std::string campaign;
+  std::string workdir;
+  int threads = 2;
+  bool verbose = false, wait = true;
+  std::string format = "table";
+  std::uint64_t seed = 1;
+};
+
+std::string pct(const nlohmann::json& v) {
+  if (!v.is_number()) return "-";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(1) << 100.0 * v.get<double>() << " %";
+  return s.str();
+}
+
+std::string num(const nlohmann::json& v) {
+  if (!v.is_number()) return "-";
+  std::ostringstream s;
+  s << std::setprecision(4) << v.get<double>();
+  return s.str();
+}
+
+void print_report(std::ostream& out, const nlohmann::json& r) {
+  out << "\nmeasured metrics against the factor box and the best calibration "
+         "(seed 000 Tables 10-15)\n";
+  out << std::left << std::setw(38) << "metric" << std::right << std::setw(11) << "target"
+      << std::setw(11) << "env min" << std::setw(11) << "env max" << std::setw(11) << "predicted"
+      << std::setw(11) << "simulated" << std::setw(10) << "error" << std::setw(10) << "curv. p"
+      << "\n";
+  for (const auto& m : r["metrics"]) {
+    std::string name = m["response"].get<std::string>() + (m["holdout"] ? " (held out)" : "");
+    out << std::left << std::setw(38) << name << std::right << std::setw(11) << num(m["target"])
+        << std::setw(11) << num(m["envelope_min"]) << std::setw(11) << num(m["envelope_max"])
+        << std::setw(11) << num(m["predicted"]) << std::setw(11) << num(m["simulated"])
+        << std::setw(10) << pct(m["relative_error"]) << std::setw(10) << num(m["curvature_p"])
+        << "\n";
+    if (!m["reachable"]) out << "    " << m["statement"].get<std::string>() << "\n";
+  }
+  const auto& b = r["baseline"];
+  out << "baseline RMS error: predicted " << pct(b["predicted_rms"]) << ", verified "
+      << pct(b["verified_rms"]) << ", held out " << pct(b["holdout_rms"]) << "\n";
+  out << "\nmetrics that pull against each other\n";
+  if (r["conflicts"].empty()) out << "  none (each metric's own best fit keeps the others near)\n";
+  for (const auto& c : r["conflicts"]) out << "  " << c["statement"].get<std::string>() << "\n";
+  out << "\ncandidate causes, each tested by simulation (best first)\n";
+  out << std::left << std::setw(34) << "candidate" << std::right << std::setw(6) << "runs"
+      << std::setw(12) << "predicted" << std::setw(12) << "verified" << std::setw(12) << "held out"
+      << std::setw(10) << "explains"
+      << "\n";
+  for (const auto& c : r["candidates"]) {
+    out << std::left << std::setw(34) << c["id"].get<std::string>() << std::right << std::setw(6)
+        << c["runs"].get<int>() << std::setw(12) << pct(c["predicted_rms"]) << std::setw(12)
+        << pct(c["verified_rms"]) << std::setw(12) << pct(c["holdout_rms"]) << std::setw(10)
+        << (c["explains"] ? "yes" : "no") << "\n";
+    out << "    " << c["cause"].get<std::string>() << ": " << c["state"].get<std::string>();
+    if (!c["evidence"].get<std::string>().empty()) out << "; " << c["evidence"].get<std::string>();
+    out << "\n";
+  }
+  out << "\n" << r["conclusion"].get<std::string>() << "\n";
+}
+
+/// Calls Diagnose until it is done, running the campaign's jobs in between (or once, without
+/// waiting). Returns the last reply.
+v1::DiagnoseReply drive(v1::CampaignService::Stub& stub, const proto::ChannelOptions& channel,
+                        std::int64_t id, const DiagnoseOptions& o) {
+  v1::DiagnoseRequest req;
+  req.set_id(id);
+  req.set_seed(o.seed);
+  for (;;) {
+    v1::DiagnoseReply reply;
+    check(stub.Diagnose(proto::make_context(channel, 600).get(), req, &reply), "diagnose");
+    if (reply.state() == "done" || !o.wait) return reply;
+    std::cerr << "diagnosis: " << reply.conclusion();
+    if (reply.jobs_queued()) std::cerr << " (" << reply.jobs_queued() << " jobs queued)";
+    std::cerr << "\n";
+    watch_campaign(stub, channel, id, std::cerr);
+  }
+}
+
+void report(const v1::DiagnoseReply& reply, const std::string& format) {
+  const auto r = nlohmann::json::parse(reply.report_json().empty() ? "{}" : reply.report_json());
+  if (format == "json") {
+    std::cout << (r.empty()
+                      ? nlohmann::json{{"state", reply.state()}, {"conclusion", reply.conclusion()}}
+                      : r)
+                     .dump(2)
+              << "\n";
+    return;
+  }
+  if (r.empty()) {
+    std::cout << reply.state() << ": " << reply.conclusion() << "\n";
+    return;
+  }
+  print_report(std::cout, r);
+}
+
+void run(const DiagnoseOptions& o) {
+  if (std::filesystem::is_regular_file(o.campaign)) {
+    const SpecFile file = read_campaign_spec(o.campaign);
+    EmbeddedService service(work_directory(o.campaign, o.workdir), o.threads, o.verbose);
+    const std::int64_t id = service.submit_or_resume(file, std::cerr);
+    watch_campaign(service.stub(), service.channel(), id, std::cerr);
+    report(drive(service.stub(), service.channel(), id, o), o.format);
+    return;
+  }
+  std::int64_t id = 0;
+  try {
+    id = std::stoll(o.campaign);
+  } catch (const std::exception&) {
+    throw CLI::ValidationError("campaign",
+                               "'" + o.campaign + "' is neither a spec file nor a campaign id");
+  }
+  auto stub = campaign_stub(o.channel);
+  report(drive(*stub, o.channel, id, o), o.format);
+}
+
+}  // namespace
+
+void add_diagnose_command(CLI::App& app) {
+  auto o = std::make_shared<DiagnoseOptions>();
+  auto* cmd =
+      app.add_subcommand("diagnose",
+                         "What the calibrated model gets wrong, the candidate causes tested by "
+                         "simulation, the named cause and the gain");
+  add_connection_options(*cmd, o->channel);
+  cmd->add_option("campaign", o->campaign, "campaign id, or a spec YAML (embedded default)")
+      ->required();
+  cmd->add_option("--workdir", o->workdir, "embedded: directory of the SQLite file");
+  cmd->add_option("--threads", o->threads, "embedded: simulation threads of the local worker")
+      ->capture_default_str();
+  cmd->add_flag("!--no-wait", o->wait, "report the current state and queue the next runs only");
+  cmd->add_option("--seed", o->seed, "calibration multi-start seed")->capture_default_str();
+  cmd->add_option("--format", o->format, "table or json")->check(CLI::IsMember({"table", "json"}));
+  cmd->add_flag("-v,--verbose", o->verbose, "embedded: coordinator and worker logs");
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace demcal::cli

@@ -1,0 +1,73 @@
+#include "client/embedded.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+#include <random>
+
+#include "core/common/error.hpp"
+
+namespace demcal::cli {
+namespace {
+
+std::string random_token() {
+  std::random_device rd;
+  std::string t;
+  for (int i = 0; i < 32; ++i) t += "0123456789abcdef"[rd() % 16];
+  return t;
+}
+
+}  // namespace
+
+std::filesystem::path work_directory(const std::string& spec, const std::string& workdir) {
+  return workdir.empty() ? std::filesystem::path("demcal-work") / std::filesystem::path(spec).stem()
+                         : std::filesystem::path(workdir);
+}
+
+EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, int threads, bool verbose) {
+  std::filesystem::create_directories(workdir);
+  spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
+  server::CoordinatorOptions co;
+  co.listen = "127.0.0.1:0";
+  co.db = db_ = (workdir / "campaign.db").string();
+  co.token = random_token();
+  coordinator_ = std::make_unique<server::Coordinator>(co);
+  channel_.address = "127.0.0.1:" + std::to_string(coordinator_->port());
+  channel_.token = co.token;
+  worker::WorkerOptions wo;
+  wo.channel = channel_;
+  wo.threads = threads;
+  wo.id = "embedded";
+  worker_ = std::thread([this, wo] { worker::run_worker(wo, flags_); });
+  stub_ = campaign_stub(channel_);
+}
+
+EmbeddedService::~EmbeddedService() {
+  flags_.stop = true;
+  if (worker_.joinable()) worker_.join();
+  coordinator_->shutdown();
+}
+
+std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostream& out) {
+  v1::ListReply list;
+  check(stub_->List(proto::make_context(channel_, 30).get(), {}, &list), "list");
+  std::int64_t id = 0;
+  for (const auto& c : list.campaigns())
+    if (c.name() == file.spec.name() && c.state() != v1::CANCELLED) id = std::max(id, c.id());
+  if (id) {
+    out << "resuming campaign " << id << " '" << file.spec.name() << "'\n";
+    return id;
+  }
+  v1::SubmitRequest req;
+  *req.mutable_spec() = file.spec;
+  v1::SubmitReply reply;
+  const auto s = stub_->Submit(proto::make_context(channel_, 120).get(), req, &reply);
+  if (s.error_code() == grpc::StatusCode::INVALID_ARGUMENT)
+    throw InputError("", file.locate(s.error_message()));
+  check(s, "submit");
+  out << "campaign " << reply.id() << " '" << file.spec.name() << "'\n";
+  print_design_summary(out, reply.design());
+  return reply.id();
+}
+
+}  // namespace demcal::cli

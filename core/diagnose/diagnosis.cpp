@@ -1,0 +1,428 @@
+#include "core/diagnose/diagnosis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/calib/calibration.hpp"
+#include "core/common/error.hpp"
+#include "core/doe/alias_structure.hpp"
+#include "core/doe/analysis.hpp"
+#include "core/doe/model_fit.hpp"
+
+namespace demcal::diagnose {
+namespace {
+
+/// A candidate's augmented design in its extended factor space.
+struct Plan {
+  std::string id, cause;
+  std::map<std::string, std::string> switches;
+  std::vector<Factor> factors;  ///< base factors, then the new one (if any)
+  double base_coded = 0.0;      ///< the new factor's coded value in the base runs
+  Eigen::MatrixXd new_rows;     ///< runs to simulate
+  doe::ModelKind model = doe::ModelKind::kTwoFactor;
+};
+
+bool is_factorial(const Eigen::MatrixXd& x, Eigen::Index r) {
+  for (Eigen::Index c = 0; c < x.cols(); ++c)
+    if (std::abs(std::abs(x(r, c)) - 1.0) > 1e-9) return false;
+  return true;
+}
+
+bool has_centre(const Eigen::MatrixXd& x) {
+  for (Eigen::Index r = 0; r < x.rows(); ++r)
+    if (x.row(r).cwiseAbs().maxCoeff() < 1e-9) return true;
+  return false;
+}
+
+Eigen::MatrixXd factorial_rows(const Eigen::MatrixXd& x) {
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index r = 0; r < x.rows(); ++r)
+    if (is_factorial(x, r)) rows.push_back(r);
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), x.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i) out.row(Eigen::Index(i)) = x.row(rows[i]);
+  return out;
+}
+
+/// The base factorial runs crossed with a new factor at the given coded levels.
+Eigen::MatrixXd crossed(const Eigen::MatrixXd& design, const std::vector<double>& levels) {
+  const Eigen::MatrixXd f = factorial_rows(design);
+  Eigen::MatrixXd out(f.rows() * Eigen::Index(levels.size()), f.cols() + 1);
+  Eigen::Index r = 0;
+  for (double level : levels)
+    for (Eigen::Index i = 0; i < f.rows(); ++i, ++r) {
+      out.row(r).head(f.cols()) = f.row(i);
+      out(r, f.cols()) = level;
+    }
+  return out;
+}
+
+bool has_factor(const Problem& p, const std::string& path) {
+  return std::any_of(p.factors.begin(), p.factors.end(),
+                     [&](const Factor& f) { return f.path == path; });
+}
+
+Plan new_factor_plan(const Problem& p, std::string id, std::string cause,
+                     std::map<std::string, std::string> switches, Factor extra, double base_value) {
+  Plan plan{std::move(id), std::move(cause), std::move(switches), p.factors};
+  plan.base_coded = extra.factor.to_coded(base_value);
+  plan.factors.push_back(std::move(extra));
+  // The base runs sit at one end of the new factor (a sphere is a rod of aspect ratio 1, no
+  // rolling model is mu_r = 0): its factorial runs again at the other end complete a design
+  // in which the new factor and its interactions with every main effect are clear. A fixed
+  // value inside the range needs both ends.
+  std::vector<double> levels;
+  if (plan.base_coded > -1.0 + 1e-9) levels.push_back(-1.0);
+  if (plan.base_coded < 1.0 - 1e-9) levels.push_back(1.0);
+  plan.new_rows = crossed(p.design, levels);
+  return plan;
+}
+
+std::vector<Plan> candidate_plans(const Problem& p) {
+  std::vector<Plan> plans;
+  const auto& o = p.options;
+  if (p.shape_kind == "sphere" && !has_factor(p, "shape.aspect_ratio"))
+    plans.push_back(new_factor_plan(
+        p, "shape", "particle shape: elongated rigid rods instead of spheres", {{"shape", "rod"}},
+        {"shape.aspect_ratio", doe::Factor{"shape.aspect_ratio", 1.0, o.aspect_ratio_max}}, 1.0));
+  bool rolling_factor = false;
+  for (const auto& f : p.factors) rolling_factor |= f.path.rfind("particle_law.rolling.", 0) == 0;
+  if (p.rolling_model == "none" && !rolling_factor)
+    plans.push_back(new_factor_plan(
+        p, "rolling", "rolling resistance: the model has none (CDT, mu_r)",
+        {{"particle_law.rolling", "cdt"}},
+        {"particle_law.rolling.mu_r", doe::Factor{"particle_law.rolling.mu_r", 0.0, o.rolling_max}},
+        0.0));
+  for (const auto& [path, value] : p.fixed) {
+    if (has_factor(p, path) || !(value > 0.0)) continue;
+    double lo = value / o.fixed_span, hi = value * o.fixed_span;
+    if (auto it = p.valid.find(path); it != p.valid.end()) {
+      lo = std::max(lo, it->second.first);
+      hi = std::min(hi, it->second.second);
+    }
+    if (!(lo < hi)) continue;
+    plans.push_back(new_factor_plan(
+        p, "fixed:" + path, "a parameter held fixed: " + path + " = " + std::to_string(value), {},
+        {path, doe::Factor{path, lo, hi, doe::Scale::kLog}}, value));
+  }
+  const auto k = p.design.cols();
+  {
+    // Non-linearity: face-centred axial runs (and a centre run if the design has none) turn the
+    // design into a composite one that supports the full quadratic model.
+    Plan plan{"curvature", "non-linearity: a response curved inside the box", {}, p.factors};
+    plan.model = doe::ModelKind::kQuadratic;
+    const Eigen::Index extra = has_centre(p.design) ? 0 : 1;
+    plan.new_rows = Eigen::MatrixXd::Zero(2 * k + extra, k);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      plan.new_rows(2 * c, c) = -1.0;
+      plan.new_rows(2 * c + 1, c) = 1.0;
+    }
+    plans.push_back(std::move(plan));
+  }
+  const auto alias = doe::analyse_aliasing(factorial_rows(p.design));
+  if (alias.resolution && *alias.resolution <= 4) {
+    // Interactions aliased with main effects or with each other: the full fold-over separates
+    // every main effect from the 2FIs (Montgomery §8.6).
+    Plan plan{
+        "interaction", "a two-factor interaction aliased in the design (fold-over)", {}, p.factors};
+    plan.new_rows = -factorial_rows(p.design);
+    plans.push_back(std::move(plan));
+  }
+  if (o.candidates.empty()) return plans;
+  std::vector<Plan> chosen;
+  for (const auto& id : o.candidates) {
+    auto it = std::find_if(plans.begin(), plans.end(), [&](const Plan& x) { return x.id == id; });
+    if (it == plans.end()) {
+      std::string known;
+      for (const auto& x : plans) known += (known.empty() ? "" : ", ") + x.id;
+      throw InputError(
+          "diagnose.candidates",
+          "'" + id + "' is not a candidate for this campaign (applicable: " + known + ")");
+    }
+    chosen.push_back(*it);
+  }
+  return chosen;
+}
+
+std::map<std::string, double> natural_point(const std::vector<Factor>& factors,
+                                            const Eigen::VectorXd& natural) {
+  std::map<std::string, double> out;
+  for (std::size_t f = 0; f < factors.size(); ++f) out[factors[f].path] = natural(Eigen::Index(f));
+  return out;
+}
+
+double target_weight(const Measurement& m) {
+  return m.uncertainty ? (m.value / *m.uncertainty) * (m.value / *m.uncertainty) : m.weight;
+}
+
+/// The calibration objective of core/calib as an RMS relative error over `which` measurements
+/// (holdout or not), from values by response; NaN when a value is missing.
+double rms_error(const std::vector<Measurement>& ms, const std::map<std::string, double>& values,
+                 bool holdout) {
+  double sum = 0.0, weights = 0.0;
+  for (const auto& m : ms) {
+    if (m.holdout != holdout) continue;
+    auto it = values.find(m.response);
+    if (it == values.end() || !std::isfinite(it->second)) return kPending;
+    const double e = (it->second - m.value) / std::abs(m.value);
+    sum += target_weight(m) * e * e;
+    weights += target_weight(m);
+  }
+  return weights > 0.0 ? std::sqrt(sum / weights) : kPending;
+}
+
+Eigen::Index response_column(const Problem& p, const std::string& response) {
+  for (std::size_t c = 0; c < p.responses.size(); ++c)
+    if (p.responses[c] == response) return Eigen::Index(c);
+  throw InputError("measurements", "no response " + response + " in the campaign's tests");
+}
+
+/// Fitted models of every measurement on (coded, results) and the calibration over `factors`.
+struct Fitted {
+  std::vector<calib::MetricTarget> all;  ///< one per measurement, in order
+  calib::CalibrationResult result;
+  bool reaches_all = true;
+};
+
+Fitted fit_and_calibrate(const Problem& p, const std::vector<Factor>& factors,
+                         const Eigen::MatrixXd& coded, const Eigen::MatrixXd& results,
+                         doe::ModelKind kind) {
+  Fitted out;
+  calib::CalibrationProblem problem;
+  for (const auto& f : factors) problem.factors.push_back(f.factor);
+  for (const auto& m : p.measurements) {
+    calib::MetricTarget t;
+    t.name = m.response;
+    t.model = doe::fit_model(coded, results.col(response_column(p, m.response)), kind);
+    t.target = m.value;
+    t.weight = m.weight;
+    t.uncertainty = m.uncertainty;
+    out.all.push_back(t);
+    if (!m.holdout) problem.metrics.push_back(std::move(t));
+  }
+  calib::CalibrationOptions o;
+  o.starts = p.options.starts;
+  o.seed = p.options.seed;
+  out.result = calib::calibrate(problem, o);
+  for (const auto& m : out.result.metrics) out.reaches_all &= m.reachable;
+  return out;
+}
+
+/// Rows of a group's results as a matrix in response order (NaN where missing).
+Eigen::MatrixXd group_matrix(const Problem& p, const GroupResults& g, Eigen::Index rows) {
+  Eigen::MatrixXd y = Eigen::MatrixXd::Constant(rows, Eigen::Index(p.responses.size()), kPending);
+  for (const auto& [row, values] : g)
+    for (const auto& [name, value] : values)
+      for (std::size_t c = 0; c < p.responses.size(); ++c)
+        if (p.responses[c] == name && row >= 1 && row <= rows) y(row - 1, Eigen::Index(c)) = value;
+  return y;
+}
+
+const GroupResults* find_group(const std::map<std::string, GroupResults>& groups,
+                               const std::string& name) {
+  auto it = groups.find(name);
+  return it == groups.end() ? nullptr : &it->second;
+}
+
+std::string percent(double x) {
+  std::ostringstream s;
+  s.precision(3);
+  s << 100.0 * x << " %";
+  return s.str();
+}
+
+std::vector<Conflict> conflicts(const Problem& p, const Fitted& joint) {
+  std::vector<Conflict> out;
+  std::vector<std::size_t> calibrated;
+  for (std::size_t i = 0; i < p.measurements.size(); ++i)
+    if (!p.measurements[i].holdout) calibrated.push_back(i);
+  if (calibrated.size() < 2) return out;
+  calib::CalibrationOptions o;
+  o.starts = p.options.starts;
+  o.seed = p.options.seed;
+  std::vector<doe::Factor> box;
+  for (const auto& f : p.factors) box.push_back(f.factor);
+  for (std::size_t a : calibrated) {
+    calib::CalibrationProblem alone{box, {joint.all[a]}};
+    const auto fit = calib::calibrate(alone, o);
+    for (std::size_t b : calibrated) {
+      if (a == b) continue;
+      const auto& mb = joint.all[b];
+      const double t = std::abs(mb.target);
+      const double at_a = (mb.model.predict(fit.coded) - mb.target) / t;
+      const double at_joint = (mb.model.predict(joint.result.coded) - mb.target) / t;
+      if (std::abs(at_a) > std::max(2.0 * std::abs(at_joint), 0.05))
+        out.push_back({p.measurements[a].response, p.measurements[b].response, at_a, at_joint,
+                       "fitting " + p.measurements[a].response + " alone puts " +
+                           p.measurements[b].response + " " + percent(at_a) + " off (" +
+                           percent(at_joint) + " at the joint best fit)"});
+    }
+  }
+  return out;
+}
+
+/// Simulated values of the verification row of a group (row 1), or empty while pending.
+std::map<std::string, double> verified(const std::map<std::string, GroupResults>& groups,
+                                       const std::string& name) {
+  const auto* g = find_group(groups, name);
+  if (!g || !g->count(1)) return {};
+  return g->at(1);
+}
+
+}  // namespace
+
+std::vector<std::string> applicable_candidates(const Problem& problem) {
+  Problem p = problem;
+  p.options.candidates.clear();
+  std::vector<std::string> ids;
+  for (const auto& plan : candidate_plans(p)) ids.push_back(plan.id);
+  return ids;
+}
+
+Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups) {
+  Step step;
+  Report& rep = step.report;
+  if (std::none_of(p.measurements.begin(), p.measurements.end(),
+                   [](const Measurement& m) { return !m.holdout; }))
+    throw InputError("measurements",
+                     "the diagnosis needs at least one measurement to calibrate "
+                     "against (not held out)");
+  const auto plans = candidate_plans(p);
+  const int k = static_cast<int>(p.design.cols());
+
+  // 1. Baseline: envelopes, calibration, conflicts, curvature (no new simulation).
+  const Fitted base =
+      fit_and_calibrate(p, p.factors, p.design, p.results, doe::ModelKind::kTwoFactor);
+  rep.baseline_proposed = natural_point(p.factors, base.result.natural);
+  rep.baseline_predicted_rms = std::sqrt(base.result.objective);
+  calib::CalibrationOptions eo;
+  eo.starts = p.options.starts;
+  eo.seed = p.options.seed;
+  const auto base_sim = verified(groups, "baseline");
+  for (std::size_t i = 0; i < p.measurements.size(); ++i) {
+    const auto& m = p.measurements[i];
+    MetricRow row;
+    row.response = m.response;
+    row.target = m.value;
+    row.holdout = m.holdout;
+    const auto env = calib::reachable_envelope(base.all[i].model, eo);
+    row.envelope_min = env.min;
+    row.envelope_max = env.max;
+    row.reachable = m.value >= env.min && m.value <= env.max;
+    row.statement = row.reachable ? "within reach of the factor box"
+                    : m.value > env.max
+                        ? "above what the factor box reaches (max " + std::to_string(env.max) + ")"
+                        : "below what the factor box reaches (min " + std::to_string(env.min) + ")";
+    row.predicted = base.all[i].model.predict(base.result.coded);
+    doe::AnalysisOptions ao;
+    const auto analysis =
+        doe::analyse_response(p.design, p.results.col(response_column(p, m.response)), ao);
+    if (analysis.curvature.available) row.curvature_p = analysis.curvature.p_value;
+    if (auto it = base_sim.find(m.response); it != base_sim.end()) {
+      row.simulated = it->second;
+      row.relative_error = (it->second - m.value) / std::abs(m.value);
+    }
+    rep.metrics.push_back(row);
+  }
+  rep.conflicts = conflicts(p, base);
+  RunRequest baseline{"baseline", 1, {}, rep.baseline_proposed};
+  step.requests.push_back(baseline);
+  if (!base_sim.empty()) {
+    rep.baseline_verified_rms = rms_error(p.measurements, base_sim, false);
+    rep.baseline_holdout_rms = rms_error(p.measurements, base_sim, true);
+  }
+
+  // 2. Candidates: augmented designs, then their calibrations verified.
+  bool all_verified = !base_sim.empty();
+  for (const auto& plan : plans) {
+    CandidateOutcome c;
+    c.id = plan.id;
+    c.cause = plan.cause;
+    c.factors = plan.factors;
+    c.runs = static_cast<int>(plan.new_rows.rows());
+    for (Eigen::Index r = 0; r < plan.new_rows.rows(); ++r) {
+      RunRequest req{plan.id, static_cast<int>(r + 1), plan.switches, {}};
+      for (std::size_t f = 0; f < plan.factors.size(); ++f)
+        req.parameters[plan.factors[f].path] =
+            plan.factors[f].factor.to_natural(plan.new_rows(r, Eigen::Index(f)));
+      step.requests.push_back(std::move(req));
+    }
+    const auto* g = find_group(groups, plan.id);
+    if (!g || static_cast<Eigen::Index>(g->size()) < plan.new_rows.rows()) {
+      c.state = "pending";
+      all_verified = false;
+      rep.candidates.push_back(std::move(c));
+      continue;
+    }
+    // Base runs (with the new factor at its base value) and the new runs, fitted together.
+    const Eigen::Index n0 = p.design.rows(), n1 = plan.new_rows.rows();
+    const Eigen::Index cols = static_cast<Eigen::Index>(plan.factors.size());
+    Eigen::MatrixXd coded(n0 + n1, cols);
+    coded.topLeftCorner(n0, k) = p.design;
+    if (cols > k) coded.block(0, k, n0, 1).setConstant(plan.base_coded);
+    coded.bottomRows(n1) = plan.new_rows;
+    Eigen::MatrixXd y(n0 + n1, p.results.cols());
+    y.topRows(n0) = p.results;
+    y.bottomRows(n1) = group_matrix(p, *g, n1);
+    try {
+      const Fitted fit = fit_and_calibrate(p, plan.factors, coded, y, plan.model);
+      c.state = "designed";
+      c.proposed = natural_point(plan.factors, fit.result.natural);
+      c.predicted_rms = std::sqrt(fit.result.objective);
+      c.reaches_all = fit.reaches_all;
+      step.requests.push_back({plan.id + "/verify", 1, plan.switches, c.proposed});
+      c.simulated = verified(groups, plan.id + "/verify");
+      if (!c.simulated.empty()) {
+        c.state = "verified";
+        c.verified_rms = rms_error(p.measurements, c.simulated, false);
+        c.holdout_rms = rms_error(p.measurements, c.simulated, true);
+        if (!std::isfinite(c.verified_rms)) c.state = "failed";
+      } else {
+        all_verified = false;
+      }
+    } catch (const InputError& e) {
+      c.state = "failed";
+      c.evidence = std::string("could not be fitted: ") + e.what();
+    }
+    rep.candidates.push_back(std::move(c));
+  }
+
+  // 3. Ranking, evidence and the named cause.
+  std::stable_sort(rep.candidates.begin(), rep.candidates.end(),
+                   [](const CandidateOutcome& a, const CandidateOutcome& b) {
+                     const double x = std::isfinite(a.verified_rms) ? a.verified_rms : 1e300;
+                     const double y = std::isfinite(b.verified_rms) ? b.verified_rms : 1e300;
+                     return x < y;
+                   });
+  const double base_rms = rep.baseline_verified_rms;
+  for (auto& c : rep.candidates) {
+    if (c.state != "verified") continue;
+    c.explains = std::isfinite(base_rms) && c.verified_rms < (1.0 - p.options.margin) * base_rms;
+    std::ostringstream e;
+    e << "verified RMS error " << percent(c.verified_rms) << " against " << percent(base_rms)
+      << " for the baseline (predicted " << percent(c.predicted_rms) << ")";
+    if (std::isfinite(c.holdout_rms))
+      e << "; held-out " << percent(c.holdout_rms) << " against "
+        << percent(rep.baseline_holdout_rms);
+    for (const auto& f : c.factors)
+      if (!has_factor(p, f.path))
+        e << "; " << f.path << " = " << c.proposed.at(f.path) << " in [" << f.factor.low << ", "
+          << f.factor.high << "]";
+    e << (c.reaches_all ? "; its box reaches every target" : "; some target stays out of reach");
+    c.evidence = e.str();
+  }
+  rep.state = all_verified ? "done" : "running";
+  if (!all_verified) {
+    rep.conclusion = "simulations still running";
+  } else if (!rep.candidates.empty() && rep.candidates.front().explains) {
+    rep.named_cause = rep.candidates.front().id;
+    rep.conclusion = "named cause: " + rep.candidates.front().cause + " (" +
+                     rep.candidates.front().evidence + ")";
+  } else {
+    rep.conclusion = "no candidate cuts the verified error (" + percent(base_rms) + ") by " +
+                     percent(p.options.margin) + " or more: none is named";
+  }
+  return step;
+}
+
+}  // namespace demcal::diagnose

@@ -1,0 +1,186 @@
+#include "server/diagnosis.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "core/common/error.hpp"
+#include "core/diagnose/diagnosis.hpp"
+#include "core/lab/material.hpp"
+#include "proto/material_convert.hpp"
+#include "server/analysis.hpp"
+#include "server/convert.hpp"
+#include "server/plan.hpp"
+
+namespace demcal::server {
+namespace {
+
+constexpr const char* kPrefix = "diagnose:";
+
+double or_default(double v, double fallback) {
+  return v > 0.0 ? v : fallback;
+}
+
+diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan& plan,
+                               const std::vector<JobRow>& jobs, std::uint64_t seed) {
+  diagnose::Problem p;
+  for (const auto& f : plan.factors) p.factors.push_back({f.path, f.factor});
+  p.design = plan.design.coded;
+  p.responses = plan.responses;
+  p.results = response_matrix(plan, jobs);
+  for (const auto& t : plan.targets)
+    p.measurements.push_back({t.response, t.value, t.weight, t.uncertainty, t.holdout});
+  const auto& m = spec.material();
+  p.shape_kind = m.shape().kind().empty() ? "sphere" : m.shape().kind();
+  p.rolling_model =
+      m.particle_law().rolling().model().empty() ? "none" : m.particle_law().rolling().model();
+  for (const auto& [path, value] : spec.fixed()) p.fixed[path] = value;
+  const auto model = proto::to_material_model(m, "spec.material");
+  for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
+  const auto& o = spec.diagnose();
+  p.options.candidates.assign(o.candidates().begin(), o.candidates().end());
+  p.options.aspect_ratio_max = or_default(o.aspect_ratio_max(), 3.0);
+  p.options.rolling_max = or_default(o.rolling_max(), 0.3);
+  p.options.fixed_span = or_default(o.fixed_span(), 2.0);
+  p.options.margin = or_default(o.margin(), 0.3);
+  p.options.seed = seed ? seed : 1;
+  return p;
+}
+
+/// Finished diagnosis rows: a row counts once every test's job of it has ended; a failed job
+/// leaves its test's metrics missing (NaN).
+std::map<std::string, diagnose::GroupResults> finished_groups(const std::vector<JobRow>& jobs,
+                                                              const CampaignPlan& plan) {
+  std::map<std::pair<std::string, int>, std::vector<const JobRow*>> rows;
+  for (const auto& j : jobs)
+    if (j.kind.rfind(kPrefix, 0) == 0) rows[{j.kind.substr(9), j.std_order}].push_back(&j);
+  std::map<std::string, diagnose::GroupResults> out;
+  for (const auto& [key, row_jobs] : rows) {
+    bool ended = true;
+    for (const auto* j : row_jobs) ended &= j->state == "done" || j->state == "failed";
+    if (!ended) continue;
+    auto& values = out[key.first][key.second];
+    for (const auto& r : plan.responses) values[r] = diagnose::kPending;
+    for (const auto* j : row_jobs)
+      if (j->state == "done" && j->metrics_json)
+        for (const auto& [metric, value] : metrics_from_json(*j->metrics_json))
+          values[j->test + "." + metric] = value;
+  }
+  return out;
+}
+
+/// The campaign's material with a candidate's model switches applied. A rolling model switched
+/// on starts at mu_r = 0 so that a wall law copied from the particle law has none.
+v1::Material switched(const v1::Material& base, const std::map<std::string, std::string>& sw) {
+  v1::Material m = base;
+  for (const auto& [what, value] : sw) {
+    if (what == "shape") {
+      m.mutable_shape()->set_kind(value);
+    } else if (what == "particle_law.rolling") {
+      auto* slot = m.mutable_particle_law()->mutable_rolling();
+      slot->set_model(value);
+      (*slot->mutable_params())["mu_r"] = 0.0;
+    } else {
+      throw InputError("diagnose", "unknown model switch " + what);
+    }
+  }
+  return m;
+}
+
+nlohmann::json finite(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json report_json(const diagnose::Report& r) {
+  nlohmann::json j;
+  j["state"] = r.state;
+  j["named_cause"] = r.named_cause;
+  j["conclusion"] = r.conclusion;
+  for (const auto& m : r.metrics)
+    j["metrics"].push_back({{"response", m.response},
+                            {"target", m.target},
+                            {"holdout", m.holdout},
+                            {"envelope_min", m.envelope_min},
+                            {"envelope_max", m.envelope_max},
+                            {"reachable", m.reachable},
+                            {"statement", m.statement},
+                            {"curvature_p", finite(m.curvature_p)},
+                            {"predicted", m.predicted},
+                            {"simulated", finite(m.simulated)},
+                            {"relative_error", finite(m.relative_error)}});
+  j["baseline"] = {{"proposed", r.baseline_proposed},
+                   {"predicted_rms", finite(r.baseline_predicted_rms)},
+                   {"verified_rms", finite(r.baseline_verified_rms)},
+                   {"holdout_rms", finite(r.baseline_holdout_rms)}};
+  j["conflicts"] = nlohmann::json::array();
+  for (const auto& c : r.conflicts)
+    j["conflicts"].push_back({{"fitted", c.fitted},
+                              {"other", c.other},
+                              {"other_error_alone", c.other_error_alone},
+                              {"other_error_joint", c.other_error_joint},
+                              {"statement", c.statement}});
+  j["candidates"] = nlohmann::json::array();
+  for (const auto& c : r.candidates) {
+    nlohmann::json cj = {{"id", c.id},
+                         {"cause", c.cause},
+                         {"state", c.state},
+                         {"runs", c.runs},
+                         {"proposed", c.proposed},
+                         {"reaches_all", c.reaches_all},
+                         {"predicted_rms", finite(c.predicted_rms)},
+                         {"verified_rms", finite(c.verified_rms)},
+                         {"holdout_rms", finite(c.holdout_rms)},
+                         {"explains", c.explains},
+                         {"evidence", c.evidence}};
+    nlohmann::json sim = nlohmann::json::object();
+    for (const auto& [k, v] : c.simulated) sim[k] = finite(v);
+    cj["simulated"] = sim;
+    for (const auto& f : c.factors)
+      cj["factors"].push_back({{"path", f.path}, {"low", f.factor.low}, {"high", f.factor.high}});
+    j["candidates"].push_back(cj);
+  }
+  return j;
+}
+
+}  // namespace
+
+v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::uint64_t seed) {
+  v1::DiagnoseReply reply;
+  const CampaignPlan plan = plan_from_json(row.design_json);
+  v1::CampaignSpec spec;
+  from_json(row.spec_json, spec);
+  const auto jobs = store.jobs(row.id);
+  const auto design = store.counts(row.id, "design");
+  if (design.queued + design.leased > 0) {
+    reply.set_state("waiting");
+    reply.set_conclusion("the design runs are not finished (" + std::to_string(design.done) +
+                         " of " + std::to_string(design.total()) + " done)");
+    return reply;
+  }
+  const auto step =
+      diagnose::advance(make_problem(spec, plan, jobs, seed), finished_groups(jobs, plan));
+  std::set<std::pair<std::string, int>> stored;
+  for (const auto& j : jobs) stored.insert({j.kind, j.std_order});
+  std::vector<NewJob> fresh;
+  for (const auto& req : step.requests) {
+    const std::string kind = kPrefix + req.group;
+    if (stored.count({kind, req.row})) continue;
+    const auto add =
+        jobs_at(spec, switched(spec.material(), req.switches), req.parameters, req.row, kind);
+    fresh.insert(fresh.end(), add.begin(), add.end());
+  }
+  if (!fresh.empty()) {
+    store.add_jobs(row.id, fresh);
+    spdlog::info("campaign {}: diagnosis queued {} jobs", row.id, fresh.size());
+  }
+  reply.set_state(step.report.state);
+  reply.set_named_cause(step.report.named_cause);
+  reply.set_conclusion(step.report.conclusion);
+  reply.set_report_json(report_json(step.report).dump());
+  reply.set_jobs_queued(static_cast<int>(fresh.size()));
+  return reply;
+}
+
+}  // namespace demcal::server

@@ -1,0 +1,16 @@
+#pragma once
+// The coordinator's side of the diagnosis: the stored campaign as a diagnose::Problem, the
+// finished diagnosis jobs as its group results, the runs it asks for queued as jobs of kind
+// "diagnose:<group>" (row = std_order), and the report as JSON.
+#include <string>
+
+#include "demcal/v1/campaign.pb.h"
+#include "server/store.hpp"
+
+namespace demcal::server {
+
+/// Advances the diagnosis of a campaign: queues the runs it needs that are not stored yet and
+/// fills the reply. Throws InputError when the campaign cannot be diagnosed.
+v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::uint64_t seed);
+
+}  // namespace demcal::server
