@@ -8,9 +8,9 @@ struct Wrench {
 };
 
 /// Sum of the member forces and of their torques about the centre of mass.
-Wrench body_wrench(const particles::ParticleStore& p, std::size_t b) {
+Wrench body_wrench(const particles::ParticleStore& p, std::size_t b, const Vec3& gravity) {
   const auto& c = p.clumps;
-  Wrench w;
+  Wrench w{gravity * c.mass[b], {}};
   for (std::size_t k = c.first[b]; k < c.first[b] + c.count[b]; ++k) {
     w.force += p.f[k];
     w.torque += cross(c.q[b].rotate(p.body_offset[k]), p.f[k]) + p.torque[k];
@@ -42,14 +42,15 @@ Vec3 body_angular_velocity(const particles::Clumps& c, std::size_t b) {
   return angular_velocity(c.q[b], c.inertia[b], c.angular_momentum[b]);
 }
 
-void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, double dt, int threads) {
+void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, const Vec3& gravity,
+                      double dt, int threads) {
   auto& c = p.clumps;
   const int n = static_cast<int>(c.size());
   const double half = 0.5 * dt;
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (int b = 0; b < n; ++b) {
     if (c.parked[b]) continue;
-    const Wrench w = body_wrench(p, b);
+    const Wrench w = body_wrench(p, b, gravity);
     c.v[b] += w.force * (half / c.mass[b]);
     c.angular_momentum[b] += w.torque * half;
     c.x[b] += c.v[b] * dt;
@@ -63,13 +64,13 @@ void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, double 
   }
 }
 
-void clump_kick(particles::ParticleStore& p, double half_dt, int threads) {
+void clump_kick(particles::ParticleStore& p, const Vec3& gravity, double half_dt, int threads) {
   auto& c = p.clumps;
   const int n = static_cast<int>(c.size());
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (int b = 0; b < n; ++b) {
     if (c.parked[b]) continue;
-    const Wrench w = body_wrench(p, b);
+    const Wrench w = body_wrench(p, b, gravity);
     c.v[b] += w.force * (half_dt / c.mass[b]);
     c.angular_momentum[b] += w.torque * half_dt;
     c.omega[b] = angular_velocity(c.q[b], c.inertia[b], c.angular_momentum[b]);

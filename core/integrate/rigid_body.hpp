@@ -8,8 +8,10 @@
 // (a second-order orientation update for the free rotation of an asymmetric body, in the
 // manner of the NO_SQUISH / Richardson schemes of LAMMPS rigid and LIGGGHTS multisphere).
 // Forces and torques of a body are the sums over its member spheres, torques taken about the
-// centre of mass with the member's lever arm R b_k. Members carry no contact with each other
-// (the neighbour list skips pairs of one body).
+// centre of mass with the member's lever arm R b_k, plus its weight M g at the centre of mass
+// (members carry no gravity: their mass shares are by own volume, whose centre is not the
+// union's centroid for an asymmetric clump, so weights on members would turn it). Members carry no
+// contact with each other (the neighbour list skips pairs of one body).
 #include "core/common/domain.hpp"
 #include "core/particles/particle_store.hpp"
 
@@ -17,9 +19,10 @@ namespace demcal::integrate {
 
 /// First half of a step for the clumps: kick with the members' last forces, drift, turn, and
 /// place the members (positions wrapped into periodic boxes, velocities v + omega x R b).
-void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, double dt, int threads);
+void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, const Vec3& gravity,
+                      double dt, int threads);
 /// Second half: kick with the members' new forces and update the members' velocities.
-void clump_kick(particles::ParticleStore& p, double half_dt, int threads);
+void clump_kick(particles::ParticleStore& p, const Vec3& gravity, double half_dt, int threads);
 /// The angular velocity of body b from its angular momentum and orientation.
 Vec3 body_angular_velocity(const particles::Clumps& c, std::size_t b);
 

@@ -55,6 +55,22 @@ particles::InsertRequest material_insert_request(const MaterialModel& material,
   return req;
 }
 
+void fill_region(sim::World& w, particles::InsertRequest req, Rng& rng, double safety, double pause,
+                 int rounds) {
+  const std::size_t goal = w.particles.units() + req.count;
+  for (int round = 1;; ++round) {
+    req.count = goal - w.particles.units();
+    try {
+      particles::insert_random(w.particles, req, rng);
+    } catch (const InputError&) {
+      if (round == rounds) throw;
+    }
+    w.dt = sim::recommended_time_step(w, safety);
+    if (w.particles.units() == goal) return;
+    sim::run(w, std::max<long>(1, std::lround(pause / w.dt)));
+  }
+}
+
 sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
                           const RunOptions& options) {
   sim::World w = make_material_world(material, options);
@@ -79,8 +95,7 @@ sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
   w.walls.push_back(
       walls::make_wall("die", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius}, kWallDie));
   req.region = particles::CylinderRegion{{0, 0, 0}, radius, 0.0, height};
-  particles::insert_random(w.particles, req, rng);
-  w.dt = sim::recommended_time_step(w, spec.time_step_safety);
+  fill_region(w, req, rng, spec.time_step_safety);
   return w;
 }
 

@@ -41,6 +41,13 @@ particles::InsertRequest material_insert_request(const MaterialModel& material,
                                                  const particles::Region& region,
                                                  std::size_t count);
 
+/// Inserts the request's particles into the world as a filling would: what fits at random
+/// without overlap, then a pause of `pause` simulated seconds in which it falls, then the rest,
+/// for at most `rounds` rounds (a dense fill, or clumps that take more room than spheres).
+/// Sets the world's time step to `time_step_safety` times the critical one.
+void fill_region(sim::World& world, particles::InsertRequest request, Rng& rng,
+                 double time_step_safety, double pause = 0.1, int rounds = 8);
+
 /// Expected solid volume of `count` particles of the distribution (mean of 2,000 seeded samples),
 /// for sizing a die, drum or hopper to its bed.
 double expected_solid_volume(const particles::SizeDistribution& sizes, double count,

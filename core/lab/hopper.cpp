@@ -63,8 +63,7 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
       material, particles::BoxRegion{{-0.5 * top, 0.0, h}, {0.5 * top, depth, h + bin}},
       static_cast<std::size_t>(s.particles));
   // Spheres stay inside the region, so none overlaps a periodic image across y = 0 / depth.
-  particles::insert_random(w.particles, req, rng);
-  w.dt = sim::recommended_time_step(w, s.time_step_safety);
+  fill_region(w, req, rng, s.time_step_safety);
 
   sim::HealthLimits limits;
   limits.lo = {-top - bin, -1e3, -(h + bin) * 4.0 - 1.0};

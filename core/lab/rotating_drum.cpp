@@ -133,8 +133,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   particles::InsertRequest req =
       material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth},
                               static_cast<std::size_t>(s.particles));
-  particles::insert_random(w.particles, req, rng);
-  w.dt = sim::recommended_time_step(w, s.time_step_safety);
+  fill_region(w, req, rng, s.time_step_safety);
 
   sim::HealthLimits limits;
   limits.lo = {-1.5 * radius, -1.5 * radius, -radius};

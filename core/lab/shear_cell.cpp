@@ -95,8 +95,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   particles::InsertRequest req =
       material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, fill_h},
                               static_cast<std::size_t>(s.particles));
-  particles::insert_random(w.particles, req, rng);
-  w.dt = sim::recommended_time_step(w, s.time_step_safety);
+  fill_region(w, req, rng, s.time_step_safety);
   sim::HealthLimits limits = die_limits(w, radius, fill_h + h_v);
   limits.lo.z = -fill_h;
 

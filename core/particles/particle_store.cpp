@@ -163,6 +163,12 @@ double ParticleStore::solid_volume(std::size_t i) const {
   return body[i] < 0 ? own : own * clumps.volume_weight[body[i]];
 }
 
+std::size_t ParticleStore::units() const {
+  std::size_t lone = 0;
+  for (auto b : body) lone += b < 0 ? 1 : 0;
+  return lone + clumps.size();
+}
+
 double ParticleStore::total_mass() const {
   double m = 0.0;
   for (double mi : mass) m += mi;

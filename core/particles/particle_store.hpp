@@ -19,7 +19,8 @@ enum class Motion : std::uint8_t { kFree = 0, kKinematic = 1, kClumpMember = 2 }
 /// spheres in the store; the members carry the contacts, the body carries the motion: its forces
 /// and torques are the sums over its members, it is integrated as one rigid body (see
 /// integrate/rigid_body.hpp), and the members are placed from it. A member's mass is its share
-/// of the body's mass by own volume, so gravity and mass sums need no special case.
+/// of the body's mass by own volume (mass sums need no special case); the body's weight acts
+/// at its centre of mass, not through the members.
 struct Clumps {
   std::vector<std::size_t> first;      ///< first member's index in the store
   std::vector<std::uint32_t> count;    ///< members
@@ -54,6 +55,8 @@ class ParticleStore {
   Clumps clumps;
 
   std::size_t size() const { return x.size(); }
+  /// Particles as the user counts them: lone spheres plus clumps.
+  std::size_t units() const;
 
   /// Adds a solid sphere of the given radius and density; returns its index.
   std::size_t add_sphere(const Vec3& position, double radius, double density,

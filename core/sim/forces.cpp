@@ -59,7 +59,8 @@ void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
     auto& deferred = w.deferred[tid];
     deferred.clear();
     for (int i = lo; i < hi; ++i) {
-      p.f[i] = w.gravity * p.mass[i];
+      // A clump's weight acts at its centre of mass (rigid_body.hpp), not through its members.
+      p.f[i] = p.motion[i] == particles::Motion::kClumpMember ? Vec3{} : w.gravity * p.mass[i];
       p.torque[i] = {};
     }
     for (int i = lo; i < hi; ++i) {

@@ -18,7 +18,7 @@ void step(World& w) {
   // 1. First half kick with the forces of the last step, then drift (velocity Verlet); rigid
   //    clumps kick, drift and turn as bodies and place their member spheres.
   integrate::kick_drift(w.particles, w.dt, w.threads);
-  integrate::clump_kick_drift(w.particles, w.domain, w.dt, w.threads);
+  integrate::clump_kick_drift(w.particles, w.domain, w.gravity, w.dt, w.threads);
 
   // 2. Walls move with their prescribed or controlled velocities.
   for (auto& wall : w.walls) walls::advance(wall, w.dt);
@@ -39,7 +39,7 @@ void step(World& w) {
 
   // 5. Second half kick with the new forces (clumps: with the sums over their members).
   integrate::kick(w.particles, half, w.threads);
-  integrate::clump_kick(w.particles, half, w.threads);
+  integrate::clump_kick(w.particles, w.gravity, half, w.threads);
 
   w.time += w.dt;
   ++w.step_count;

@@ -224,7 +224,7 @@ TEST(SimClumps, FreeFallFollowsHalfGTSquared) {
 // summed member weights then exert a torque M g x R d about the centre of mass, and a clump
 // falling freely from rest starts to turn. Fixing it needs the body kick to take gravity at the
 // centre of mass (or member masses whose centre is the centroid).
-TEST(SimClumps, DISABLED_AsymmetricClumpInFreeFallDoesNotTurn) {
+TEST(SimClumps, AsymmetricClumpInFreeFallDoesNotTurn) {
   sim::World w = empty_world({0, 0, -kG});
   const auto cluster = shape("cluster", {{"spheres", 5.0}, {"irregularity", 0.6}, {"seed", 1.0}});
   const Quat q0 = rotation_quat({0.3, -0.6, 0.8});
