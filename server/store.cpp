@@ -44,6 +44,32 @@ const std::vector<const char*>& migrations() {
         wall_seconds REAL NOT NULL,
         stored REAL NOT NULL);
       )sql",
+      // 2: jobs of the diagnosis (kind 'diagnose:<group>'). SQLite cannot change a CHECK in
+      // place: the table is rebuilt (https://www.sqlite.org/lang_altertable.html, the 12 steps;
+      // foreign keys are off while migrating).
+      R"sql(
+      CREATE TABLE jobs_v2 (
+        id INTEGER PRIMARY KEY AUTOINCREMENT,
+        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
+        std_order INTEGER NOT NULL,
+        run_order INTEGER NOT NULL,
+        test TEXT NOT NULL,
+        kind TEXT NOT NULL CHECK (kind IN ('design', 'verify') OR kind LIKE 'diagnose:%'),
+        payload TEXT NOT NULL,
+        state TEXT NOT NULL
+          CHECK (state IN ('queued', 'leased', 'done', 'failed', 'cancelled')),
+        attempt INTEGER NOT NULL DEFAULT 0,
+        counted INTEGER NOT NULL DEFAULT 0,
+        lease_deadline REAL NOT NULL DEFAULT 0,
+        worker TEXT NOT NULL DEFAULT '',
+        error TEXT NOT NULL DEFAULT '',
+        finished REAL NOT NULL DEFAULT 0);
+      INSERT INTO jobs_v2 SELECT * FROM jobs;
+      DROP TABLE jobs;
+      ALTER TABLE jobs_v2 RENAME TO jobs;
+      CREATE INDEX jobs_queue ON jobs (state, campaign_id, kind, run_order);
+      CREATE INDEX jobs_campaign ON jobs (campaign_id);
+      )sql",
   };
   return m;
 }
@@ -119,8 +145,9 @@ Store::Store(const std::string& path, StoreLimits limits) : limits_(limits) {
   sqlite3_busy_timeout(db_, 10000);
   exec("PRAGMA journal_mode=WAL");
   exec("PRAGMA synchronous=FULL");
-  exec("PRAGMA foreign_keys=ON");
+  // Foreign keys are enforced from here on; migrations that rebuild a table run before.
   migrate();
+  exec("PRAGMA foreign_keys=ON");
 }
 
 Store::~Store() {
@@ -156,9 +183,8 @@ std::string Store::journal_mode() {
 
 void Store::migrate() {
   Transaction tx(*this);
-  Statement v(db_, "PRAGMA user_version");
-  v.step();
-  const int version = v.i32(0);
+  // Read through schema_version(): its statement is finalised before a migration drops a table.
+  const int version = schema_version();
   if (version > latest_schema_version())
     throw std::runtime_error("database schema version " + std::to_string(version) +
                              " is newer than this coordinator's " +
@@ -167,6 +193,8 @@ void Store::migrate() {
     exec(migrations()[std::size_t(i)]);
     exec(("PRAGMA user_version=" + std::to_string(i + 1)).c_str());
   }
+  Statement fk(db_, "PRAGMA foreign_key_check");
+  if (fk.step()) throw std::runtime_error("schema migration broke a foreign key");
   tx.commit();
 }
 
