@@ -184,8 +184,13 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const Calibration
     }
     return j / total_weight;
   };
+  // Ridge toward the centre (reported objective without it): of the many sets that fit equally
+  // well when there are more factors than metrics, the one nearest the design centre.
+  const Objective regularised = [&](const Eigen::VectorXd& x) {
+    return objective(x) + options.centre_weight * x.squaredNorm() / k;
+  };
   CalibrationResult out;
-  out.coded = minimise(objective, k, options);
+  out.coded = minimise(options.centre_weight > 0.0 ? regularised : objective, k, options);
   out.objective = objective(out.coded);
   out.natural.resize(k);
   for (int i = 0; i < k; ++i)

@@ -15,6 +15,8 @@ const char* to_string(ModelKind kind) {
       return "2fi";
     case ModelKind::kQuadratic:
       return "quadratic";
+    case ModelKind::kSquares:
+      return "squares";
   }
   return "unknown";
 }
@@ -23,7 +25,8 @@ ModelKind parse_model_kind(const std::string& text, const std::string& where) {
   if (text == "main") return ModelKind::kMain;
   if (text == "2fi") return ModelKind::kTwoFactor;
   if (text == "quadratic") return ModelKind::kQuadratic;
-  throw InputError(where, "unknown model '" + text + "' (main, 2fi or quadratic)");
+  if (text == "squares") return ModelKind::kSquares;
+  throw InputError(where, "unknown model '" + text + "' (main, 2fi, quadratic or squares)");
 }
 
 std::string ModelTerm::name() const {
@@ -54,12 +57,12 @@ struct Candidate {
 std::vector<Candidate> candidates(int k, ModelKind kind) {
   std::vector<Candidate> out;
   for (int i = 0; i < k; ++i) out.push_back({Word{1} << i, false});
-  if (kind != ModelKind::kMain) {
+  if (kind == ModelKind::kTwoFactor || kind == ModelKind::kQuadratic) {
     for (int i = 0; i < k; ++i) {
       for (int j = i + 1; j < k; ++j) out.push_back({(Word{1} << i) | (Word{1} << j), false});
     }
   }
-  if (kind == ModelKind::kQuadratic) {
+  if (kind == ModelKind::kQuadratic || kind == ModelKind::kSquares) {
     for (int i = 0; i < k; ++i) out.push_back({Word{1} << i, true});
   }
   return out;
@@ -174,7 +177,7 @@ ModelFit fit_model(const Eigen::MatrixXd& coded, const Eigen::VectorXd& response
   for (const Candidate& c : candidates(fit.factor_count, kind)) consider(c);
   if (options.saturate) {
     const int target = distinct_rows(x);
-    if (kind == ModelKind::kMain) {
+    if (kind == ModelKind::kMain || kind == ModelKind::kSquares) {
       for (int i = 0; i < fit.factor_count; ++i) {
         for (int j = i + 1; j < fit.factor_count; ++j) {
           if (basis.cols() < target) consider({(Word{1} << i) | (Word{1} << j), false});

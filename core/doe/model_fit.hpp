@@ -13,9 +13,10 @@
 
 namespace demcal::doe {
 
-enum class ModelKind { kMain, kTwoFactor, kQuadratic };
+/// kSquares: main effects and pure squares without interactions (additive curvature).
+enum class ModelKind { kMain, kTwoFactor, kQuadratic, kSquares };
 const char* to_string(ModelKind kind);
-/// "main", "2fi" or "quadratic"; throws InputError naming `where` otherwise.
+/// "main", "2fi", "quadratic" or "squares"; throws InputError naming `where` otherwise.
 ModelKind parse_model_kind(const std::string& text, const std::string& where);
 
 /// One estimable column and every effect aliased with it (first member = the column used).
