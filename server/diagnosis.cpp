@@ -131,6 +131,8 @@ nlohmann::json report_json(const diagnose::Report& r) {
                          {"reaches_all", c.reaches_all},
                          {"predicted_rms", finite(c.predicted_rms)},
                          {"verified_rms", finite(c.verified_rms)},
+                         {"rounds", c.rounds},
+                         {"design_misprediction", finite(c.design_misprediction)},
                          {"holdout_rms", finite(c.holdout_rms)},
                          {"explains", c.explains},
                          {"evidence", c.evidence}};

@@ -123,9 +123,11 @@ std::vector<Plan> candidate_plans(const Problem& p) {
   const auto alias = doe::analyse_aliasing(factorial_rows(p.design));
   if (alias.resolution && *alias.resolution <= 4) {
     // Interactions aliased with main effects or with each other: the full fold-over separates
-    // every main effect from the 2FIs (Montgomery §8.6).
+    // every main effect from the 2FIs (Montgomery §8.6). Its model has the 2FIs and the one
+    // curvature term the centre runs support (the squares form one chain on a two-level design).
     Plan plan{
         "interaction", "a two-factor interaction aliased in the design (fold-over)", {}, p.factors};
+    plan.model = doe::ModelKind::kQuadratic;
     plan.new_rows = -factorial_rows(p.design);
     plans.push_back(std::move(plan));
   }
@@ -185,12 +187,9 @@ struct Fitted {
   bool reaches_all = true;
 };
 
-Fitted fit_and_calibrate(const Problem& p, const std::vector<Factor>& factors,
-                         const Eigen::MatrixXd& coded, const Eigen::MatrixXd& results,
-                         doe::ModelKind kind) {
-  Fitted out;
-  calib::CalibrationProblem problem;
-  for (const auto& f : factors) problem.factors.push_back(f.factor);
+std::vector<calib::MetricTarget> fit_targets(const Problem& p, const Eigen::MatrixXd& coded,
+                                             const Eigen::MatrixXd& results, doe::ModelKind kind) {
+  std::vector<calib::MetricTarget> out;
   for (const auto& m : p.measurements) {
     calib::MetricTarget t;
     t.name = m.response;
@@ -198,9 +197,53 @@ Fitted fit_and_calibrate(const Problem& p, const std::vector<Factor>& factors,
     t.target = m.value;
     t.weight = m.weight;
     t.uncertainty = m.uncertainty;
-    out.all.push_back(t);
-    if (!m.holdout) problem.metrics.push_back(std::move(t));
+    out.push_back(std::move(t));
   }
+  return out;
+}
+
+/// The regressor of a term as ModelFit::predict uses it (a chain's members share equally).
+double term_value(const doe::ModelFit& fit, std::size_t t, const Eigen::VectorXd& x) {
+  const auto& term = fit.terms[t];
+  double sum = 0.0;
+  for (const auto& m : term.chain) {
+    double v = m.sign;
+    for (int i = 0; i < fit.factor_count; ++i)
+      if (m.word & (doe::Word{1} << i)) v *= term.squared ? x(i) * x(i) : x(i);
+    sum += v;
+  }
+  return sum / static_cast<double>(term.chain.size());
+}
+
+/// The same terms refitted by least squares on more rows (the design's and verification runs):
+/// the alias structure stays the design's, the coefficients learn from every run.
+void refit(doe::ModelFit& fit, const Eigen::MatrixXd& coded, const Eigen::VectorXd& y) {
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index r = 0; r < y.size(); ++r)
+    if (std::isfinite(y(r))) rows.push_back(r);
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  const auto terms = static_cast<Eigen::Index>(fit.terms.size());
+  Eigen::MatrixXd x(n, terms + 1);
+  Eigen::VectorXd b(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    x(i, 0) = 1.0;
+    for (Eigen::Index t = 0; t < terms; ++t)
+      x(i, t + 1) = term_value(fit, std::size_t(t), coded.row(rows[std::size_t(i)]).transpose());
+    b(i) = y(rows[std::size_t(i)]);
+  }
+  const Eigen::VectorXd beta = x.completeOrthogonalDecomposition().solve(b);
+  fit.intercept = beta(0);
+  fit.coefficients = beta.tail(terms);
+}
+
+Fitted calibrate_targets(const Problem& p, const std::vector<Factor>& factors,
+                         std::vector<calib::MetricTarget> all) {
+  Fitted out;
+  out.all = std::move(all);
+  calib::CalibrationProblem problem;
+  for (const auto& f : factors) problem.factors.push_back(f.factor);
+  for (std::size_t i = 0; i < p.measurements.size(); ++i)
+    if (!p.measurements[i].holdout) problem.metrics.push_back(out.all[i]);
   calib::CalibrationOptions o;
   o.starts = p.options.starts;
   o.seed = p.options.seed;
@@ -208,6 +251,26 @@ Fitted fit_and_calibrate(const Problem& p, const std::vector<Factor>& factors,
   out.result = calib::calibrate(problem, o);
   for (const auto& m : out.result.metrics) out.reaches_all &= m.reachable;
   return out;
+}
+
+/// Relative RMS misprediction of `models` on `rows` (calibrated metrics): how far the runs of
+/// an augmented design lie from what the base model expected there.
+double misprediction(const Problem& p, const std::vector<calib::MetricTarget>& models,
+                     const Eigen::MatrixXd& rows, const Eigen::MatrixXd& y) {
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < p.measurements.size(); ++i) {
+    if (p.measurements[i].holdout) continue;
+    const Eigen::Index col = response_column(p, p.measurements[i].response);
+    for (Eigen::Index r = 0; r < rows.rows(); ++r) {
+      if (!std::isfinite(y(r, col))) continue;
+      const Eigen::VectorXd x = rows.row(r).head(models[i].model.factor_count).transpose();
+      const double e = (models[i].model.predict(x) - y(r, col)) / std::abs(models[i].target);
+      sum += e * e;
+      ++n;
+    }
+  }
+  return n ? std::sqrt(sum / n) : kPending;
 }
 
 /// Rows of a group's results as a matrix in response order (NaN where missing).
@@ -293,8 +356,8 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
   const int k = static_cast<int>(p.design.cols());
 
   // 1. Baseline: envelopes, calibration, conflicts, curvature (no new simulation).
-  const Fitted base =
-      fit_and_calibrate(p, p.factors, p.design, p.results, doe::ModelKind::kTwoFactor);
+  const Fitted base = calibrate_targets(
+      p, p.factors, fit_targets(p, p.design, p.results, doe::ModelKind::kTwoFactor));
   rep.baseline_proposed = natural_point(p.factors, base.result.natural);
   rep.baseline_predicted_rms = std::sqrt(base.result.objective);
   calib::CalibrationOptions eo;
@@ -366,21 +429,38 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
     Eigen::MatrixXd y(n0 + n1, p.results.cols());
     y.topRows(n0) = p.results;
     y.bottomRows(n1) = group_matrix(p, *g, n1);
+    c.design_misprediction = misprediction(p, base.all, plan.new_rows, y.bottomRows(n1));
     try {
-      const Fitted fit = fit_and_calibrate(p, plan.factors, coded, y, plan.model);
-      c.state = "designed";
-      c.proposed = natural_point(plan.factors, fit.result.natural);
-      c.predicted_rms = std::sqrt(fit.result.objective);
-      c.reaches_all = fit.reaches_all;
-      step.requests.push_back({plan.id + "/verify", 1, plan.switches, c.proposed});
-      c.simulated = verified(groups, plan.id + "/verify");
-      if (!c.simulated.empty()) {
+      // Calibrate, verify, add the verified run to the data, refit, and again: at most
+      // `rounds` rounds, fewer once a verified error is below `converged`.
+      auto models = fit_targets(p, coded, y, plan.model);
+      for (int round = 1; round <= p.options.rounds; ++round) {
+        const Fitted fit = calibrate_targets(p, plan.factors, models);
+        c.proposed = natural_point(plan.factors, fit.result.natural);
+        c.predicted_rms = std::sqrt(fit.result.objective);
+        c.reaches_all = fit.reaches_all;
+        c.state = "designed";
+        step.requests.push_back({plan.id + "/verify", round, plan.switches, c.proposed});
+        const auto* v = find_group(groups, plan.id + "/verify");
+        if (!v || !v->count(round)) {
+          all_verified = false;
+          break;
+        }
+        c.simulated = v->at(round);
+        c.rounds = round;
         c.state = "verified";
         c.verified_rms = rms_error(p.measurements, c.simulated, false);
         c.holdout_rms = rms_error(p.measurements, c.simulated, true);
-        if (!std::isfinite(c.verified_rms)) c.state = "failed";
-      } else {
-        all_verified = false;
+        if (!std::isfinite(c.verified_rms)) {
+          c.state = "failed";
+          break;
+        }
+        if (c.verified_rms <= p.options.converged || round == p.options.rounds) break;
+        coded.conservativeResize(coded.rows() + 1, Eigen::NoChange);
+        coded.bottomRows(1) = fit.result.coded.transpose();
+        y.conservativeResize(y.rows() + 1, Eigen::NoChange);
+        y.bottomRows(1) = group_matrix(p, {{1, c.simulated}}, 1);
+        for (auto& m : models) refit(m.model, coded, y.col(response_column(p, m.name)));
       }
     } catch (const InputError& e) {
       c.state = "failed";
@@ -402,7 +482,9 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
     c.explains = std::isfinite(base_rms) && c.verified_rms < (1.0 - p.options.margin) * base_rms;
     std::ostringstream e;
     e << "verified RMS error " << percent(c.verified_rms) << " against " << percent(base_rms)
-      << " for the baseline (predicted " << percent(c.predicted_rms) << ")";
+      << " for the baseline (predicted " << percent(c.predicted_rms) << ", " << c.rounds
+      << " verification round" << (c.rounds == 1 ? "" : "s") << "); the base model mispredicted "
+      << "its runs by " << percent(c.design_misprediction);
     if (std::isfinite(c.holdout_rms))
       e << "; held-out " << percent(c.holdout_rms) << " against "
         << percent(rep.baseline_holdout_rms);
@@ -422,12 +504,12 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
   const auto remedy = [](const CandidateOutcome& c) {
     return c.id == "interaction" || c.id == "curvature";
   };
+  // Among the remedies, the one whose runs the base model mispredicted most found the flaw.
   const CandidateOutcome* named = nullptr;
   for (const auto& c : rep.candidates)
-    if (c.explains && remedy(c) == reachable) {
+    if (c.explains && remedy(c) == reachable &&
+        (!named || (reachable && c.design_misprediction > named->design_misprediction)))
       named = &c;
-      break;
-    }
   for (const auto& c : rep.candidates)
     if (!named && c.explains) named = &c;
   if (!all_verified) {

@@ -14,7 +14,8 @@
 //       fixed:<p>    a parameter held fixed, varied over [v / span, v * span];
 //       curvature    non-linearity: axial runs, main effects and squares;
 //       interaction  a two-factor interaction aliased in the design: the fold-over;
-//     each extended model is fitted, calibrated and its proposed set verified by simulation;
+//     each extended model is fitted, calibrated and its proposed set verified by simulation,
+//     the verified run joining its data for up to `rounds` rounds;
 //   - the named cause (the candidate whose verified error is lowest, if it cuts the baseline's
 //     verified error by the stated margin) and the gain, on the calibrated metrics and on
 //     metrics held out of the calibration.
@@ -59,6 +60,11 @@ struct Options {
   /// moves a fit by less than a 1 % error allows and settles the valleys of fits with more
   /// factors than metrics where the fitted models are best supported.
   double centre_weight = 1e-4;
+  /// A candidate's calibration is verified, the verified run joins its data, the models are
+  /// refitted and it is calibrated again: at most `rounds` times, fewer once the verified RMS
+  /// error is at most `converged`.
+  int rounds = 3;
+  double converged = 0.01;
 };
 
 /// The campaign as the diagnosis sees it.
@@ -115,7 +121,12 @@ struct CandidateOutcome {
   std::vector<Factor> factors;             ///< the extended factor box
   std::map<std::string, double> proposed;  ///< its calibrated set (natural)
   bool reaches_all = false;                ///< every calibrated target inside its envelopes
-  double predicted_rms = kPending, verified_rms = kPending;
+  double predicted_rms = kPending, verified_rms = kPending;  ///< of the last round
+  int rounds = 0;                                            ///< verification rounds done
+  /// Relative RMS misprediction of its augmented runs by the base model: what the base design
+  /// did not see (ranks the remedies: an aliased interaction shows in the fold-over runs,
+  /// curvature in the axial runs).
+  double design_misprediction = kPending;
   std::map<std::string, double> simulated;  ///< verified metrics
   double holdout_rms = kPending;
   bool explains = false;

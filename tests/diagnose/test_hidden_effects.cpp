@@ -1,7 +1,7 @@
 // Hidden-effect system tests of the diagnosis (docs/diagnosis.md). A Hertz sphere model is
 // calibrated against packing solid fraction and coordination number with a 2^(3-1) design
-// (C = AB) plus a centre run. A hidden truth, drawn at random from the test seed, produces the
-// "measured" data by simulation:
+// (C = AB) plus a centre run; friction is a factor on a log scale (its effects saturate). A hidden
+// truth, drawn at random from the test seed, produces the "measured" data by simulation:
 //   shape        rigid rods of a random aspect ratio in [1.8, 2.8];
 //   rolling      spheres with CDT rolling resistance mu_r in [0.15, 0.3], outside the factor set;
 //   interaction  spheres inside the factor box, at a corner of (mu_s, A_H) where their
@@ -51,10 +51,12 @@ double in_box(Rng& rng, double lo, double hi) {
   return rng.uniform(lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo));
 }
 
-/// A coded value of magnitude 0.6..1 with a random sign, in natural units of [lo, hi].
-double at_corner(Rng& rng, double lo, double hi) {
+/// A coded value of magnitude 0.6..1 with a random sign, in natural units of [lo, hi] on a
+/// linear or a log scale.
+double at_corner(Rng& rng, double lo, double hi, bool log_scale) {
   const double c = (rng.uniform() < 0.5 ? -1.0 : 1.0) * rng.uniform(0.6, 1.0);
-  return 0.5 * (lo + hi) + 0.5 * c * (hi - lo);
+  return log_scale ? lo * std::pow(hi / lo, 0.5 * (c + 1.0))
+                   : 0.5 * (lo + hi) + 0.5 * c * (hi - lo);
 }
 
 Truth draw_truth(std::uint64_t seed) {
@@ -73,8 +75,8 @@ Truth draw_truth(std::uint64_t seed) {
     t.mu_r = rng.uniform(0.15, 0.3);
   } else {
     t.cause = "interaction";
-    t.mu_s = at_corner(rng, 0.1, 0.6);
-    t.hamaker = at_corner(rng, 0.0, kHamakerMax);
+    t.mu_s = at_corner(rng, 0.1, 0.6, true);
+    t.hamaker = at_corner(rng, 0.0, kHamakerMax, false);
   }
   return t;
 }
@@ -128,7 +130,7 @@ std::string campaign_yaml(const Truth& t, const std::map<std::string, double>& m
   y << "tests:\n  - test: packing\n    settings: {particles: " << kParticles
     << "}\n    seed: 3\n    threads: 1\n";
   y << "factors:\n"
-    << "  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.6}\n"
+    << "  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.6, scale: log}\n"
     << (cohesion ? "  - {path: particle_law.cohesion.hamaker, low: 0.0, high: " + num(kHamakerMax) +
                        "}\n"
                  : std::string("  - {path: wall_law.tangential.mu_s, low: 0.1, high: 0.6}\n"))
@@ -163,8 +165,8 @@ TEST(HiddenEffects, DiagnosisNamesTheHiddenCause) {
   std::ofstream(dir / "campaign.yaml") << campaign_yaml(truth, measured);
   const auto report = diagnose(dir / "campaign.yaml", dir / "work");
   std::cout << "seed " << g_seed << ": hidden " << truth.cause << " (mu_s " << truth.mu_s
-            << ", restitution " << truth.restitution << ", mu_r " << truth.mu_r << ", aspect ratio "
-            << truth.aspect_ratio << ")\n"
+            << ", A_H " << truth.hamaker << ", restitution " << truth.restitution << ", mu_r "
+            << truth.mu_r << ", aspect ratio " << truth.aspect_ratio << ")\n"
             << report.dump(2) << "\n";
 
   ASSERT_EQ(report["state"], "done");
