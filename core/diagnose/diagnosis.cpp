@@ -75,6 +75,13 @@ Plan new_factor_plan(const Problem& p, std::string id, std::string cause,
   if (plan.base_coded > -1.0 + 1e-9) levels.push_back(-1.0);
   if (plan.base_coded < 1.0 - 1e-9) levels.push_back(1.0);
   plan.new_rows = crossed(p.design, levels);
+  // A run at the middle of the new factor (the design centre otherwise) lets the model bend
+  // along it: a new physical parameter seldom acts linearly over its whole range.
+  if (std::abs(plan.base_coded) > 1e-9) {
+    plan.new_rows.conservativeResize(plan.new_rows.rows() + 1, Eigen::NoChange);
+    plan.new_rows.bottomRows(1).setZero();
+  }
+  plan.model = doe::ModelKind::kQuadratic;
   return plan;
 }
 
@@ -215,9 +222,13 @@ double term_value(const doe::ModelFit& fit, std::size_t t, const Eigen::VectorXd
   return sum / static_cast<double>(term.chain.size());
 }
 
-/// The same terms refitted by least squares on more rows (the design's and verification runs):
-/// the alias structure stays the design's, the coefficients learn from every run.
-void refit(doe::ModelFit& fit, const Eigen::MatrixXd& coded, const Eigen::VectorXd& y) {
+/// The same terms refitted by weighted least squares on more rows (the design's, then the
+/// verification runs from row `first_verified` on, weighted kVerifiedWeight): the alias
+/// structure stays the design's; the verified runs, near the optimum, pull the fit to be right
+/// where it is used (a trust-region flavour of surrogate correction).
+constexpr double kVerifiedWeight = 10.0;
+void refit(doe::ModelFit& fit, const Eigen::MatrixXd& coded, const Eigen::VectorXd& y,
+           Eigen::Index first_verified) {
   std::vector<Eigen::Index> rows;
   for (Eigen::Index r = 0; r < y.size(); ++r)
     if (std::isfinite(y(r))) rows.push_back(r);
@@ -230,6 +241,10 @@ void refit(doe::ModelFit& fit, const Eigen::MatrixXd& coded, const Eigen::Vector
     for (Eigen::Index t = 0; t < terms; ++t)
       x(i, t + 1) = term_value(fit, std::size_t(t), coded.row(rows[std::size_t(i)]).transpose());
     b(i) = y(rows[std::size_t(i)]);
+    if (rows[std::size_t(i)] >= first_verified) {
+      x.row(i) *= std::sqrt(kVerifiedWeight);
+      b(i) *= std::sqrt(kVerifiedWeight);
+    }
   }
   const Eigen::VectorXd beta = x.completeOrthogonalDecomposition().solve(b);
   fit.intercept = beta(0);
@@ -460,7 +475,7 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
         coded.bottomRows(1) = fit.result.coded.transpose();
         y.conservativeResize(y.rows() + 1, Eigen::NoChange);
         y.bottomRows(1) = group_matrix(p, {{1, c.simulated}}, 1);
-        for (auto& m : models) refit(m.model, coded, y.col(response_column(p, m.name)));
+        for (auto& m : models) refit(m.model, coded, y.col(response_column(p, m.name)), n0 + n1);
       }
     } catch (const InputError& e) {
       c.state = "failed";
