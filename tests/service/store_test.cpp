@@ -3,6 +3,8 @@
 #include "server/store.hpp"
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
+#include <unistd.h>
 
 #include <filesystem>
 
@@ -131,6 +133,123 @@ TEST(Store, VerificationJobsReopenADoneCampaign) {
   ASSERT_EQ(ids.size(), 1u);
   EXPECT_EQ(s.campaign(id)->state, "running");
   EXPECT_EQ(s.counts(id, "verify").queued, 1);
+}
+
+// Migration 1's SQL as released (server/store.cpp): the schema of a version-1 database.
+constexpr const char* kSchemaV1 = R"sql(
+      CREATE TABLE campaigns (
+        id INTEGER PRIMARY KEY AUTOINCREMENT,
+        name TEXT NOT NULL,
+        state TEXT NOT NULL CHECK (state IN ('running', 'done', 'cancelled')),
+        spec_json TEXT NOT NULL,
+        design_json TEXT NOT NULL,
+        created REAL NOT NULL,
+        finished REAL NOT NULL DEFAULT 0);
+      CREATE TABLE jobs (
+        id INTEGER PRIMARY KEY AUTOINCREMENT,
+        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
+        std_order INTEGER NOT NULL,
+        run_order INTEGER NOT NULL,
+        test TEXT NOT NULL,
+        kind TEXT NOT NULL CHECK (kind IN ('design', 'verify')),
+        payload TEXT NOT NULL,
+        state TEXT NOT NULL
+          CHECK (state IN ('queued', 'leased', 'done', 'failed', 'cancelled')),
+        attempt INTEGER NOT NULL DEFAULT 0,
+        counted INTEGER NOT NULL DEFAULT 0,
+        lease_deadline REAL NOT NULL DEFAULT 0,
+        worker TEXT NOT NULL DEFAULT '',
+        error TEXT NOT NULL DEFAULT '',
+        finished REAL NOT NULL DEFAULT 0);
+      CREATE INDEX jobs_queue ON jobs (state, campaign_id, kind, run_order);
+      CREATE INDEX jobs_campaign ON jobs (campaign_id);
+      CREATE TABLE results (
+        job_id INTEGER PRIMARY KEY REFERENCES jobs(id),
+        attempt INTEGER NOT NULL,
+        worker TEXT NOT NULL,
+        metrics_json TEXT NOT NULL,
+        wall_seconds REAL NOT NULL,
+        stored REAL NOT NULL);
+      )sql";
+
+void exec_v1(sqlite3* db, const char* sql) {
+  char* err = nullptr;
+  const int rc = sqlite3_exec(db, sql, nullptr, nullptr, &err);
+  const std::string msg = err ? err : "";
+  sqlite3_free(err);
+  ASSERT_EQ(rc, SQLITE_OK) << msg << " in " << sql;
+}
+
+TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJobs) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("demcal_store_v1_" + std::to_string(::getpid()) + ".db");
+  std::filesystem::remove(path);
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(path.string().c_str(), &db), SQLITE_OK);
+    exec_v1(db, kSchemaV1);
+    exec_v1(db, "PRAGMA user_version=1");
+    exec_v1(db,
+            "INSERT INTO campaigns (name, state, spec_json, design_json, created, finished) "
+            "VALUES ('old', 'done', '{\"spec\":1}', '{}', 100.0, 200.0)");
+    exec_v1(db,
+            "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state, "
+            "attempt, counted, worker, finished) "
+            "VALUES (1, 1, 1, 'packing', 'design', '{\"p\":1}', 'done', 1, 1, 'w1', 150.0)");
+    exec_v1(db,
+            "INSERT INTO results (job_id, attempt, worker, metrics_json, wall_seconds, stored) "
+            "VALUES (1, 1, 'w1', '{\"solid_fraction\":0.61}', 12.5, 150.0)");
+    // Version 1 refuses a diagnosis job: the migration is what admits them.
+    char* err = nullptr;
+    EXPECT_NE(sqlite3_exec(db,
+                           "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, "
+                           "payload, state) VALUES (1, 1, 1, 'packing', 'diagnose:shape', '{}', "
+                           "'queued')",
+                           nullptr, nullptr, &err),
+              SQLITE_OK);
+    sqlite3_free(err);
+    ASSERT_EQ(sqlite3_close(db), SQLITE_OK);
+  }
+  {
+    Store s(path.string());
+    EXPECT_EQ(Store::latest_schema_version(), 2);
+    EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
+    ASSERT_EQ(s.campaigns().size(), 1u);
+    const auto campaign = s.campaign(1);
+    ASSERT_TRUE(campaign);
+    EXPECT_EQ(campaign->name, "old");
+    EXPECT_EQ(campaign->spec_json, R"({"spec":1})");
+    auto js = s.jobs(1);
+    ASSERT_EQ(js.size(), 1u);
+    EXPECT_EQ(js[0].id, 1);
+    EXPECT_EQ(js[0].kind, "design");
+    EXPECT_EQ(js[0].state, "done");
+    EXPECT_EQ(js[0].payload, R"({"p":1})");
+    EXPECT_EQ(js[0].worker, "w1");
+    EXPECT_EQ(js[0].attempt, 1);
+    ASSERT_TRUE(js[0].metrics_json);
+    EXPECT_EQ(*js[0].metrics_json, R"({"solid_fraction":0.61})");
+    EXPECT_DOUBLE_EQ(js[0].wall_seconds, 12.5);
+    EXPECT_EQ(s.result_count(1), 1);
+
+    const auto ids = s.add_jobs(1, {{1, 1, "packing", "diagnose:shape", "{}"}});
+    ASSERT_EQ(ids.size(), 1u);
+    EXPECT_GT(ids[0], 1);  // a new id after the migrated job's
+    EXPECT_EQ(s.counts(1, "diagnose:shape").queued, 1);
+    EXPECT_EQ(s.campaign(1)->state, "running");
+    EXPECT_ANY_THROW(s.add_jobs(1, {{1, 1, "packing", "bogus", "{}"}}));
+    js = s.jobs(1);
+    ASSERT_EQ(js.size(), 2u);  // the rejected job left nothing behind
+    EXPECT_EQ(js[1].kind, "diagnose:shape");
+  }
+  {
+    Store s(path.string());  // reopening does not migrate again
+    EXPECT_EQ(s.schema_version(), 2);
+    EXPECT_EQ(s.jobs(1).size(), 2u);
+  }
+  std::filesystem::remove(path);
+  std::filesystem::remove(path.string() + "-wal");
+  std::filesystem::remove(path.string() + "-shm");
 }
 
 }  // namespace
