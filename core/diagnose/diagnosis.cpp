@@ -132,8 +132,11 @@ std::vector<Plan> candidate_plans(const Problem& p) {
     // Interactions aliased with main effects or with each other: the full fold-over separates
     // every main effect from the 2FIs (Montgomery §8.6). Its model has the 2FIs and the one
     // curvature term the centre runs support (the squares form one chain on a two-level design).
-    Plan plan{
-        "interaction", "a two-factor interaction aliased in the design (fold-over)", {}, p.factors};
+    Plan plan{"interaction",
+              "effects the design confounds (a two-factor interaction aliased with a main effect; "
+              "the fold-over separates them)",
+              {},
+              p.factors};
     plan.model = doe::ModelKind::kQuadratic;
     plan.new_rows = -factorial_rows(p.design);
     plans.push_back(std::move(plan));
@@ -519,14 +522,18 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
   const auto remedy = [](const CandidateOutcome& c) {
     return c.id == "interaction" || c.id == "curvature";
   };
-  // Among the remedies, the one whose runs the base model mispredicted most found the flaw.
-  const CandidateOutcome* named = nullptr;
-  for (const auto& c : rep.candidates)
-    if (c.explains && remedy(c) == reachable &&
-        (!named || (reachable && c.design_misprediction > named->design_misprediction)))
-      named = &c;
-  for (const auto& c : rep.candidates)
-    if (!named && c.explains) named = &c;
+  // Within the extensions the lowest verified error wins (candidates are ranked by it); within
+  // the remedies, the one whose runs the base model mispredicted most found the flaw.
+  const auto pick = [&](bool remedies) {
+    const CandidateOutcome* best = nullptr;
+    for (const auto& c : rep.candidates)
+      if (c.explains && remedy(c) == remedies &&
+          (!best || (remedies && c.design_misprediction > best->design_misprediction)))
+        best = &c;
+    return best;
+  };
+  const CandidateOutcome* named = pick(reachable);
+  if (!named) named = pick(!reachable);
   if (!all_verified) {
     rep.conclusion = "simulations still running";
   } else if (named) {
