@@ -62,17 +62,19 @@ void print_report(std::ostream& out, const nlohmann::json& r) {
   if (r["conflicts"].empty()) out << "  none (each metric's own best fit keeps the others near)\n";
   for (const auto& c : r["conflicts"]) out << "  " << c["statement"].get<std::string>() << "\n";
   out << "\ncandidate causes, each tested by simulation (best first)\n";
-  out << std::left << std::setw(34) << "candidate" << std::right << std::setw(6) << "runs"
-      << std::setw(12) << "predicted" << std::setw(12) << "verified" << std::setw(12) << "held out"
-      << std::setw(10) << "explains"
+  out << std::left << std::setw(14) << "candidate" << std::right << std::setw(6) << "runs"
+      << std::setw(13) << "mispredicted" << std::setw(11) << "predicted" << std::setw(10)
+      << "verified" << std::setw(8) << "rounds" << std::setw(10) << "held out" << std::setw(10)
+      << "explains"
       << "\n";
   for (const auto& c : r["candidates"]) {
-    out << std::left << std::setw(34) << c["id"].get<std::string>() << std::right << std::setw(6)
-        << c["runs"].get<int>() << std::setw(12) << pct(c["predicted_rms"]) << std::setw(12)
-        << pct(c["verified_rms"]) << std::setw(12) << pct(c["holdout_rms"]) << std::setw(10)
+    out << std::left << std::setw(14) << c["id"].get<std::string>() << std::right << std::setw(6)
+        << c["runs"].get<int>() << std::setw(13) << pct(c["design_misprediction"]) << std::setw(11)
+        << pct(c["predicted_rms"]) << std::setw(10) << pct(c["verified_rms"]) << std::setw(8)
+        << c["rounds"].get<int>() << std::setw(10) << pct(c["holdout_rms"]) << std::setw(10)
         << (c["explains"] ? "yes" : "no") << "\n";
-    out << "    " << c["cause"].get<std::string>() << ": " << c["state"].get<std::string>();
-    if (!c["evidence"].get<std::string>().empty()) out << "; " << c["evidence"].get<std::string>();
+    out << "    " << c["cause"].get<std::string>() << " [" << c["state"].get<std::string>() << "]";
+    if (!c["evidence"].get<std::string>().empty()) out << ": " << c["evidence"].get<std::string>();
     out << "\n";
   }
   out << "\n" << r["conclusion"].get<std::string>() << "\n";
