@@ -5,6 +5,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <string_view>
 
 #include "core/common/error.hpp"
 #include "core/diagnose/diagnosis.hpp"
@@ -17,7 +18,7 @@
 namespace demcal::server {
 namespace {
 
-constexpr const char* kPrefix = "diagnose:";
+constexpr std::string_view kPrefix = "diagnose:";
 
 double or_default(double v, double fallback) {
   return v > 0.0 ? v : fallback;
@@ -55,7 +56,8 @@ std::map<std::string, diagnose::GroupResults> finished_groups(const std::vector<
                                                               const CampaignPlan& plan) {
   std::map<std::pair<std::string, int>, std::vector<const JobRow*>> rows;
   for (const auto& j : jobs)
-    if (j.kind.rfind(kPrefix, 0) == 0) rows[{j.kind.substr(9), j.std_order}].push_back(&j);
+    if (j.kind.starts_with(kPrefix))
+      rows[{j.kind.substr(kPrefix.size()), j.std_order}].push_back(&j);
   std::map<std::string, diagnose::GroupResults> out;
   for (const auto& [key, row_jobs] : rows) {
     bool ended = true;
@@ -167,7 +169,7 @@ v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::u
   for (const auto& j : jobs) stored.insert({j.kind, j.std_order});
   std::vector<NewJob> fresh;
   for (const auto& req : step.requests) {
-    const std::string kind = kPrefix + req.group;
+    const std::string kind = std::string(kPrefix) + req.group;
     if (stored.count({kind, req.row})) continue;
     const auto add =
         jobs_at(spec, switched(spec.material(), req.switches), req.parameters, req.row, kind);

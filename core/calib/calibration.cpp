@@ -108,10 +108,6 @@ std::string number(double v) {
   return s.str();
 }
 
-double effective_weight(const MetricTarget& m) {
-  return m.uncertainty ? std::pow(m.target / *m.uncertainty, 2) : m.weight;
-}
-
 void validate(const CalibrationProblem& problem) {
   if (problem.factors.empty()) throw InputError("factors", "no factors to calibrate");
   if (problem.metrics.empty()) throw InputError("metrics", "no metrics to calibrate against");
@@ -137,6 +133,10 @@ void validate(const CalibrationProblem& problem) {
 }
 
 }  // namespace
+
+double effective_weight(const MetricTarget& m) {
+  return m.uncertainty ? std::pow(m.target / *m.uncertainty, 2) : m.weight;
+}
 
 Envelope reachable_envelope(const doe::ModelFit& model, const CalibrationOptions& options) {
   const int k = model.factor_count;

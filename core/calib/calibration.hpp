@@ -67,6 +67,10 @@ struct CalibrationResult {
   std::vector<MetricOutcome> metrics;
 };
 
+/// A metric's weight in the objective: (target / uncertainty)^2 when an uncertainty is given,
+/// else its weight; its term is that weight times the squared relative error.
+double effective_weight(const MetricTarget& metric);
+
 /// Checks the problem (names the offending metric or factor) and solves it.
 CalibrationResult calibrate(const CalibrationProblem& problem, const CalibrationOptions& options);
 

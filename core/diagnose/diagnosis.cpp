@@ -164,22 +164,20 @@ std::map<std::string, double> natural_point(const std::vector<Factor>& factors,
   return out;
 }
 
-double target_weight(const Measurement& m) {
-  return m.uncertainty ? (m.value / *m.uncertainty) * (m.value / *m.uncertainty) : m.weight;
-}
-
-/// The calibration objective of core/calib as an RMS relative error over `which` measurements
-/// (holdout or not), from values by response; NaN when a value is missing.
-double rms_error(const std::vector<Measurement>& ms, const std::map<std::string, double>& values,
-                 bool holdout) {
+/// The calibration objective of core/calib as an RMS relative error over the held-out or the
+/// calibrated measurements (`targets` one per measurement), from values by response; NaN when
+/// a value is missing.
+double rms_error(const Problem& p, const std::vector<calib::MetricTarget>& targets,
+                 const std::map<std::string, double>& values, bool holdout) {
   double sum = 0.0, weights = 0.0;
-  for (const auto& m : ms) {
-    if (m.holdout != holdout) continue;
-    auto it = values.find(m.response);
+  for (std::size_t i = 0; i < p.measurements.size(); ++i) {
+    if (p.measurements[i].holdout != holdout) continue;
+    const auto& t = targets[i];
+    auto it = values.find(t.name);
     if (it == values.end() || !std::isfinite(it->second)) return kPending;
-    const double e = (it->second - m.value) / std::abs(m.value);
-    sum += target_weight(m) * e * e;
-    weights += target_weight(m);
+    const double e = (it->second - t.target) / std::abs(t.target);
+    sum += calib::effective_weight(t) * e * e;
+    weights += calib::effective_weight(t);
   }
   return weights > 0.0 ? std::sqrt(sum / weights) : kPending;
 }
@@ -212,19 +210,6 @@ std::vector<calib::MetricTarget> fit_targets(const Problem& p, const Eigen::Matr
   return out;
 }
 
-/// The regressor of a term as ModelFit::predict uses it (a chain's members share equally).
-double term_value(const doe::ModelFit& fit, std::size_t t, const Eigen::VectorXd& x) {
-  const auto& term = fit.terms[t];
-  double sum = 0.0;
-  for (const auto& m : term.chain) {
-    double v = m.sign;
-    for (int i = 0; i < fit.factor_count; ++i)
-      if (m.word & (doe::Word{1} << i)) v *= term.squared ? x(i) * x(i) : x(i);
-    sum += v;
-  }
-  return sum / static_cast<double>(term.chain.size());
-}
-
 /// The same terms refitted by weighted least squares on more rows (the design's, then the
 /// verification runs from row `first_verified` on, weighted kVerifiedWeight): the alias
 /// structure stays the design's; the verified runs, near the optimum, pull the fit to be right
@@ -242,7 +227,7 @@ void refit(doe::ModelFit& fit, const Eigen::MatrixXd& coded, const Eigen::Vector
   for (Eigen::Index i = 0; i < n; ++i) {
     x(i, 0) = 1.0;
     for (Eigen::Index t = 0; t < terms; ++t)
-      x(i, t + 1) = term_value(fit, std::size_t(t), coded.row(rows[std::size_t(i)]).transpose());
+      x(i, t + 1) = fit.term_value(std::size_t(t), coded.row(rows[std::size_t(i)]).transpose());
     b(i) = y(rows[std::size_t(i)]);
     if (rows[std::size_t(i)] >= first_verified) {
       x.row(i) *= std::sqrt(kVerifiedWeight);
@@ -354,14 +339,6 @@ std::map<std::string, double> verified(const std::map<std::string, GroupResults>
 
 }  // namespace
 
-std::vector<std::string> applicable_candidates(const Problem& problem) {
-  Problem p = problem;
-  p.options.candidates.clear();
-  std::vector<std::string> ids;
-  for (const auto& plan : candidate_plans(p)) ids.push_back(plan.id);
-  return ids;
-}
-
 Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups) {
   Step step;
   Report& rep = step.report;
@@ -411,8 +388,8 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
   RunRequest baseline{"baseline", 1, {}, rep.baseline_proposed};
   step.requests.push_back(baseline);
   if (!base_sim.empty()) {
-    rep.baseline_verified_rms = rms_error(p.measurements, base_sim, false);
-    rep.baseline_holdout_rms = rms_error(p.measurements, base_sim, true);
+    rep.baseline_verified_rms = rms_error(p, base.all, base_sim, false);
+    rep.baseline_holdout_rms = rms_error(p, base.all, base_sim, true);
   }
 
   // 2. Candidates: augmented designs, then their calibrations verified.
@@ -467,8 +444,8 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
         c.simulated = v->at(round);
         c.rounds = round;
         c.state = "verified";
-        c.verified_rms = rms_error(p.measurements, c.simulated, false);
-        c.holdout_rms = rms_error(p.measurements, c.simulated, true);
+        c.verified_rms = rms_error(p, base.all, c.simulated, false);
+        c.holdout_rms = rms_error(p, base.all, c.simulated, true);
         if (!std::isfinite(c.verified_rms)) {
           c.state = "failed";
           break;

@@ -154,7 +154,4 @@ struct Step {
 /// when the problem cannot be diagnosed (no calibrated measurement, unknown candidate id).
 Step advance(const Problem& problem, const std::map<std::string, GroupResults>& groups);
 
-/// Candidate ids applicable to the problem (for `--candidates` and docs).
-std::vector<std::string> applicable_candidates(const Problem& problem);
-
 }  // namespace demcal::diagnose

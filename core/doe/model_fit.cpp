@@ -96,20 +96,23 @@ Eigen::VectorXd term_column(const ModelTerm& term, const Eigen::MatrixXd& coded)
   return word_column(term.chain.front().word, term.squared, coded);
 }
 
+double ModelFit::term_value(std::size_t t, const Eigen::VectorXd& x) const {
+  const auto& chain = terms[t].chain;
+  double sum = 0.0;
+  for (const auto& m : chain) {
+    double v = m.sign;
+    for (int i = 0; i < factor_count; ++i) {
+      if (m.word & (Word{1} << i)) v *= terms[t].squared ? x(i) * x(i) : x(i);
+    }
+    sum += v;
+  }
+  return sum / static_cast<double>(chain.size());
+}
+
 double ModelFit::predict(const Eigen::VectorXd& x) const {
   double y = intercept;
-  for (std::size_t t = 0; t < terms.size(); ++t) {
-    const auto& chain = terms[t].chain;
-    double sum = 0.0;
-    for (const auto& m : chain) {
-      double v = m.sign;
-      for (int i = 0; i < factor_count; ++i) {
-        if (m.word & (Word{1} << i)) v *= terms[t].squared ? x(i) * x(i) : x(i);
-      }
-      sum += v;
-    }
-    y += coefficients(Eigen::Index(t)) * sum / static_cast<double>(chain.size());
-  }
+  for (std::size_t t = 0; t < terms.size(); ++t)
+    y += coefficients(Eigen::Index(t)) * term_value(t, x);
   return y;
 }
 

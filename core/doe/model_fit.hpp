@@ -54,6 +54,9 @@ struct ModelFit {
   /// Prediction at one coded point; an alias chain's coefficient is shared equally between
   /// its members, which reproduces the fit on every design point and commits to no member.
   double predict(const Eigen::VectorXd& coded_point) const;
+  /// The regressor of term t at a coded point as predict() uses it: the mean of its chain's
+  /// signed members.
+  double term_value(std::size_t t, const Eigen::VectorXd& coded_point) const;
 };
 
 struct FitOptions {

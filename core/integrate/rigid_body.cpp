@@ -42,6 +42,18 @@ Vec3 body_angular_velocity(const particles::Clumps& c, std::size_t b) {
   return angular_velocity(c.q[b], c.inertia[b], c.angular_momentum[b]);
 }
 
+namespace {
+
+/// Half a kick of body b with its members' forces and its weight: velocity and angular momentum.
+void kick_body(particles::ParticleStore& p, std::size_t b, const Vec3& gravity, double half_dt) {
+  auto& c = p.clumps;
+  const Wrench w = body_wrench(p, b, gravity);
+  c.v[b] += w.force * (half_dt / c.mass[b]);
+  c.angular_momentum[b] += w.torque * half_dt;
+}
+
+}  // namespace
+
 void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, const Vec3& gravity,
                       double dt, int threads) {
   auto& c = p.clumps;
@@ -50,16 +62,14 @@ void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, const V
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (int b = 0; b < n; ++b) {
     if (c.parked[b]) continue;
-    const Wrench w = body_wrench(p, b, gravity);
-    c.v[b] += w.force * (half / c.mass[b]);
-    c.angular_momentum[b] += w.torque * half;
+    kick_body(p, b, gravity, half);
     c.x[b] += c.v[b] * dt;
     domain.wrap(c.x[b]);
-    const Vec3 omega0 = angular_velocity(c.q[b], c.inertia[b], c.angular_momentum[b]);
+    const Vec3 omega0 = body_angular_velocity(c, b);
     const Quat q_mid = (rotation_quat(omega0 * half) * c.q[b]).normalized();
     const Vec3 omega_mid = angular_velocity(q_mid, c.inertia[b], c.angular_momentum[b]);
     c.q[b] = (rotation_quat(omega_mid * dt) * c.q[b]).normalized();
-    c.omega[b] = angular_velocity(c.q[b], c.inertia[b], c.angular_momentum[b]);
+    c.omega[b] = body_angular_velocity(c, b);
     place_members(p, b, &domain);
   }
 }
@@ -70,10 +80,8 @@ void clump_kick(particles::ParticleStore& p, const Vec3& gravity, double half_dt
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (int b = 0; b < n; ++b) {
     if (c.parked[b]) continue;
-    const Wrench w = body_wrench(p, b, gravity);
-    c.v[b] += w.force * (half_dt / c.mass[b]);
-    c.angular_momentum[b] += w.torque * half_dt;
-    c.omega[b] = angular_velocity(c.q[b], c.inertia[b], c.angular_momentum[b]);
+    kick_body(p, b, gravity, half_dt);
+    c.omega[b] = body_angular_velocity(c, b);
     place_members(p, b, nullptr);
   }
 }

@@ -19,7 +19,8 @@ LabTestInfo packing_info() {
       "sampling volume away from the walls",
       "seed 000 §2.7.1, §3.1",
       {{"solid_fraction", "-", "solid volume over sampling volume"},
-       {"coordination_number", "-", "mean number of touching particles (clumps: bodies) per particle in the sampling volume"}},
+       {"coordination_number", "-",
+        "mean number of touching particles (clumps: bodies) per particle in the sampling volume"}},
       settings_docs<PackingSettings>()};
 }
 

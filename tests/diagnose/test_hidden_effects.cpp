@@ -105,6 +105,16 @@ std::string material_yaml(const Truth& t, bool truth) {
   return y.str();
 }
 
+/// Runs a demcal command and parses its standard output as JSON.
+nlohmann::json run_json(const std::string& cmd) {
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  EXPECT_EQ(pclose(p), 0) << cmd;
+  return nlohmann::json::parse(out);
+}
+
 /// The measured data: the truth simulated in the packing test (its own lab seed).
 std::map<std::string, double> measure(const Truth& t, const std::filesystem::path& dir) {
   const auto file = dir / "truth.yaml";
@@ -113,12 +123,7 @@ std::map<std::string, double> measure(const Truth& t, const std::filesystem::pat
                       << material_yaml(t, true);
   const std::string cmd = std::string(DEMCAL_CLI_BIN) + " lab run " + file.string() + " --out " +
                           (dir / "truth").string();
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  EXPECT_EQ(pclose(p), 0) << cmd;
-  const auto j = nlohmann::json::parse(out);
+  const auto j = run_json(cmd);
   return {{"solid_fraction", j["metrics"]["solid_fraction"].get<double>()},
           {"coordination_number", j["metrics"]["coordination_number"].get<double>()}};
 }
@@ -147,12 +152,7 @@ nlohmann::json diagnose(const std::filesystem::path& spec, const std::filesystem
   const std::string cmd = std::string(DEMCAL_CLI_BIN) + " diagnose " + spec.string() +
                           " --format json --threads 1 --workdir " + work.string() + " 2>" +
                           (work.parent_path() / "diagnose.log").string();
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  EXPECT_EQ(pclose(p), 0) << cmd;
-  return nlohmann::json::parse(out);
+  return run_json(cmd);
 }
 
 TEST(HiddenEffects, DiagnosisNamesTheHiddenCause) {
