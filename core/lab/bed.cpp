@@ -204,7 +204,9 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
     walls::Wall probe;
     probe.force = w.walls[measured].force * sign;
     servo.update(probe, w.dt);
-    w.walls[driven].velocity = probe.velocity;
+    const bool at_limit = axial_position(w.walls[driven]) * axis.z <= s.retreat_limit;
+    w.walls[driven].velocity =
+        at_limit && dot(probe.velocity, axis) < 0.0 ? Vec3{} : probe.velocity;
     if (record && w.step_count % record_every == 0) record(w, stress);
     sum_s += stress;
     sum_z += axial_position(w.walls[driven]);

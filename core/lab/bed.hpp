@@ -3,6 +3,7 @@
 // the lab tests (seed 000 §2.7.1: random non-overlapping insertion in a cylinder, then settling
 // under gravity). Tests then add pistons, cut the bed, or shear it.
 #include <functional>
+#include <limits>
 
 #include "core/lab/lab_test.hpp"
 #include "core/particles/insertion.hpp"
@@ -98,6 +99,10 @@ struct ServoSettings {
   double tolerance = 0.0;  ///< |stress - target| (Pa) counted as reached
   double hold_time = 0.0;  ///< (s) the stress must stay within tolerance
   double max_time = 0.0;   ///< (s) per phase; the phase ends there reached or not
+  /// The driven wall does not back away (move against the compression axis) past this
+  /// coordinate along the axis: a container bottom never sinks below the floor the bed settled
+  /// on, even when a bed jammed against the die keeps the stress above the target.
+  double retreat_limit = -std::numeric_limits<double>::infinity();
 };
 
 /// What a servo phase ended with: mean stress and wall position over the hold window.
@@ -109,9 +114,9 @@ struct ServoPhase {
 };
 
 /// Drives `driven` (a wall index) by a StressServo until the compressive stress read from wall
-/// `measured` holds `target` for hold_time (or max_time passes). `axis` is the direction in which
-/// the driven wall compresses the bed. `record(world, stress)` is called every `record_every`
-/// steps if given.
+/// `measured` holds `target` for hold_time (or max_time passes). `axis` (+z or -z) is the direction
+/// in which the driven wall compresses the bed; `servo.retreat_limit` is a coordinate along it.
+/// `record(world, stress)` is called every `record_every` steps if given.
 ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measured, Vec3 axis,
                        double area, double target, const ServoSettings& servo,
                        const sim::HealthLimits& limits,

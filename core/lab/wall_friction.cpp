@@ -53,7 +53,8 @@ LabOutput run_wall_friction(const MaterialModel& material, const Settings& value
   const double omega = rim_speed / bed.radius;
   const double turn_time = s.rotation_diameters * d_mean / rim_speed;
   auto& piston = w.walls[bed.piston];
-  std::size_t bottom = 0;
+  const std::size_t bottom = 0;
+  const double floor_z = std::get<walls::Plane>(w.walls[bottom].shape).point.z;
 
   Series series{{"normal_stress_kPa", "shear_stress_kPa", "torque_Nm", "measured_normal_kPa"}, {}};
   std::vector<double> sig, tau;
@@ -62,6 +63,10 @@ LabOutput run_wall_friction(const MaterialModel& material, const Settings& value
     const double target = sigma_real * s.stress_factor * fs;
     ServoSettings ps = servo;
     ps.tolerance = std::max(servo.tolerance * target, 2e-3 * s_max);
+    // A turn can jam the bed between the piston and the die: the stress then stays above the
+    // target however far the bottom sinks, and the loose powder would fall with it. The bottom
+    // stops at the floor; the measured stress, not the target, enters the regression.
+    ps.retreat_limit = floor_z;
     piston.omega = {};
     servo_phase(w, bottom, bed.piston, {0, 0, 1}, bed.area, target, ps, bed.limits);
     // Turn at constant normal stress: the same servo runs through the whole turn (a tolerance

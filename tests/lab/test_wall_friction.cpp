@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "core/lab/wall_friction.hpp"
 #include "lab_test_util.hpp"
@@ -43,6 +44,26 @@ TEST(WallFriction, TwoPointCalibrationHitsTarget) {
   EXPECT_GT(mu, 0.1);
   EXPECT_LT(mu, 0.2);
   EXPECT_NEAR(angle(mu), target, 0.15 * target);
+}
+
+TEST(WallFriction, BottomServoStopsAtTheFloor) {
+  // A bed jammed between the turning piston and the die keeps the stress above the target
+  // however far the bottom sinks. Here a target below anything the piston can read (a pull)
+  // makes the servo back the bottom away at full speed: without a limit it sinks by about
+  // max_speed * max_time and the powder falls with it; with the floor as its retreat limit it
+  // stops within one step of the floor.
+  const PistonBed bed = make_piston_bed(testing::soft_luding(), 100, 0.2, {}, {});
+  const ServoSettings servo{0.05, 1e-3, 0.0, 0.0, 1.0, 1e-3, 0.02};
+  auto bottom_after = [&](double retreat_limit) {
+    sim::World w = bed.world;
+    ServoSettings s = servo;
+    s.retreat_limit = retreat_limit;
+    EXPECT_FALSE(servo_phase(w, 0, bed.piston, {0, 0, 1}, bed.area, -100.0, s, bed.limits).reached);
+    return std::get<walls::Plane>(w.walls[0].shape).point.z;
+  };
+  EXPECT_LT(bottom_after(-std::numeric_limits<double>::infinity()),
+            -0.5 * servo.max_speed * servo.max_time);
+  EXPECT_GE(bottom_after(0.0), -1.01 * servo.max_speed * bed.world.dt);
 }
 
 }  // namespace
