@@ -19,7 +19,7 @@ struct DiagnoseOptions {
   proto::ChannelOptions channel;
   std::string campaign;
   std::string workdir;
-  int threads = 2;
+  LocalWorkers local;
   bool verbose = false, wait = true;
   std::string format = "table";
   std::uint64_t seed = 1;
@@ -118,7 +118,7 @@ void report(const v1::DiagnoseReply& reply, const std::string& format) {
 void run(const DiagnoseOptions& o) {
   if (std::filesystem::is_regular_file(o.campaign)) {
     const SpecFile file = read_campaign_spec(o.campaign);
-    EmbeddedService service(work_directory(o.campaign, o.workdir), o.threads, o.verbose);
+    EmbeddedService service(work_directory(o.campaign, o.workdir), o.local, o.verbose);
     const std::int64_t id = service.submit_or_resume(file, std::cerr);
     watch_campaign(service.stub(), service.channel(), id, std::cerr);
     report(drive(service.stub(), service.channel(), id, o), o.format);
@@ -147,8 +147,7 @@ void add_diagnose_command(CLI::App& app) {
   cmd->add_option("campaign", o->campaign, "campaign id, or a spec YAML (embedded default)")
       ->required();
   cmd->add_option("--workdir", o->workdir, "embedded: directory of the SQLite file");
-  cmd->add_option("--threads", o->threads, "embedded: simulation threads of the local worker")
-      ->capture_default_str();
+  add_local_worker_options(*cmd, o->local);
   cmd->add_flag("!--no-wait", o->wait, "report the current state and queue the next runs only");
   cmd->add_option("--seed", o->seed, "calibration multi-start seed")->capture_default_str();
   cmd->add_option("--format", o->format, "table or json")->check(CLI::IsMember({"table", "json"}));

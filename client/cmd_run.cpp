@@ -1,4 +1,4 @@
-// `demcal run SPEC [--workdir DIR] [--threads N] [--no-verify]`: the embedded default
+// `demcal run SPEC [--workdir DIR] [--workers N] [--threads N] [--no-verify]`: the embedded default
 // (client/embedded.hpp). The campaign runs to the end over real gRPC; the effect tables and the
 // proposed calibration (verified by simulation) are printed. Running it again with the same work
 // directory resumes the campaign of the same name instead of starting over.
@@ -14,7 +14,7 @@ namespace {
 struct RunOptions {
   std::string spec;
   std::string workdir;
-  int threads = 2;
+  LocalWorkers local;
   bool verify = true;
   bool verbose = false;
   std::string format = "table";
@@ -23,7 +23,7 @@ struct RunOptions {
 void run_embedded(const RunOptions& opt) {
   const SpecFile file = read_campaign_spec(opt.spec);
   const auto workdir = work_directory(opt.spec, opt.workdir);
-  EmbeddedService service(workdir, opt.threads, opt.verbose);
+  EmbeddedService service(workdir, opt.local, opt.verbose);
   auto* stub = &service.stub();
   const auto& channel = service.channel();
   std::cout << "work directory: " << workdir.string() << " (SQLite: " << service.db() << ")\n";
@@ -68,8 +68,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("spec", o->spec, "campaign YAML")->required()->check(CLI::ExistingFile);
   cmd->add_option("--workdir", o->workdir,
                   "directory of the SQLite file (default demcal-work/<spec>)");
-  cmd->add_option("--threads", o->threads, "simulation threads of the local worker")
-      ->capture_default_str();
+  add_local_worker_options(*cmd, o->local);
   cmd->add_flag("!--no-verify", o->verify, "do not simulate the proposed set");
   cmd->add_flag("-v,--verbose", o->verbose, "coordinator and worker logs");
   cmd->add_option("--format", o->format, "table, csv or json (effects)")

@@ -24,7 +24,17 @@ std::filesystem::path work_directory(const std::string& spec, const std::string&
                          : std::filesystem::path(workdir);
 }
 
-EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, int threads, bool verbose) {
+void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
+  cmd.add_option("--workers", local.workers, "embedded: local workers (jobs run side by side)")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  cmd.add_option("--threads", local.threads, "embedded: simulation threads of each local worker")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
+}
+
+EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local,
+                                 bool verbose) {
   std::filesystem::create_directories(workdir);
   spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
   server::CoordinatorOptions co;
@@ -34,17 +44,19 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, int threa
   coordinator_ = std::make_unique<server::Coordinator>(co);
   channel_.address = "127.0.0.1:" + std::to_string(coordinator_->port());
   channel_.token = co.token;
-  worker::WorkerOptions wo;
-  wo.channel = channel_;
-  wo.threads = threads;
-  wo.id = "embedded";
-  worker_ = std::thread([this, wo] { worker::run_worker(wo, flags_); });
+  for (int i = 1; i <= local.workers; ++i) {
+    worker::WorkerOptions wo;
+    wo.channel = channel_;
+    wo.threads = local.threads;
+    wo.id = local.workers == 1 ? "embedded" : "embedded-" + std::to_string(i);
+    workers_.emplace_back([this, wo] { worker::run_worker(wo, flags_); });
+  }
   stub_ = campaign_stub(channel_);
 }
 
 EmbeddedService::~EmbeddedService() {
   flags_.stop = true;
-  if (worker_.joinable()) worker_.join();
+  for (auto& w : workers_) w.join();
   coordinator_->shutdown();
 }
 

@@ -1,11 +1,13 @@
 #pragma once
 // The embedded default: a coordinator (SQLite file in a work directory, loopback only, a random
-// token) and a local worker in this process, talking real gRPC. Used by `demcal run` and
+// token) and local workers in this process, talking real gRPC. Used by `demcal run` and
 // `demcal diagnose SPEC`.
+#include <CLI/CLI.hpp>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "client/service_client.hpp"
 #include "client/spec_yaml.hpp"
@@ -14,9 +16,20 @@
 
 namespace demcal::cli {
 
+/// The local workers: `workers` worker loops in this process, each running one job at a time on
+/// `threads` simulation threads. Small beds use cores best as jobs side by side (two workers of
+/// one thread on 2 cores); large beds as threads of one job (docs/worker.md).
+struct LocalWorkers {
+  int workers = 1;
+  int threads = 2;
+};
+
+/// `--workers` and `--threads` of a command that runs the embedded default.
+void add_local_worker_options(CLI::App& cmd, LocalWorkers& local);
+
 class EmbeddedService {
  public:
-  EmbeddedService(const std::filesystem::path& workdir, int threads, bool verbose);
+  EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local, bool verbose);
   ~EmbeddedService();
   EmbeddedService(const EmbeddedService&) = delete;
   EmbeddedService& operator=(const EmbeddedService&) = delete;
@@ -34,7 +47,7 @@ class EmbeddedService {
   std::unique_ptr<server::Coordinator> coordinator_;
   proto::ChannelOptions channel_;
   worker::StopFlags flags_;
-  std::thread worker_;
+  std::vector<std::thread> workers_;
   std::unique_ptr<v1::CampaignService::Stub> stub_;
 };
 

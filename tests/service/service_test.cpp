@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <set>
 
@@ -118,19 +119,25 @@ class Service : public ::testing::Test {
     return campaigns_->Get(ctx(5).get(), req, &c).ok() && c.state() == v1::DONE;
   }
 
-  /// Rows of the results table per job, read from the SQLite file itself.
-  std::map<std::int64_t, int> stored_results() {
+  /// Calls `row` on each row of `sql` run on the SQLite file `db` itself (read-only).
+  static void each_row(const std::string& db_path, const char* sql,
+                       const std::function<void(sqlite3_stmt*)>& row) {
     sqlite3* db = nullptr;
-    std::map<std::int64_t, int> out;
-    if (sqlite3_open_v2(path("c.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK)
-      return out;
+    ASSERT_EQ(sqlite3_open_v2(db_path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK)
+        << db_path;
     sqlite3_stmt* st = nullptr;
-    sqlite3_prepare_v2(db, "SELECT job_id, COUNT(*) FROM results GROUP BY job_id", -1, &st,
-                       nullptr);
-    while (sqlite3_step(st) == SQLITE_ROW)
-      out[sqlite3_column_int64(st, 0)] = sqlite3_column_int(st, 1);
+    EXPECT_EQ(sqlite3_prepare_v2(db, sql, -1, &st, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+    while (st && sqlite3_step(st) == SQLITE_ROW) row(st);
     sqlite3_finalize(st);
     sqlite3_close(db);
+  }
+
+  /// Rows of the results table per job, read from the SQLite file itself.
+  std::map<std::int64_t, int> stored_results() {
+    std::map<std::int64_t, int> out;
+    each_row(
+        path("c.db"), "SELECT job_id, COUNT(*) FROM results GROUP BY job_id",
+        [&](sqlite3_stmt* st) { out[sqlite3_column_int64(st, 0)] = sqlite3_column_int(st, 1); });
     return out;
   }
 
@@ -381,8 +388,9 @@ TEST_F(Service, CoordinatorKilledAndRestartedCampaignCompletesNothingLostOrDupli
 TEST_F(Service, CliRunsACampaignEndToEnd) {
   const std::string spec = path("tiny.yaml");
   std::ofstream(spec) << tiny_spec(200, 1);  // (60 particles: packing could not insert them all)
-  Process run({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1"},
-              path("run.log"));
+  Process run(
+      {DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--workers", "2", "--threads", "1"},
+      path("run.log"));
   ASSERT_EQ(run.wait_exit(150), 0) << run.log();
   const std::string out = run.log();
   EXPECT_NE(out.find("resolution full factorial"), std::string::npos) << out;
@@ -390,7 +398,16 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
   EXPECT_NE(out.find("alias chain"), std::string::npos);
   EXPECT_NE(out.find("proposed parameter set"), std::string::npos);
   EXPECT_NE(out.find("verification: done (1 jobs)"), std::string::npos) << out;
-  EXPECT_TRUE(fs::exists(path("work/campaign.db")));
+  // Both local workers ran jobs side by side (--workers 2), by the jobs table of the file.
+  std::map<std::string, int> jobs_by_worker;
+  each_row(path("work/campaign.db"), "SELECT worker, COUNT(*) FROM jobs GROUP BY worker",
+           [&](sqlite3_stmt* st) {
+             jobs_by_worker[reinterpret_cast<const char*>(sqlite3_column_text(st, 0))] =
+                 sqlite3_column_int(st, 1);
+           });
+  EXPECT_GE(jobs_by_worker["embedded-1"], 1) << out;
+  EXPECT_GE(jobs_by_worker["embedded-2"], 1) << out;
+  EXPECT_EQ(jobs_by_worker["embedded-1"] + jobs_by_worker["embedded-2"], 6);  // 5 runs + verify
   // A bad spec is refused before anything runs, naming the file, line and field.
   std::string bad = tiny_spec(60);
   bad.replace(bad.find("density: 2500"), 13, "densty: 2500");
