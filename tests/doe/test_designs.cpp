@@ -5,6 +5,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/common/error.hpp"
 #include "core/doe/alias_structure.hpp"
@@ -16,9 +17,15 @@ namespace {
 
 const std::string kOracle = std::string(DEMCAL_SOURCE_DIR) + "/../shared/reference/doe-oracle/";
 
-Eigen::MatrixXd read_oracle_matrix(const std::string& file) {
+/// An oracle file, open; a missing one is an error naming its path (the test fails, no crash).
+std::ifstream open_oracle(const std::string& file) {
   std::ifstream in(kOracle + file);
-  EXPECT_TRUE(in) << kOracle + file;
+  if (!in) throw std::runtime_error("cannot read the FrF2 oracle file " + kOracle + file);
+  return in;
+}
+
+Eigen::MatrixXd read_oracle_matrix(const std::string& file) {
+  std::ifstream in = open_oracle(file);
   std::string line;
   std::getline(in, line);  // header
   std::vector<std::vector<double>> rows;
@@ -58,8 +65,7 @@ std::vector<std::string> defining_words(const AliasStructure& a) {
 /// factor named F and shifts the later letters up by one; map them back (G->F, ..., N->M)
 /// so the chains can be compared with those of the folded design without a block factor.
 std::vector<std::string> oracle_fold_chains(const std::string& section) {
-  std::ifstream in(kOracle + "foldover_checks.txt");
-  EXPECT_TRUE(in);
+  std::ifstream in = open_oracle("foldover_checks.txt");
   std::string line;
   bool inside = false, fi2 = false;
   std::vector<std::string> chains;
