@@ -17,8 +17,7 @@
 namespace demcal::cli {
 
 /// The local workers: `workers` worker loops in this process, each running one job at a time on
-/// `threads` simulation threads. Small beds use cores best as jobs side by side (two workers of
-/// one thread on 2 cores); large beds as threads of one job (docs/worker.md).
+/// `threads` simulation threads (which to choose: docs/worker.md).
 struct LocalWorkers {
   int workers = 1;
   int threads = 2;

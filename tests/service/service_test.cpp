@@ -119,7 +119,7 @@ class Service : public ::testing::Test {
     return campaigns_->Get(ctx(5).get(), req, &c).ok() && c.state() == v1::DONE;
   }
 
-  /// Calls `row` on each row of `sql` run on the SQLite file `db` itself (read-only).
+  /// Calls `row` on each row of `sql` run on the SQLite file `db_path` itself (read-only).
   static void each_row(const std::string& db_path, const char* sql,
                        const std::function<void(sqlite3_stmt*)>& row) {
     sqlite3* db = nullptr;
