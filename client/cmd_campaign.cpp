@@ -1,4 +1,5 @@
 // `demcal list | status ID | watch ID | cancel ID`: campaigns on a coordinator.
+#include <algorithm>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -46,15 +47,26 @@ void add_campaign_commands(CLI::App& app) {
     v1::Campaign c;
     check(stub->Get(proto::make_context(o->channel, 30).get(), req, &c), "status");
     print_campaign_row(c);
-    if (!o->jobs) return;
     v1::ResultsReply r;
     check(stub->GetResults(proto::make_context(o->channel, 30).get(), req, &r), "results");
+    const auto flagged = std::count_if(r.jobs().begin(), r.jobs().end(),
+                                       [](const v1::JobResult& j) { return j.flags_size() > 0; });
+    if (flagged > 0)
+      std::cout << "  " << flagged
+                << " result(s) with flagged metrics: a phase did not reach its target (--jobs)\n";
+    if (!o->jobs) return;
+    // A flagged metric (a phase it is computed from did not reach its target) is marked '!'
+    // and its reason follows the job line.
     for (const auto& j : r.jobs()) {
       std::cout << "  job " << j.job_id() << " " << j.kind() << " run " << j.std_order() << " "
                 << j.test() << " " << j.state() << " attempt " << j.attempt();
-      for (const auto& [k, v] : j.metrics()) std::cout << " " << k << "=" << v;
+      for (const auto& [k, v] : j.metrics())
+        std::cout << " " << k << "=" << v << (j.flags().contains(k) ? "!" : "");
+      if (j.has_cost() && j.cost().wall_seconds() > 0.0)
+        std::cout << "  [" << j.cost().steps() << " steps, " << j.cost().wall_seconds() << " s]";
       if (!j.error().empty()) std::cout << "  (" << j.error() << ")";
       std::cout << "\n";
+      for (const auto& [k, why] : j.flags()) std::cout << "    ! " << k << ": " << why << "\n";
     }
   });
 

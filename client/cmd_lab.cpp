@@ -36,6 +36,8 @@ void run_lab(const LabOptions& opt) {
   j["metrics"] = out.metrics;
   for (const auto& m : test.metrics) j["units"][m.name] = m.unit;
   if (!out.notes.empty()) j["notes"] = out.notes;
+  j["flags"] = out.flags;
+  j["cost"] = to_json(out.cost);
   if (!opt.out_dir.empty()) {
     for (const auto& [name, series] : out.series) {
       const std::string path = opt.out_dir + "/" + name + ".csv";

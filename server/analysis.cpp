@@ -35,6 +35,16 @@ Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobR
   return y;
 }
 
+std::map<std::string, std::vector<int>> flagged_runs(const std::vector<JobRow>& jobs) {
+  std::map<std::string, std::vector<int>> out;
+  for (const auto& job : jobs) {
+    if (job.kind != "design" || job.state != "done") continue;
+    for (const auto& [metric, why] : nlohmann::json::parse(job.flags_json).items())
+      out[job.test + "." + metric].push_back(job.std_order);
+  }
+  return out;
+}
+
 doe::ResponseAnalysis analyse(const CampaignPlan& plan, const Eigen::VectorXd& y,
                               doe::ModelKind model, double alpha) {
   doe::AnalysisOptions o;

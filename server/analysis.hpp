@@ -17,6 +17,9 @@ std::string metrics_to_json(const std::map<std::string, double>& metrics);
 std::map<std::string, double> metrics_from_json(const std::string& json);
 
 /// One row per design row (standard order), one column per plan.responses; NaN = no result.
+/// Per response ("test.metric"), the design runs (std order) whose value is flagged: a phase it
+/// is computed from did not reach its target.
+std::map<std::string, std::vector<int>> flagged_runs(const std::vector<JobRow>& jobs);
 Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobRow>& jobs);
 
 doe::ResponseAnalysis analyse(const CampaignPlan& plan, const Eigen::VectorXd& y,

@@ -355,6 +355,9 @@ v1::JobResult job_message(const JobRow& job) {
   r.set_error(job.error);
   r.set_worker(job.worker);
   r.set_wall_seconds(job.wall_seconds);
+  for (const auto& [k, v] : nlohmann::json::parse(job.flags_json).items())
+    (*r.mutable_flags())[k] = v.get<std::string>();
+  from_json(job.cost_json, *r.mutable_cost());
   return r;
 }
 
@@ -433,7 +436,11 @@ std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
         {"job_id", job.id},   {"std_order", job.std_order}, {"test", job.test},
         {"kind", job.kind},   {"state", job.state},         {"attempt", job.attempt},
         {"error", job.error}, {"worker", job.worker},       {"wall_seconds", job.wall_seconds}};
-    if (job.metrics_json) o["metrics"] = nlohmann::json::parse(*job.metrics_json);
+    if (job.metrics_json) {
+      o["metrics"] = nlohmann::json::parse(*job.metrics_json);
+      o["flags"] = nlohmann::json::parse(job.flags_json);
+      o["cost"] = nlohmann::json::parse(job.cost_json);
+    }
     j["jobs"].push_back(o);
   }
   return j.dump(2);

@@ -1,8 +1,10 @@
 #include "server/services.hpp"
 
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 #include "core/common/error.hpp"
@@ -142,7 +144,9 @@ grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
   if (!row) return not_found(req->id());
   try {
     const CampaignPlan plan = plan_from_json(row->design_json);
-    const Eigen::MatrixXd y = response_matrix(plan, store_.jobs(row->id));
+    const auto jobs = store_.jobs(row->id);
+    const Eigen::MatrixXd y = response_matrix(plan, jobs);
+    const auto flagged = flagged_runs(jobs);
     const auto kind = model_kind(req->model(), "model");
     const double alpha = req->alpha() > 0 ? req->alpha() : 0.05;
     for (const auto& l : factor_legend(plan)) reply->add_factor_letters(l);
@@ -156,7 +160,17 @@ grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
         continue;
       }
       try {
-        *reply->add_metrics() = effects_message(plan.responses[c], analyse(plan, col, kind, alpha));
+        v1::MetricEffects effects =
+            effects_message(plan.responses[c], analyse(plan, col, kind, alpha));
+        auto* m = reply->add_metrics();
+        *m = std::move(effects);
+        if (const auto f = flagged.find(plan.responses[c]); f != flagged.end()) {
+          std::string runs;
+          for (int r : f->second) runs += (runs.empty() ? "" : ", ") + std::to_string(r);
+          m->add_notes("flagged runs " + runs +
+                       ": a phase this metric is computed from did not reach its target "
+                       "(demcal status --jobs)");
+        }
       } catch (const InputError& e) {
         auto* m = reply->add_metrics();
         m->set_metric(plan.responses[c]);
@@ -301,12 +315,46 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* ctx, const v1::He
   return grpc::Status::OK;
 }
 
+namespace {
+
+/// Checks the flags and the cost block of a result: a flag names a reported metric, texts and
+/// the phase list are bounded, every number is finite and not negative. Empty when valid.
+std::string result_extras_error(const v1::CompleteRequest& req) {
+  constexpr std::size_t kMaxText = 2000, kMaxPhases = 10000;
+  for (const auto& [metric, reason] : req.flags()) {
+    if (!req.metrics().contains(metric))
+      return "flags." + metric + ": flags a metric the result does not report";
+    if (reason.size() > kMaxText) return "flags." + metric + ": longer than 2000 characters";
+  }
+  const auto& c = req.cost();
+  auto bad = [](double v) { return !std::isfinite(v) || v < 0.0; };
+  if (bad(c.time_step()) || bad(c.simulated_time()) || bad(c.wall_seconds()) ||
+      bad(c.particle_steps_per_second()) || c.steps() < 0 || c.particles() < 0)
+    return "cost: numbers must be finite and >= 0";
+  if (c.time_step_limit().size() > kMaxText) return "cost.time_step_limit: too long";
+  if (static_cast<std::size_t>(c.phases_size()) > kMaxPhases) return "cost.phases: more than 10000";
+  for (int i = 0; i < c.phases_size(); ++i) {
+    const auto& p = c.phases(i);
+    if (bad(p.simulated_time()) || bad(p.wall_seconds()) || p.steps() < 0)
+      return "cost.phases[" + std::to_string(i) + "]: numbers must be finite and >= 0";
+    if (p.name().size() > kMaxText || p.target().size() > kMaxText)
+      return "cost.phases[" + std::to_string(i) + "]: text too long";
+  }
+  return {};
+}
+
+}  // namespace
+
 grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::CompleteRequest* req,
                                          v1::CompleteReply*) {
   DEMCAL_AUTHORIZE(ctx);
+  if (const std::string error = result_extras_error(*req); !error.empty())
+    return {grpc::StatusCode::INVALID_ARGUMENT, error};
   std::map<std::string, double> metrics(req->metrics().begin(), req->metrics().end());
+  const nlohmann::json flags(std::map<std::string, std::string>(req->flags().begin(),
+                                                                 req->flags().end()));
   if (!store_.complete(req->job_id(), req->attempt(), req->worker(), metrics_to_json(metrics),
-                       req->wall_seconds(), now_seconds())) {
+                       req->wall_seconds(), now_seconds(), flags.dump(), to_json(req->cost()))) {
     spdlog::warn("job {}: result of attempt {} from {} rejected (not the current lease)",
                  req->job_id(), req->attempt(), req->worker());
     return {grpc::StatusCode::FAILED_PRECONDITION,

@@ -70,6 +70,11 @@ const std::vector<const char*>& migrations() {
       CREATE INDEX jobs_queue ON jobs (state, campaign_id, kind, run_order);
       CREATE INDEX jobs_campaign ON jobs (campaign_id);
       )sql",
+      // 3: per result, the metrics flagged as untrustworthy and the run's cost block.
+      R"sql(
+      ALTER TABLE results ADD COLUMN flags_json TEXT NOT NULL DEFAULT '{}';
+      ALTER TABLE results ADD COLUMN cost_json TEXT NOT NULL DEFAULT '{}';
+      )sql",
   };
   return m;
 }
@@ -264,7 +269,8 @@ namespace {
 constexpr const char* kJobColumns =
     "SELECT j.id, j.campaign_id, j.std_order, j.run_order, j.test, j.kind, j.state, j.payload, "
     "j.worker, j.error, j.attempt, j.counted, j.lease_deadline, r.metrics_json, "
-    "COALESCE(r.wall_seconds, 0), j.finished FROM jobs j LEFT JOIN results r ON r.job_id = j.id";
+    "COALESCE(r.wall_seconds, 0), j.finished, COALESCE(r.flags_json, '{}'), "
+    "COALESCE(r.cost_json, '{}') FROM jobs j LEFT JOIN results r ON r.job_id = j.id";
 }
 
 template <class S>
@@ -286,6 +292,8 @@ JobRow read_job(const S& s) {
   if (!s.is_null(13)) j.metrics_json = s.text(13);
   j.wall_seconds = s.f64(14);
   j.finished = s.f64(15);
+  j.flags_json = s.text(16);
+  j.cost_json = s.text(17);
   return j;
 }
 
@@ -374,7 +382,8 @@ bool Store::heartbeat(std::int64_t job_id, int attempt, double now) {
 }
 
 bool Store::complete(std::int64_t job_id, int attempt, const std::string& worker,
-                     const std::string& metrics_json, double wall_seconds, double now) {
+                     const std::string& metrics_json, double wall_seconds, double now,
+                     const std::string& flags_json, const std::string& cost_json) {
   std::lock_guard lock(mutex_);
   Transaction tx(*this);
   Statement u(db_,
@@ -383,10 +392,10 @@ bool Store::complete(std::int64_t job_id, int attempt, const std::string& worker
   u.bind(1, now).bind(2, job_id).bind(3, attempt).bind(4, now).step();
   if (sqlite3_changes(db_) != 1) return false;  // rolled back: not the current lease
   Statement r(db_,
-              "INSERT INTO results (job_id, attempt, worker, metrics_json, wall_seconds, stored) "
-              "VALUES (?, ?, ?, ?, ?, ?)");
+              "INSERT INTO results (job_id, attempt, worker, metrics_json, wall_seconds, stored, "
+              "flags_json, cost_json) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
   r.bind(1, job_id).bind(2, attempt).bind(3, worker).bind(4, metrics_json);
-  r.bind(5, wall_seconds).bind(6, now).step();
+  r.bind(5, wall_seconds).bind(6, now).bind(7, flags_json).bind(8, cost_json).step();
   finish_campaigns(now);
   tx.commit();
   return true;

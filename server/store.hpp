@@ -49,6 +49,8 @@ struct JobRow {
   std::optional<std::string> metrics_json;  ///< the stored result
   double wall_seconds = 0.0;
   double finished = 0.0;
+  std::string flags_json = "{}";  ///< metric -> why it cannot be trusted
+  std::string cost_json = "{}";   ///< the run's cost block (demcal.v1.RunCost as JSON)
 };
 
 struct Counts {
@@ -93,7 +95,8 @@ class Store {
   bool heartbeat(std::int64_t job_id, int attempt, double now);
   /// Stores the result of the current, unexpired lease exactly once; false otherwise.
   bool complete(std::int64_t job_id, int attempt, const std::string& worker,
-                const std::string& metrics_json, double wall_seconds, double now);
+                const std::string& metrics_json, double wall_seconds, double now,
+                const std::string& flags_json = "{}", const std::string& cost_json = "{}");
   /// See the state machine above; false when the lease is not the current one.
   bool fail(std::int64_t job_id, int attempt, const std::string& reason, bool retryable,
             bool give_back, double now);

@@ -31,9 +31,32 @@ void nap(double seconds, const StopFlags& flags) {
 struct Outcome {
   bool ok = false;
   std::map<std::string, double> metrics;
+  std::map<std::string, std::string> flags;
+  v1::RunCost cost;
   std::string reason;
   bool retryable = false;
 };
+
+v1::RunCost to_proto(const lab::RunCost& c) {
+  v1::RunCost r;
+  r.set_time_step(c.time_step);
+  r.set_time_step_limit(c.time_step_limit);
+  r.set_particles(static_cast<std::int64_t>(c.particles));
+  r.set_steps(c.steps);
+  r.set_simulated_time(c.simulated_time);
+  r.set_wall_seconds(c.wall_seconds);
+  r.set_particle_steps_per_second(c.particle_steps_per_second());
+  for (const auto& p : c.phases) {
+    auto* q = r.add_phases();
+    q->set_name(p.name);
+    q->set_target(p.target);
+    q->set_steps(p.steps);
+    q->set_simulated_time(p.simulated_time);
+    q->set_wall_seconds(p.wall_seconds);
+    q->set_reached(p.reached);
+  }
+  return r;
+}
 
 Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progress) {
   Outcome o;
@@ -47,6 +70,8 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
         lab::run_lab_test(job.test(), material, proto::to_settings(job.settings()), ro);
     o.ok = true;
     o.metrics = out.metrics;
+    o.flags = out.flags;
+    o.cost = to_proto(out.cost);
   } catch (const SimulationFailure& e) {
     o.reason = std::string("simulation failed (") + to_string(e.reason()) + "): " + e.what();
   } catch (const InputError& e) {
@@ -197,6 +222,8 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
         c.set_worker(id);
         c.set_wall_seconds(wall);
         for (const auto& [k, v] : out.metrics) (*c.mutable_metrics())[k] = v;
+        for (const auto& [k, v] : out.flags) (*c.mutable_flags())[k] = v;
+        *c.mutable_cost() = out.cost;
         v1::CompleteReply cr;
         s = stub->Complete(proto::make_context(opt.channel, 10).get(), c, &cr);
       } else {

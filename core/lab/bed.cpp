@@ -71,6 +71,12 @@ void fill_region(sim::World& w, particles::InsertRequest req, Rng& rng, double s
   }
 }
 
+PhaseCost timed_fill(sim::World& w, const particles::InsertRequest& req, Rng& rng, double safety) {
+  const PhaseClock clock(w);
+  fill_region(w, req, rng, safety);
+  return clock.stop(w, "fill", "all particles inserted", true);
+}
+
 sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
                           const RunOptions& options) {
   sim::World w = make_material_world(material, options);
@@ -124,18 +130,23 @@ long run_checked(sim::World& world, long steps, const sim::HealthLimits& limits,
   return steps;
 }
 
-double settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limits) {
+PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limits) {
+  const PhaseClock clock(w);
   const auto& p = w.particles;
   double mgd = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) mgd += p.mass[i] * norm(w.gravity) * 2.0 * p.radius[i];
   mgd /= static_cast<double>(std::max<std::size_t>(p.size(), 1));
   const double t0 = w.time;
   const long chunk = std::max<long>(200, std::lround(0.002 / w.dt));
-  while (w.time - t0 < spec.max_settle_time) {
+  bool rest = false;
+  while (!rest && w.time - t0 < spec.max_settle_time) {
     run_checked(w, chunk, limits);
-    if (p.kinetic_energy() / static_cast<double>(p.size()) < spec.settle_energy * mgd) break;
+    rest = p.kinetic_energy() / static_cast<double>(p.size()) < spec.settle_energy * mgd;
   }
-  return w.time - t0;
+  char target[96];
+  std::snprintf(target, sizeof target, "mean kinetic energy < %.3g m g d within %.3g s",
+                spec.settle_energy, spec.max_settle_time);
+  return clock.stop(w, "settle", target, rest);
 }
 
 }  // namespace demcal::lab
@@ -174,6 +185,56 @@ double axial_position(const walls::Wall& w) {
 }
 }  // namespace
 
+namespace {
+
+/// Approach speed at `stress` (module comment of ServoSettings): quasi-static at the target,
+/// up to approach_inertial_number while the error is at least half the reference stress.
+double approach_speed(const ServoSettings& s, double target, double stress) {
+  const double ref = std::max(target, std::abs(stress));
+  const double blend = std::min(1.0, std::abs(target - stress) / (0.5 * ref));
+  const double inertial =
+      s.inertial_number + (s.approach_inertial_number - s.inertial_number) * blend;
+  return inertial * s.speed_scale * std::sqrt(ref);
+}
+
+/// The phase's simulated time limit: the given one, or (rule) half the bed height at the
+/// quasi-static speed of the larger of the start and target stresses, plus 50 hold times.
+double phase_time_limit(const ServoSettings& s, double target, double start) {
+  if (s.max_time > 0.0) return s.max_time;
+  const double v = s.inertial_number * s.speed_scale * std::sqrt(std::max(target, std::abs(start)));
+  return 0.5 * s.height / v + 50.0 * s.hold_time;
+}
+
+/// Moves the driven wall towards the target until the stress (a running mean over a quarter of
+/// the hold time, so one rattling contact does not end it) crosses it, or the wall reaches its
+/// retreat limit, or max_time passes. Nothing to do when the stress is already within tolerance.
+template <class StressOf, class Record>
+void approach_target(sim::World& world, std::size_t driven, Vec3 axis, double target,
+                     double time_limit, const ServoSettings& s, const sim::HealthLimits& limits,
+                     const StressOf& stress_of, const Record& record, int record_every) {
+  const double start = stress_of(world);
+  if (s.speed_scale <= 0.0 || std::abs(start - target) <= s.tolerance) return;
+  const double direction = target > start ? 1.0 : -1.0;
+  const double t0 = world.time;
+  const double smoothing = std::min(1.0, 4.0 * world.dt / std::max(s.hold_time, world.dt));
+  double mean = start;
+  run_checked(world, std::numeric_limits<long>::max() / 2, limits, [&](sim::World& w) {
+    const double stress = stress_of(w);
+    mean += smoothing * (stress - mean);
+    if (record && w.step_count % record_every == 0) record(w, stress);
+    const bool at_limit = axial_position(w.walls[driven]) * axis.z <= s.retreat_limit;
+    if ((mean - target) * direction >= 0.0 || (direction < 0.0 && at_limit) ||
+        w.time - t0 >= time_limit) {
+      w.walls[driven].velocity = {};
+      return false;
+    }
+    w.walls[driven].velocity = axis * (direction * approach_speed(s, target, mean));
+    return true;
+  });
+}
+
+}  // namespace
+
 ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measured, Vec3 axis,
                        double area, double target, const ServoSettings& s,
                        const sim::HealthLimits& limits,
@@ -194,7 +255,11 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
     return -dot(w.walls[measured].force, axis * sign) / area;
   };
   ServoPhase out;
+  const PhaseClock clock(world);
   const double t0 = world.time;
+  const double time_limit = phase_time_limit(s, target, stress_of(world));
+  approach_target(world, driven, axis, target, time_limit, s, limits, stress_of, record,
+                  record_every);
   // The stress on a piston is carried by a few tens of contacts and rattles; the phase ends when
   // the mean over a block of hold_time is within tolerance of the target.
   double block_start = world.time, sum_s = 0.0, sum_z = 0.0;
@@ -222,7 +287,7 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
       sum_s = sum_z = 0.0;
       n_sum = 0;
     }
-    return w.time - t0 < s.max_time;
+    return w.time - t0 < time_limit;
   });
   if (!out.reached && n_sum > 0) {
     out.stress = sum_s / static_cast<double>(n_sum);
@@ -230,10 +295,11 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
   }
   world.walls[driven].velocity = {};
   out.time = world.time - t0;
-  if (std::getenv("DEMCAL_LAB_TRACE"))
-    std::fprintf(stderr, "servo phase target %g Pa: stress %g Pa at %g m after %g s (%s), dt %g\n",
-                 target, out.stress, out.position, out.time, out.reached ? "reached" : "timed out",
-                 world.dt);
+  char goal[160];
+  std::snprintf(goal, sizeof goal, "stress %s +- %s (simulated) held %.3g s within %.3g s",
+                stress_text(target).c_str(), stress_text(s.tolerance).c_str(), s.hold_time,
+                time_limit);
+  out.cost = clock.stop(world, "servo", goal, out.reached);
   return out;
 }
 
@@ -252,6 +318,19 @@ void write_snapshot(const sim::World& world, const RunOptions& options, const st
 }  // namespace demcal::lab
 
 namespace demcal::lab {
+void add_bed_phases(LabOutput& out, const PistonBed& bed,
+                    const std::vector<std::string>& depending) {
+  out.add_phase(bed.filled, {});
+  out.add_phase(bed.settled, depending);
+}
+
+void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string& name,
+                     const std::vector<std::string>& depending) {
+  PhaseCost cost = phase.cost;
+  cost.name = name;
+  out.add_phase(cost, depending);
+}
+
 PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, double safety,
                           const RunOptions& options,
                           const std::function<void(sim::World&)>& set_laws) {
@@ -259,7 +338,9 @@ PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, 
   spec.particles = particles;
   spec.time_step_safety = safety;
   PistonBed b;
+  const PhaseClock fill_clock;
   b.world = make_die_world(material, spec, options);
+  b.filled = fill_clock.stop(b.world, "fill", "all particles inserted", true);
   sim::World& w = b.world;
   if (set_laws) set_laws(w);
   // The piston shares the bottom's law; add it (far above) so the time step covers its law.
@@ -269,7 +350,7 @@ PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, 
   b.limits = die_limits(w, b.radius, top);
   b.piston = add_piston(w, 1e3 * top + 1.0);
   w.dt = sim::recommended_time_step(w, safety);
-  settle(w, spec, b.limits);
+  b.settled = settle(w, spec, b.limits);
   b.h0 = metrics_top(w);
   auto& disk = std::get<walls::Disk>(w.walls[b.piston].shape);
   disk.centre.z = b.h0;

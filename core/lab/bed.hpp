@@ -49,6 +49,10 @@ particles::InsertRequest material_insert_request(const MaterialModel& material,
 void fill_region(sim::World& world, particles::InsertRequest request, Rng& rng,
                  double time_step_safety, double pause = 0.1, int rounds = 8);
 
+/// fill_region as a recorded phase "fill".
+PhaseCost timed_fill(sim::World& world, const particles::InsertRequest& request, Rng& rng,
+                     double time_step_safety);
+
 /// Expected solid volume of `count` particles of the distribution (mean of 2,000 seeded samples),
 /// for sizing a die, drum or hopper to its bed.
 double expected_solid_volume(const particles::SizeDistribution& sizes, double count,
@@ -63,8 +67,8 @@ sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
 double metrics_top(const sim::World& world);
 
 /// Steps until the bed is at rest (mean kinetic energy criterion of BedSpec) or max time; checks
-/// health every few hundred steps. Returns the simulated time spent.
-double settle(sim::World& world, const BedSpec& spec, const sim::HealthLimits& limits);
+/// health every few hundred steps. Returns the phase "settle" with whether it came to rest.
+PhaseCost settle(sim::World& world, const BedSpec& spec, const sim::HealthLimits& limits);
 
 /// Steps `steps` steps with a health check every `check_every`, calling `each` (if given) after
 /// every step; stops early when `each` returns false. Returns the steps done.
@@ -98,11 +102,19 @@ struct ServoSettings {
   double kd = 0.0;         ///< m/s per Pa/s
   double tolerance = 0.0;  ///< |stress - target| (Pa) counted as reached
   double hold_time = 0.0;  ///< (s) the stress must stay within tolerance
-  double max_time = 0.0;   ///< (s) per phase; the phase ends there reached or not
+  double max_time = 0.0;   ///< (s) per phase, reached or not; 0 = by the rule (phase_time_limit)
   /// The driven wall does not back away (move against the compression axis) past this
   /// coordinate along the axis: a container bottom never sinks below the floor the bed settled
   /// on, even when a bed jammed against the die keeps the stress above the target.
   double retreat_limit = -std::numeric_limits<double>::infinity();
+  /// The approach before the controller holds (docs/lab-tests.md, "Servo phases"): the wall
+  /// moves at v = I h sqrt(sigma_ref / rho) / d, I blending from approach_inertial_number far
+  /// from the target to inertial_number at it, until the stress crosses the target.
+  /// speed_scale = h / (d sqrt(rho)); 0 = no approach (the controller alone).
+  double speed_scale = 0.0;
+  double height = 0.0;  ///< bed height h the speeds and the time-limit rule refer to (m)
+  double inertial_number = 0.0;
+  double approach_inertial_number = 0.0;
 };
 
 /// What a servo phase ended with: mean stress and wall position over the hold window.
@@ -111,6 +123,7 @@ struct ServoPhase {
   double position = 0.0;  ///< wall's axial coordinate (m): piston face z or bottom z
   double time = 0.0;      ///< simulated time spent (s)
   bool reached = false;
+  PhaseCost cost;  ///< named "servo"; callers rename it
 };
 
 /// Drives `driven` (a wall index) by a StressServo until the compressive stress read from wall
@@ -140,9 +153,16 @@ struct PistonBed {
   double radius = 0.0, area = 0.0;
   double h0 = 0.0;  ///< settled bed height = initial piston position (m)
   sim::HealthLimits limits;
+  PhaseCost filled, settled;  ///< the phases that built it
 };
 /// Builds the die world, lets `set_laws` replace wall laws (e.g. stiff or adhesive piston and
 /// bottom), sets dt = safety * critical over all laws, settles, and adds the piston at the bed top.
+/// Records the bed's fill and settle phases in `out`; `depending` are the metrics read from the
+/// settled state (its height).
+void add_bed_phases(LabOutput& out, const PistonBed& bed, const std::vector<std::string>& depending);
+/// Records a servo phase under `name`, flagging `depending` if it did not reach its target.
+void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string& name,
+                     const std::vector<std::string>& depending);
 PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, double safety,
                           const RunOptions& options,
                           const std::function<void(sim::World&)>& set_laws);

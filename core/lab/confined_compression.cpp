@@ -15,9 +15,8 @@
 
 namespace demcal::lab {
 
-ServoSettings make_servo(const sim::World& w, double h, double stress_max, double max_speed,
-                         double kp, double ki, double kd, double tolerance, double hold_steps,
-                         double max_phase_time) {
+ServoSettings make_servo(const sim::World& w, double h, double stress_max,
+                         const ServoRequest& r) {
   const auto& p = w.particles;
   double d = 0.0, rho = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -27,16 +26,22 @@ ServoSettings make_servo(const sim::World& w, double h, double stress_max, doubl
   d /= static_cast<double>(p.size());
   rho /= static_cast<double>(p.size());
   ServoSettings s;
-  // Quasi-static: inertial number I = (v / h) d sqrt(rho / sigma) = 2e-3 at the largest stress.
-  s.max_speed = max_speed > 0.0 ? max_speed : 2e-3 * h / (d * std::sqrt(rho / stress_max));
+  // Quasi-static: inertial number I = (v / h) d sqrt(rho / sigma) (GDR MiDi 2004) at the
+  // largest stress.
+  s.speed_scale = h / (d * std::sqrt(rho));
+  s.height = h;
+  s.inertial_number = r.inertial_number;
+  s.approach_inertial_number = r.approach_inertial_number;
+  s.max_speed = r.max_speed > 0.0 ? r.max_speed : r.inertial_number * s.speed_scale * std::sqrt(stress_max);
+  if (r.approach_inertial_number <= 0.0) s.speed_scale = 0.0;
   // Full speed at an error of the whole largest stress: slow enough that the loop stays well
   // behind the bed's elastic wave transit time for usual bulk stiffnesses.
-  s.kp = kp > 0.0 ? kp : s.max_speed / stress_max;
-  s.ki = ki;
-  s.kd = kd;
-  s.tolerance = tolerance;  // relative; servo_phase callers scale it per target
-  s.hold_time = hold_steps * w.dt;
-  s.max_time = max_phase_time > 0.0 ? max_phase_time : 0.5 * h / s.max_speed;
+  s.kp = r.kp > 0.0 ? r.kp : s.max_speed / stress_max;
+  s.ki = r.ki;
+  s.kd = r.kd;
+  s.tolerance = r.tolerance;  // relative; servo_phase callers scale it per target
+  s.hold_time = r.hold_steps * w.dt;
+  s.max_time = r.max_phase_time;
   return s;
 }
 
@@ -53,13 +58,15 @@ LabOutput run_confined_compression(const MaterialModel& material, const Settings
                                   });
   sim::World& w = bed.world;
   LabOutput out;
+  add_bed_phases(out, bed, {"compressibility", "confined_modulus"});
   write_snapshot(w, options, "settled", out);
   const double s_max = s.max_stress * fs;
-  ServoSettings servo = make_servo(w, bed.h0, s_max, s.servo_max_speed, s.servo_kp, s.servo_ki,
-                                   s.servo_kd, s.servo_tolerance, s.hold_steps, s.max_phase_time);
+  ServoSettings servo = make_servo(w, bed.h0, s_max, servo_request(s));
   Series series{{"time_s", "height_m", "stress_kPa", "phase"}, {}};
   int phase_no = 0;
-  auto phase = [&](double target_real) {
+  // Each phase is recorded with the metrics computed from its end state.
+  auto phase = [&](const std::string& name, double target_real,
+                   const std::vector<std::string>& depending) {
     ServoSettings ps = servo;
     ps.tolerance = std::max(servo.tolerance * target_real, 2e-3 * s.max_stress) * fs;
     ++phase_no;
@@ -71,23 +78,25 @@ LabOutput run_confined_compression(const MaterialModel& material, const Settings
                                  stress / fs / 1e3, static_cast<double>(phase_no)});
         });
     if (options.progress) options.progress(phase_no / (2.0 * s.cycles + 2.0));
+    add_servo_phase(out, r, name, depending);
     return r;
   };
 
   // Eq. 31-33 with h1 = the first loaded height; per cycle c: loaded (h_l, sigma_l) and
   // unloaded (h_u, sigma_u) states; k_unload from loaded c-1 -> unloaded c (eq. 33),
   // k_load from unloaded c -> loaded c (eq. 32); arithmetic means over the cycles (§2.7.2).
-  const ServoPhase first = phase(s.max_stress);
+  const ServoPhase first =
+      phase("load 1", s.max_stress, {"compressibility", "k_load", "k_unload", "confined_modulus"});
   const double h1 = first.position;
   ServoPhase loaded = first;
   double k_load = 0.0, k_unload = 0.0, e_conf = 0.0;
-  int reached = first.reached ? 1 : 0;
   const int cycles = static_cast<int>(std::lround(s.cycles));
   Series cycles_series{{"cycle", "h_loaded_m", "h_unloaded_m", "k_load_MPa", "k_unload_MPa"}, {}};
   for (int c = 1; c <= cycles; ++c) {
-    const ServoPhase un = phase(s.min_stress);
-    const ServoPhase re = phase(s.max_stress);
-    reached += (un.reached ? 1 : 0) + (re.reached ? 1 : 0);
+    std::vector<std::string> depending{"k_load", "k_unload"};
+    if (c == cycles) depending.push_back("confined_modulus");
+    const ServoPhase un = phase("unload " + std::to_string(c), s.min_stress, depending);
+    const ServoPhase re = phase("load " + std::to_string(c + 1), s.max_stress, depending);
     const double ku = (loaded.stress - un.stress) * h1 / (un.position - loaded.position);
     const double kl = (re.stress - un.stress) * h1 / (un.position - re.position);
     k_unload += ku / fs / 1e6;
@@ -100,7 +109,7 @@ LabOutput run_confined_compression(const MaterialModel& material, const Settings
       e_conf = (re.stress - un.stress) / ((un.position - re.position) / bed.h0) / fs / 1e6;
     loaded = re;
   }
-  const ServoPhase final_unload = phase(s.final_stress);
+  const ServoPhase final_unload = phase("final unload", s.final_stress, {"final_solid_fraction"});
   write_snapshot(w, options, "final", out);
 
   const double d_max =
@@ -118,9 +127,8 @@ LabOutput run_confined_compression(const MaterialModel& material, const Settings
   out.series["stress_strain"] = std::move(series);
   out.series["cycles"] = std::move(cycles_series);
   out.series["summary"] =
-      Series{{"h0_m", "h1_m", "h_final_m", "phases_reached", "phases"},
-             {{bed.h0, h1, final_unload.position, double(reached + (final_unload.reached ? 1 : 0)),
-               double(2 * cycles + 2)}}};
+      Series{{"h0_m", "h1_m", "h_final_m"}, {{bed.h0, h1, final_unload.position}}};
+  out.cost.close(w);
   return out;
 }
 

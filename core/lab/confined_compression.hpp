@@ -36,9 +36,15 @@ namespace demcal::lab {
       {"hold_steps",  "-", 10,                                                                   \
        1e7,           400, "steps over which the mean stress must be within tolerance",          \
        &S::hold_steps},                                                                          \
+      {"servo_inertial_number", "-", 1e-5, 0.1, 2e-3,                                            \
+       "inertial number of the wall at its target (quasi-static; docs/lab-tests.md)",            \
+       &S::servo_inertial_number},                                                               \
+      {"approach_inertial_number", "-", 0.0, 0.1, 1e-2,                                          \
+       "inertial number of the approach far from the target; 0 = no approach (controller only)", \
+       &S::approach_inertial_number},                                                            \
   {                                                                                              \
     "max_phase_time", "s", 0.0, 1e4, 0.0,                                                        \
-        "simulated time limit of one servo phase; 0 = half a bed height at the speed limit",     \
+        "simulated time limit of one servo phase; 0 = by the rule of docs/lab-tests.md",     \
         &S::max_phase_time                                                                       \
   }
 
@@ -46,9 +52,10 @@ struct ConfinedCompressionSettings {
   static constexpr const char* kName = "confined_compression";
   double particles, time_step_safety, max_stress, min_stress, final_stress, cycles,
       wall_stiffness_factor;
-  double servo_max_speed, servo_kp, servo_ki, servo_kd, servo_tolerance, hold_steps, max_phase_time;
+  double servo_max_speed, servo_kp, servo_ki, servo_kd, servo_tolerance, hold_steps, max_phase_time,
+      servo_inertial_number, approach_inertial_number;
 
-  static std::array<contact::ParamInfo<ConfinedCompressionSettings>, 14> table() {
+  static std::array<contact::ParamInfo<ConfinedCompressionSettings>, 16> table() {
     using S = ConfinedCompressionSettings;
     return {{{"particles", "-", 20, 1e7, 300, "number of particles", &S::particles},
              {"time_step_safety", "-", 0.01, 1.0, 0.2,
@@ -70,11 +77,23 @@ struct ConfinedCompressionSettings {
   }
 };
 
-/// Servo settings from the exposed values: automatic speed limit (inertial number
-/// I = v/h d sqrt(rho/sigma) = 2e-3 at `stress_max`), gains, tolerance, hold and time limits.
+/// The servo settings a test exposes (DEMCAL_SERVO_SETTINGS), 0 = automatic where documented.
+struct ServoRequest {
+  double max_speed, kp, ki, kd, tolerance, hold_steps, max_phase_time, inertial_number,
+      approach_inertial_number;
+};
+template <class S>
+ServoRequest servo_request(const S& s) {
+  return {s.servo_max_speed, s.servo_kp,       s.servo_ki,
+          s.servo_kd,        s.servo_tolerance, s.hold_steps,
+          s.max_phase_time,  s.servo_inertial_number, s.approach_inertial_number};
+}
+
+/// Servo settings from the exposed values: automatic speed limit (the inertial number
+/// I = v/h d sqrt(rho/sigma) at `stress_max`), gains, tolerance, hold and time limits, and the
+/// approach (docs/lab-tests.md, "Servo phases").
 ServoSettings make_servo(const sim::World& world, double bed_height, double stress_max,
-                         double max_speed, double kp, double ki, double kd, double tolerance,
-                         double hold_steps, double max_phase_time);
+                         const ServoRequest& request);
 
 LabTestInfo confined_compression_info();  ///< in catalog.cpp
 LabOutput run_confined_compression(const MaterialModel& material, const Settings& settings,

@@ -63,7 +63,7 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
       material, particles::BoxRegion{{-0.5 * top, 0.0, h}, {0.5 * top, depth, h + bin}},
       static_cast<std::size_t>(s.particles));
   // Spheres stay inside the region, so none overlaps a periodic image across y = 0 / depth.
-  fill_region(w, req, rng, s.time_step_safety);
+  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety);
 
   sim::HealthLimits limits;
   limits.lo = {-top - bin, -1e3, -(h + bin) * 4.0 - 1.0};
@@ -74,7 +74,7 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
   // 1. Fill and settle with the gate closed.
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.5;
-  settle(w, settle_spec, limits);
+  const PhaseCost settled = settle(w, settle_spec, limits);
 
   // Bulk density of the settled bed: a box in the middle of the wedge, two diameters from the
   // walls (at its height the wedge is wider than the box).
@@ -86,6 +86,8 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
   const double rho_b = phi * density;
 
   LabOutput out;
+  out.add_phase(filled, {});
+  out.add_phase(settled, {"bulk_density", "beverloo_ratio"});
   if (!options.snapshot_dir.empty()) {
     io::write_particles_vtk(options.snapshot_dir + "/hopper_settled_particles.vtk", w);
     io::write_walls_vtk(options.snapshot_dir + "/hopper_walls.vtk", w, top);
@@ -139,7 +141,11 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
     return tt < s.max_time;
   };
   limits.lo.z = park_z - 3.0 * r_max * (s.particles / (per_row * per_col) + 2) - 1.0;
+  const PhaseClock discharge_clock(w);
   run_checked(w, std::lround(s.max_time / w.dt) + 1, limits, each);
+  out.add_phase(discharge_clock.stop(w, "discharge", "hopper empty or arched within max_time",
+                                     arched || discharged >= 0.999 * total_mass),
+                {"discharge_rate", "beverloo_ratio", "arched", "discharged_fraction"});
 
   // Discharge rate: least-squares slope of the mass-time curve between 15 % and 75 % of the
   // discharged mass (after the start-up, before the hopper runs empty).
@@ -168,6 +174,7 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
   out.metrics["discharged_fraction"] = m_end / total_mass;
   out.metrics["bulk_density"] = rho_b;
   out.series["discharge"] = std::move(curve);
+  out.cost.close(w);
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/lab/catalog.hpp"
+#include "core/lab/cost.hpp"
 #include "core/lab/material.hpp"
 
 namespace demcal::lab {
@@ -23,6 +24,13 @@ struct LabOutput {
   std::map<std::string, Series> series;
   std::vector<std::string> snapshots;  ///< VTK files written
   std::vector<std::string> notes;      ///< plain statements about the result
+  RunCost cost;                        ///< time step, steps, wall time, phases
+  /// Metrics that cannot be trusted, with the reason: a phase they are computed from did not
+  /// reach its target. A flagged metric is reported, never silently used.
+  std::map<std::string, std::string> flags;
+
+  /// Records a phase; if it did not reach its target, flags `metrics` with its name and target.
+  void add_phase(const PhaseCost& phase, const std::vector<std::string>& metrics);
 };
 
 struct RunOptions {

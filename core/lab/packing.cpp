@@ -34,7 +34,9 @@ LabOutput run_packing(const MaterialModel& material, const Settings& values,
   BedSpec bed;
   bed.particles = static_cast<std::size_t>(s.particles);
   bed.time_step_safety = s.time_step_safety;
+  const PhaseClock fill_clock;
   sim::World w = make_die_world(material, bed, options);
+  const PhaseCost filled = fill_clock.stop(w, "fill", "all particles inserted", true);
   const double radius = std::get<walls::Cylinder>(w.walls[1].shape).radius;
   double top = 0.0;
   for (std::size_t i = 0; i < w.particles.size(); ++i)
@@ -48,6 +50,7 @@ LabOutput run_packing(const MaterialModel& material, const Settings& values,
   const auto full_law = w.pair_law(0, 0);
   const auto touch_law = simulated_law(material, contact_only(material.particle_law));
 
+  const PhaseClock prepare_clock(w);
   if (method == 1 || method == 2) {
     // Free motion without cohesion and gravity, under a lid at the top of the insertion region.
     contact::ContactLawSpec plain = material.particle_law;
@@ -96,7 +99,8 @@ LabOutput run_packing(const MaterialModel& material, const Settings& values,
       return true;
     });
   }
-  settle(w, bed, limits);
+  const PhaseCost prepared = prepare_clock.stop(w, "agitate or fall", "its fixed time", true);
+  const PhaseCost settled = settle(w, bed, limits);
 
   if (s.cut_fraction < 1.0) {
     // The bed cut to height (seed 000 §2.7.1: the simulation box shrunk after settling).
@@ -116,9 +120,13 @@ LabOutput run_packing(const MaterialModel& material, const Settings& values,
                                                std::to_string(s.wall_margin) +
                                                " diameters from its walls; use more particles");
   LabOutput out;
+  out.add_phase(filled, {});
+  if (prepared.steps > 0) out.add_phase(prepared, {});
+  out.add_phase(settled, {"solid_fraction", "coordination_number"});
   write_snapshot(w, options, "packing", out);
   out.metrics["solid_fraction"] = metrics::solid_fraction(w, region);
   out.metrics["coordination_number"] = metrics::coordination_number(w, region);
+  out.cost.close(w);
   return out;
 }
 

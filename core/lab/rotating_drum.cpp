@@ -133,7 +133,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   particles::InsertRequest req =
       material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth},
                               static_cast<std::size_t>(s.particles));
-  fill_region(w, req, rng, s.time_step_safety);
+  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety);
 
   sim::HealthLimits limits;
   limits.lo = {-1.5 * radius, -1.5 * radius, -radius};
@@ -142,7 +142,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
 
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.0;
-  settle(w, settle_spec, limits);
+  const PhaseCost settled = settle(w, settle_spec, limits);
 
   // Froude scaling: Fr = w^2 R / g of the seed's drum at the seed's rpm.
   const double speed_factor =
@@ -159,6 +159,8 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   auto image = [&] { return project_drum(w.particles.x, w.particles.radius, radius, pixel); };
 
   LabOutput out;
+  out.add_phase(filled, {});
+  out.add_phase(settled, {});
   Series angle_series{{"time", "angle_deg", "csa_occupied_percent"}, {}};
   const double frame = 0.05;  // s between images
   const long frame_steps = std::max<long>(1, std::lround(frame / w.dt));
@@ -172,6 +174,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
 
   // 4 rpm: first turn the bed up to its angle (60 deg of drum rotation at most), then measure.
   const double w4 = set_speed(kDrumSpeeds[0]);
+  const PhaseClock angle_clock(w);
   run_for(std::min(60.0 * M_PI / 180.0 / w4, 3.0), {});
   double angle_sum = 0.0;
   int angle_n = 0;
@@ -185,6 +188,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
     }
   });
   out.metrics["dynamic_angle_of_repose"] = angle_n ? angle_sum / angle_n : 0.0;
+  out.add_phase(angle_clock.stop(w, "4 rpm", "angle_time of turning", true), {});
   if (options.progress) options.progress(0.4);
   if (!options.snapshot_dir.empty()) {
     const std::string p = options.snapshot_dir + "/drum_4rpm_particles.vtk";
@@ -197,6 +201,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   for (std::size_t k = 0; k < kDrumSpeeds.size(); ++k) {
     const int rpm = kDrumSpeeds[k];
     const double omega = set_speed(rpm);
+    const PhaseClock rpm_clock(w);
     double sum = 0.0;
     int n = 0, frames = 0;
     const int total = std::max(1, static_cast<int>(std::lround(s.area_time / frame)));
@@ -207,6 +212,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
       ++n;
       centri = centri && centrifuging(w, radius);
     });
+    out.add_phase(rpm_clock.stop(w, std::to_string(rpm) + " rpm", "area_time of turning", true), {});
     const double csa = n ? sum / n : 0.0;
     out.metrics["csa_occupied_" + std::to_string(rpm)] = csa;
     out.metrics["centrifuging_" + std::to_string(rpm)] = centri ? 1.0 : 0.0;
@@ -216,6 +222,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   out.metrics["drum_diameter"] = 2.0 * radius;
   out.series["angle"] = std::move(angle_series);
   out.series["area_method"] = std::move(area);
+  out.cost.close(w);
   return out;
 }
 

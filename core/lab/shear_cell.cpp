@@ -95,13 +95,13 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   particles::InsertRequest req =
       material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, fill_h},
                               static_cast<std::size_t>(s.particles));
-  fill_region(w, req, rng, s.time_step_safety);
+  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety);
   sim::HealthLimits limits = die_limits(w, radius, fill_h + h_v);
   limits.lo.z = -fill_h;
 
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.0;
-  settle(w, settle_spec, limits);
+  const PhaseCost settled = settle(w, settle_spec, limits);
 
   // The head: its disk half a diameter above the bed top, vanes reaching into the bed's top.
   const double top = metrics::bed_top(w);
@@ -135,9 +135,13 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   };
 
   LabOutput out;
+  out.add_phase(filled, {});
+  out.add_phase(settled, {});
   Series pre{{"time", "normal_stress_kpa", "shear_stress_kpa", "tip_travel"}, {}};
   // 1. Consolidate at sigma_pre with the head at rest (the bed rises into the vanes).
+  const PhaseClock consolidate_clock(w);
   servo_run(w, sigma_pre, 4.0 * s.consolidation_time, {});
+  out.add_phase(consolidate_clock.stop(w, "consolidate", "fixed time under the servo", true), {});
   // 2. Pre-shear at constant tip speed until the tips have travelled pre_shear_travel diameters.
   const double omega = s.tip_speed / r_head;
   w.walls[kHead].omega = {0, 0, omega};
@@ -146,6 +150,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   double tau_sum = 0.0, sigma_sum = 0.0;
   long tau_n = 0;
   const long record = std::max<long>(1, std::lround(0.002 / w.dt));
+  const PhaseClock pre_clock(w);
   servo_run(w, sigma_pre, pre_time, [&](sim::World& ww) {
     const double t = ww.time - t_pre0;
     if (t > 2.0 / 3.0 * pre_time) {
@@ -159,6 +164,8 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
     if (options.progress) options.progress(0.4 * t / pre_time);
     return true;
   });
+  out.add_phase(pre_clock.stop(w, "pre-shear", "tip travel of pre_shear_travel diameters", true),
+                {});
   const double tau_pre = tau_n ? tau_sum / tau_n : 0.0;
   const double sigma_pre_measured = tau_n ? sigma_sum / tau_n : sigma_pre;
   w.walls[kHead].omega = {};
@@ -176,6 +183,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   const double torque_pre = tau_pre * 2.0 * M_PI * std::pow(r_head, 3) / 3.0;
   for (std::size_t k = 0; k < kShearNormalKPa.size(); ++k) {
     sim::World v = restart;
+    const PhaseClock step_clock(v);
     const double sigma_x = kShearNormalKPa[k] * 1e3 * s.stress_scale;
     servo_run(v, sigma_pre, s.consolidation_time, {});
     servo_run(v, sigma_x, s.consolidation_time, {});
@@ -214,6 +222,13 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
       }
       return angle * r_head < 1.5 * d;  // yielded: the tips have moved 1.5 diameters
     });
+    char step_name[64];
+    std::snprintf(step_name, sizeof step_name, "shear step %g kPa", kShearNormalKPa[k]);
+    out.add_phase(step_clock.stop(v, step_name, "yield: tips moved 1.5 diameters within the time",
+                                  angle * r_head >= 1.5 * d),
+                  {"yield_locus_slope", "yield_locus_intercept", "ffc",
+                   "effective_friction_angle", "mohr_consistent", "unconfined_yield_strength",
+                   "major_consolidation_stress"});
     points.rows.push_back({sigma_x / 1e3, sig_at_max / 1e3, tau_max / 1e3});
     // The locus uses the normal stress measured on the floor at the yield point.
     xs.push_back(sig_at_max / 1e3);
@@ -253,6 +268,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
         "effective_friction_angle are 0 (undefined)");
   out.series["pre_shear"] = std::move(pre);
   out.series["yield_points"] = std::move(points);
+  out.cost.close(w);
   return out;
 }
 

@@ -76,9 +76,9 @@ LabOutput run_tensile(const MaterialModel& material, const Settings& values,
                                   });
   sim::World& w = bed.world;
   LabOutput out;
+  add_bed_phases(out, bed, {});
   const ServoSettings servo =
-      make_servo(w, bed.h0, s.consolidation_stress * fs, s.servo_max_speed, s.servo_kp, s.servo_ki,
-                 s.servo_kd, s.servo_tolerance, s.hold_steps, s.max_phase_time);
+      make_servo(w, bed.h0, s.consolidation_stress * fs, servo_request(s));
   auto phase = [&](double target_real) {
     ServoSettings ps = servo;
     ps.tolerance = std::max(servo.tolerance * target_real, 2e-3 * s.consolidation_stress) * fs;
@@ -86,7 +86,9 @@ LabOutput run_tensile(const MaterialModel& material, const Settings& values,
                        bed.limits);
   };
   const ServoPhase consolidated = phase(s.consolidation_stress);
+  add_servo_phase(out, consolidated, "consolidate", {"tensile_strength"});
   const ServoPhase unloaded = phase(s.unload_stress);
+  add_servo_phase(out, unloaded, "unload", {"tensile_strength"});
   if (options.progress) options.progress(0.5);
   write_snapshot(w, options, "consolidated", out);
 
@@ -110,6 +112,7 @@ LabOutput run_tensile(const MaterialModel& material, const Settings& values,
   double acc = 0.0;
   long n_acc = 0, k = 0;
   std::vector<double> z_late;
+  const PhaseClock pull_clock(w);
   run_checked(w, steps, bed.limits, [&](sim::World& world) {
     const double z = std::get<walls::Disk>(world.walls[bed.piston].shape).centre.z;
     acc += -world.walls[bed.piston].force.z / bed.area;
@@ -133,6 +136,7 @@ LabOutput run_tensile(const MaterialModel& material, const Settings& values,
     return true;
   });
   piston.velocity = {};
+  out.add_phase(pull_clock.stop(w, "pull", "pull distance travelled", true), {});
   // Powder stuck to the piston: the particles that followed it over the last quarter of the pull.
   double stuck_mass = 0.0;
   const double dz_piston = 0.25 * travel;
@@ -148,6 +152,7 @@ LabOutput run_tensile(const MaterialModel& material, const Settings& values,
        "unloaded_height_m", "consolidation_reached", "wall_hamaker_factor", "wall_k2_factor"},
       {{peak / fs / 1e3, peak_strain, stuck_stress / fs / 1e3, consolidated.position,
         unloaded.position, consolidated.reached ? 1.0 : 0.0, f_ah, f_k2}}};
+  out.cost.close(w);
   return out;
 }
 

@@ -11,9 +11,10 @@ struct TensileSettings {
   static constexpr const char* kName = "tensile";
   double particles, time_step_safety, consolidation_stress, unload_stress, pull_speed,
       pull_distance, wall_stiffness_factor, wall_hamaker_factor, wall_k2_factor;
-  double servo_max_speed, servo_kp, servo_ki, servo_kd, servo_tolerance, hold_steps, max_phase_time;
+  double servo_max_speed, servo_kp, servo_ki, servo_kd, servo_tolerance, hold_steps, max_phase_time,
+      servo_inertial_number, approach_inertial_number;
 
-  static std::array<contact::ParamInfo<TensileSettings>, 16> table() {
+  static std::array<contact::ParamInfo<TensileSettings>, 18> table() {
     using S = TensileSettings;
     return {{{"particles", "-", 20, 1e7, 300, "number of particles", &S::particles},
              {"time_step_safety", "-", 0.01, 1.0, 0.2,

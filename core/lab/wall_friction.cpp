@@ -41,11 +41,11 @@ LabOutput run_wall_friction(const MaterialModel& material, const Settings& value
                                   });
   sim::World& w = bed.world;
   LabOutput out;
+  add_bed_phases(out, bed, {});
   const auto& stresses = wall_friction_stresses();
   const double s_max = stresses.back() * s.stress_factor * fs;
   const ServoSettings servo =
-      make_servo(w, bed.h0, s_max, s.servo_max_speed, s.servo_kp, s.servo_ki, s.servo_kd,
-                 s.servo_tolerance, s.hold_steps, s.max_phase_time);
+      make_servo(w, bed.h0, s_max, servo_request(s));
   double d_mean = 0.0;
   for (double r : w.particles.radius) d_mean += 2.0 * r;
   d_mean /= static_cast<double>(w.particles.size());
@@ -68,7 +68,9 @@ LabOutput run_wall_friction(const MaterialModel& material, const Settings& value
     // stops at the floor; the measured stress, not the target, enters the regression.
     ps.retreat_limit = floor_z;
     piston.omega = {};
-    servo_phase(w, bottom, bed.piston, {0, 0, 1}, bed.area, target, ps, bed.limits);
+    const std::string at = stress_text(sigma_real * s.stress_factor);
+    add_servo_phase(out, servo_phase(w, bottom, bed.piston, {0, 0, 1}, bed.area, target, ps, bed.limits),
+                    "press " + at, {"wall_friction_angle"});
     // Turn at constant normal stress: the same servo runs through the whole turn (a tolerance
     // that always holds, a hold time of the turn), torque averaged over its second half.
     piston.omega = {0, 0, omega};
@@ -78,7 +80,7 @@ LabOutput run_wall_friction(const MaterialModel& material, const Settings& value
     turn.tolerance = 1e300;
     turn.hold_time = turn_time;
     turn.max_time = 2.0 * turn_time;
-    servo_phase(
+    const ServoPhase turned = servo_phase(
         w, bottom, bed.piston, {0, 0, 1}, bed.area, target, turn, bed.limits,
         [&](const sim::World& world, double stress) {
           if (world.time < t_half) return;
@@ -88,6 +90,7 @@ LabOutput run_wall_friction(const MaterialModel& material, const Settings& value
           n_sum += 1.0;
         },
         1);
+    add_servo_phase(out, turned, "turn " + at, {});
     piston.omega = {};
     const double torque = t_sum / n_sum;
     const double t = shear_stress_from_torque(torque, bed.radius);
@@ -101,6 +104,7 @@ LabOutput run_wall_friction(const MaterialModel& material, const Settings& value
   // Regression through the origin on the measured (normal, shear) pairs (seed 000 §2.7.5).
   out.metrics["wall_friction_angle"] = std::atan(slope_through_origin(sig, tau)) * 180.0 / M_PI;
   out.series["wall_shear"] = std::move(series);
+  out.cost.close(w);
   return out;
 }
 

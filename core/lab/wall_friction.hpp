@@ -15,9 +15,10 @@ struct WallFrictionSettings {
   static constexpr const char* kName = "wall_friction";
   double particles, time_step_safety, stress_factor, rim_speed, rotation_diameters,
       wall_stiffness_factor, bottom_friction;
-  double servo_max_speed, servo_kp, servo_ki, servo_kd, servo_tolerance, hold_steps, max_phase_time;
+  double servo_max_speed, servo_kp, servo_ki, servo_kd, servo_tolerance, hold_steps, max_phase_time,
+      servo_inertial_number, approach_inertial_number;
 
-  static std::array<contact::ParamInfo<WallFrictionSettings>, 14> table() {
+  static std::array<contact::ParamInfo<WallFrictionSettings>, 16> table() {
     using S = WallFrictionSettings;
     return {
         {{"particles", "-", 20, 1e7, 300, "number of particles", &S::particles},

@@ -1,0 +1,60 @@
+#include "core/lab/cost.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/sim/time_step.hpp"
+#include "core/sim/world.hpp"
+
+namespace demcal::lab {
+
+double RunCost::particle_steps_per_second() const {
+  return wall_seconds > 0.0
+             ? static_cast<double>(particles) * static_cast<double>(steps) / wall_seconds
+             : 0.0;
+}
+
+void RunCost::close(const sim::World& world) {
+  time_step = world.dt;
+  const sim::TimeStepLimit limit = sim::critical_time_step(world);
+  char text[256];
+  std::snprintf(text, sizeof text, "%.3g x %s (%.4g s)", world.dt / limit.critical,
+                limit.basis.c_str(), limit.critical);
+  time_step_limit = text;
+  particles = world.particles.size();
+  steps = 0;
+  simulated_time = 0.0;
+  for (const auto& p : phases) {
+    steps += p.steps;
+    simulated_time += p.simulated_time;
+  }
+}
+
+PhaseClock::PhaseClock(const sim::World& world)
+    : steps0_(world.step_count), time0_(world.time), wall0_(std::chrono::steady_clock::now()) {}
+
+PhaseClock::PhaseClock() : wall0_(std::chrono::steady_clock::now()) {}
+
+PhaseCost PhaseClock::stop(const sim::World& world, std::string name, std::string target,
+                           bool reached) const {
+  PhaseCost c;
+  c.name = std::move(name);
+  c.target = std::move(target);
+  c.steps = world.step_count - steps0_;
+  c.simulated_time = world.time - time0_;
+  c.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+  c.reached = reached;
+  return c;
+}
+
+std::string stress_text(double pa) {
+  char text[64];
+  if (std::abs(pa) >= 1e3)
+    std::snprintf(text, sizeof text, "%.4g kPa", pa / 1e3);
+  else
+    std::snprintf(text, sizeof text, "%.4g Pa", pa);
+  return text;
+}
+
+}  // namespace demcal::lab

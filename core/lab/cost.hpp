@@ -1,0 +1,59 @@
+#pragma once
+// Where the time of a lab test goes: its time step and what bounds it, and per phase the steps,
+// simulated and wall time, and whether the phase reached its target. A metric computed from a
+// phase that did not reach its target carries a flag naming that phase (LabOutput::flags).
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace demcal::sim {
+class World;
+}
+
+namespace demcal::lab {
+
+struct PhaseCost {
+  std::string name;    ///< e.g. "settle", "load 1", "unload 2"
+  std::string target;  ///< what the phase had to reach, in words with its number
+  std::int64_t steps = 0;
+  double simulated_time = 0.0;  ///< (s)
+  double wall_seconds = 0.0;
+  bool reached = true;  ///< false: the phase ended at its time limit short of its target
+};
+
+struct RunCost {
+  double time_step = 0.0;         ///< (s, simulated)
+  std::string time_step_limit;    ///< which bound sets it, and the safety factor
+  std::size_t particles = 0;      ///< particles (clump members counted) at the end
+  std::int64_t steps = 0;         ///< all steps of the run
+  double simulated_time = 0.0;    ///< (s)
+  double wall_seconds = 0.0;      ///< the whole run, building the bed included
+  std::vector<PhaseCost> phases;  ///< in the order they ran
+
+  double particle_steps_per_second() const;
+  /// Fills the time step, its limit and the particle count from the world a test ran on, and the
+  /// steps and simulated time as the sums over the phases (a test may run phases on copies).
+  void close(const sim::World& world);
+};
+
+/// Times one phase on a world: steps, simulated time and wall time from construction to stop().
+class PhaseClock {
+ public:
+  /// Starts at the world's current step and time.
+  explicit PhaseClock(const sim::World& world);
+  /// Starts at step 0, time 0: for the phase that creates the world.
+  PhaseClock();
+  PhaseCost stop(const sim::World& world, std::string name, std::string target,
+                 bool reached) const;
+
+ private:
+  std::int64_t steps0_ = 0;
+  double time0_ = 0.0;
+  std::chrono::steady_clock::time_point wall0_;
+};
+
+/// "15 kPa" style text of a stress in Pa, for phase targets.
+std::string stress_text(double pa);
+
+}  // namespace demcal::lab
