@@ -130,22 +130,55 @@ long run_checked(sim::World& world, long steps, const sim::HealthLimits& limits,
   return steps;
 }
 
+namespace {
+/// Order of the weight stress at the bottom of the bed (Pa): its height times rho_p g 0.6.
+double weight_stress(const sim::World& w) {
+  const auto& p = w.particles;
+  double bottom = std::numeric_limits<double>::infinity(), top = -bottom, rho = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    bottom = std::min(bottom, p.x[i].z - p.radius[i]);
+    top = std::max(top, p.x[i].z + p.radius[i]);
+    rho += p.mass[i] / (4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3));
+  }
+  rho /= static_cast<double>(std::max<std::size_t>(p.size(), 1));
+  constexpr double kSolidFraction = 0.6;  // a settled bed, for the order of its weight stress
+  return kSolidFraction * rho * norm(w.gravity) * std::max(top - bottom, 0.0);
+}
+}  // namespace
+
 PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limits) {
   const PhaseClock clock(w);
   const auto& p = w.particles;
-  double mgd = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) mgd += p.mass[i] * norm(w.gravity) * 2.0 * p.radius[i];
-  mgd /= static_cast<double>(std::max<std::size_t>(p.size(), 1));
+  double mass = 0.0, volume = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    mass += p.mass[i];
+    volume += 4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3);
+  }
+  const double rho = volume > 0.0 ? mass / volume : 0.0;
+  const double sigma = spec.rest_stress > 0.0 ? spec.rest_stress : weight_stress(w);
+  // rho <v^2> < I^2 sigma with <v^2> = 2 KE / M.
+  const double ke_limit =
+      0.5 * mass * spec.rest_inertial_number * spec.rest_inertial_number * sigma / rho;
+  // Freshly inserted particles are at rest before they fall: the criterion counts only after
+  // the free-fall time of the column they were inserted in.
+  double bottom = std::numeric_limits<double>::infinity(), top = -bottom;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    bottom = std::min(bottom, p.x[i].z - p.radius[i]);
+    top = std::max(top, p.x[i].z + p.radius[i]);
+  }
+  const double fall = norm(w.gravity) > 0.0 && top > bottom
+                          ? std::sqrt(2.0 * (top - bottom) / norm(w.gravity))
+                          : 0.0;
   const double t0 = w.time;
   const long chunk = std::max<long>(200, std::lround(0.002 / w.dt));
   bool rest = false;
   while (!rest && w.time - t0 < spec.max_settle_time) {
     run_checked(w, chunk, limits);
-    rest = p.kinetic_energy() / static_cast<double>(p.size()) < spec.settle_energy * mgd;
+    rest = w.time - t0 >= fall && p.kinetic_energy() < ke_limit;
   }
-  char target[96];
-  std::snprintf(target, sizeof target, "mean kinetic energy < %.3g m g d within %.3g s",
-                spec.settle_energy, spec.max_settle_time);
+  char target[128];
+  std::snprintf(target, sizeof target, "kinetic stress < %.3g^2 x %s (simulated) within %.3g s",
+                spec.rest_inertial_number, stress_text(sigma).c_str(), spec.max_settle_time);
   return clock.stop(w, "settle", target, rest);
 }
 
@@ -206,15 +239,23 @@ double phase_time_limit(const ServoSettings& s, double target, double start) {
 }
 
 /// Moves the driven wall towards the target until the stress (a running mean over a quarter of
-/// the hold time, so one rattling contact does not end it) crosses it, or the wall reaches its
-/// retreat limit, or max_time passes. Nothing to do when the stress is already within tolerance.
+/// the hold time, so one rattling contact does not end it) has made three quarters of its way
+/// to it, or the wall reaches its retreat limit, or max_time passes. Nothing to do when the stress is already within tolerance.
+/// Returns the hold time of the phase: at least four transits of a stress wave through the bed,
+/// c = sqrt(E / rho_b) with E the secant modulus the approach measured (the bed must carry the
+/// wall's stress through its height before the stress counts as held), at most a tenth of the
+/// phase's time limit, at least ServoSettings::hold_time.
 template <class StressOf, class Record>
-void approach_target(sim::World& world, std::size_t driven, Vec3 axis, double target,
+double approach_target(sim::World& world, std::size_t driven, Vec3 axis, double target,
                      double time_limit, const ServoSettings& s, const sim::HealthLimits& limits,
                      const StressOf& stress_of, const Record& record, int record_every) {
   const double start = stress_of(world);
-  if (s.speed_scale <= 0.0 || std::abs(start - target) <= s.tolerance) return;
+  if (s.speed_scale <= 0.0 || std::abs(start - target) <= s.tolerance) return s.hold_time;
+  const double z0 = axial_position(world.walls[driven]);
   const double direction = target > start ? 1.0 : -1.0;
+  // The approach hands over to the controller a quarter of the stress change before the target,
+  // so the controller makes the last part at quasi-static speed.
+  const double handover = target - 0.25 * (target - start);
   const double t0 = world.time;
   const double smoothing = std::min(1.0, 4.0 * world.dt / std::max(s.hold_time, world.dt));
   double mean = start;
@@ -223,7 +264,7 @@ void approach_target(sim::World& world, std::size_t driven, Vec3 axis, double ta
     mean += smoothing * (stress - mean);
     if (record && w.step_count % record_every == 0) record(w, stress);
     const bool at_limit = axial_position(w.walls[driven]) * axis.z <= s.retreat_limit;
-    if ((mean - target) * direction >= 0.0 || (direction < 0.0 && at_limit) ||
+    if ((mean - handover) * direction >= 0.0 || (direction < 0.0 && at_limit) ||
         w.time - t0 >= time_limit) {
       w.walls[driven].velocity = {};
       return false;
@@ -231,6 +272,11 @@ void approach_target(sim::World& world, std::size_t driven, Vec3 axis, double ta
     w.walls[driven].velocity = axis * (direction * approach_speed(s, target, mean));
     return true;
   });
+  const double travel = std::abs(axial_position(world.walls[driven]) - z0);
+  const double modulus = travel > 0.0 ? std::abs(mean - start) * s.height / travel : 0.0;
+  const double transit =
+      modulus > 0.0 ? s.height / std::sqrt(modulus / s.bulk_density) : 0.1 * time_limit;
+  return std::clamp(4.0 * transit, s.hold_time, std::max(s.hold_time, 0.1 * time_limit));
 }
 
 }  // namespace
@@ -258,8 +304,8 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
   const PhaseClock clock(world);
   const double t0 = world.time;
   const double time_limit = phase_time_limit(s, target, stress_of(world));
-  approach_target(world, driven, axis, target, time_limit, s, limits, stress_of, record,
-                  record_every);
+  const double hold_time = approach_target(world, driven, axis, target, time_limit, s, limits,
+                                          stress_of, record, record_every);
   // The stress on a piston is carried by a few tens of contacts and rattles; the phase ends when
   // the mean over a block of hold_time is within tolerance of the target.
   double block_start = world.time, sum_s = 0.0, sum_z = 0.0;
@@ -276,7 +322,7 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
     sum_s += stress;
     sum_z += axial_position(w.walls[driven]);
     ++n_sum;
-    if (w.time - block_start >= s.hold_time) {
+    if (w.time - block_start >= hold_time) {
       out.stress = sum_s / static_cast<double>(n_sum);
       out.position = sum_z / static_cast<double>(n_sum);
       if (std::abs(out.stress - target) <= s.tolerance) {
@@ -297,7 +343,7 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
   out.time = world.time - t0;
   char goal[160];
   std::snprintf(goal, sizeof goal, "stress %s +- %s (simulated) held %.3g s within %.3g s",
-                stress_text(target).c_str(), stress_text(s.tolerance).c_str(), s.hold_time,
+                stress_text(target).c_str(), stress_text(s.tolerance).c_str(), hold_time,
                 time_limit);
   out.cost = clock.stop(world, "servo", goal, out.reached);
   return out;
@@ -332,11 +378,12 @@ void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string&
 }
 
 PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, double safety,
-                          const RunOptions& options,
+                          double stress_level, const RunOptions& options,
                           const std::function<void(sim::World&)>& set_laws) {
   BedSpec spec;
   spec.particles = particles;
   spec.time_step_safety = safety;
+  spec.rest_stress = stress_level;
   PistonBed b;
   const PhaseClock fill_clock;
   b.world = make_die_world(material, spec, options);

@@ -18,8 +18,11 @@ struct BedSpec {
   double insert_height =
       0.0;  ///< height of the insertion region (m); 0 = from a loose fraction 0.25
   double time_step_safety = 0.2;  ///< dt = safety * critical time step
-  double settle_energy =
-      1e-5;  ///< settled when the mean kinetic energy per particle < this * m g d
+  /// At rest when the kinetic stress of the residual motion, rho_p <v^2> (mass-weighted mean),
+  /// is below rest_inertial_number^2 times the stress level of the test (docs/lab-tests.md,
+  /// "Settling"): 1e-2 = the motion carries 1e-4 of the stress the test works at.
+  double rest_inertial_number = 1e-2;
+  double rest_stress = 0.0;      ///< stress level of the test (Pa, simulated); 0 = the bed's weight
   double max_settle_time = 2.0;  ///< (s) of simulated time
 };
 
@@ -101,7 +104,7 @@ struct ServoSettings {
   double ki = 0.0;         ///< m/s per Pa s
   double kd = 0.0;         ///< m/s per Pa/s
   double tolerance = 0.0;  ///< |stress - target| (Pa) counted as reached
-  double hold_time = 0.0;  ///< (s) the stress must stay within tolerance
+  double hold_time = 0.0;  ///< (s) the stress must stay within tolerance (at least; see approach)
   double max_time = 0.0;   ///< (s) per phase, reached or not; 0 = by the rule (phase_time_limit)
   /// The driven wall does not back away (move against the compression axis) past this
   /// coordinate along the axis: a container bottom never sinks below the floor the bed settled
@@ -113,6 +116,7 @@ struct ServoSettings {
   /// speed_scale = h / (d sqrt(rho)); 0 = no approach (the controller alone).
   double speed_scale = 0.0;
   double height = 0.0;  ///< bed height h the speeds and the time-limit rule refer to (m)
+  double bulk_density = 0.0;  ///< rho_b of the bed (kg/m^3), for the stress-wave transit time
   double inertial_number = 0.0;
   double approach_inertial_number = 0.0;
 };
@@ -155,15 +159,18 @@ struct PistonBed {
   sim::HealthLimits limits;
   PhaseCost filled, settled;  ///< the phases that built it
 };
-/// Builds the die world, lets `set_laws` replace wall laws (e.g. stiff or adhesive piston and
-/// bottom), sets dt = safety * critical over all laws, settles, and adds the piston at the bed top.
 /// Records the bed's fill and settle phases in `out`; `depending` are the metrics read from the
 /// settled state (its height).
-void add_bed_phases(LabOutput& out, const PistonBed& bed, const std::vector<std::string>& depending);
+void add_bed_phases(LabOutput& out, const PistonBed& bed,
+                    const std::vector<std::string>& depending);
 /// Records a servo phase under `name`, flagging `depending` if it did not reach its target.
 void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string& name,
                      const std::vector<std::string>& depending);
+/// Builds the die world, lets `set_laws` replace wall laws (e.g. stiff or adhesive piston and
+/// bottom), sets dt = safety * critical over all laws, settles relative to `stress_level` (the
+/// largest stress the test applies, simulated; BedSpec::rest_stress), and adds the piston at the
+/// bed top.
 PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, double safety,
-                          const RunOptions& options,
+                          double stress_level, const RunOptions& options,
                           const std::function<void(sim::World&)>& set_laws);
 }  // namespace demcal::lab

@@ -15,8 +15,7 @@
 
 namespace demcal::lab {
 
-ServoSettings make_servo(const sim::World& w, double h, double stress_max,
-                         const ServoRequest& r) {
+ServoSettings make_servo(const sim::World& w, double h, double stress_max, const ServoRequest& r) {
   const auto& p = w.particles;
   double d = 0.0, rho = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -30,9 +29,11 @@ ServoSettings make_servo(const sim::World& w, double h, double stress_max,
   // largest stress.
   s.speed_scale = h / (d * std::sqrt(rho));
   s.height = h;
+  s.bulk_density = 0.6 * rho;  // a settled bed, for the order of the stress-wave transit time
   s.inertial_number = r.inertial_number;
   s.approach_inertial_number = r.approach_inertial_number;
-  s.max_speed = r.max_speed > 0.0 ? r.max_speed : r.inertial_number * s.speed_scale * std::sqrt(stress_max);
+  s.max_speed =
+      r.max_speed > 0.0 ? r.max_speed : r.inertial_number * s.speed_scale * std::sqrt(stress_max);
   if (r.approach_inertial_number <= 0.0) s.speed_scale = 0.0;
   // Full speed at an error of the whole largest stress: slow enough that the loop stays well
   // behind the bed's elastic wave transit time for usual bulk stiffnesses.
@@ -51,11 +52,12 @@ LabOutput run_confined_compression(const MaterialModel& material, const Settings
   const double fs = material.factors().stress;
   const auto stiff_wall =
       simulated_law(material, stiffen_normal(material.wall_law, s.wall_stiffness_factor));
-  PistonBed bed = make_piston_bed(material, static_cast<std::size_t>(s.particles),
-                                  s.time_step_safety, options, [&](sim::World& w) {
-                                    w.set_wall_law(kWallPiston, 0, stiff_wall);
-                                    w.set_wall_law(kWallBottom, 0, stiff_wall);
-                                  });
+  PistonBed bed =
+      make_piston_bed(material, static_cast<std::size_t>(s.particles), s.time_step_safety,
+                      s.max_stress * fs, options, [&](sim::World& w) {
+                        w.set_wall_law(kWallPiston, 0, stiff_wall);
+                        w.set_wall_law(kWallBottom, 0, stiff_wall);
+                      });
   sim::World& w = bed.world;
   LabOutput out;
   add_bed_phases(out, bed, {"compressibility", "confined_modulus"});

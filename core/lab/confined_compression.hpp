@@ -36,15 +36,24 @@ namespace demcal::lab {
       {"hold_steps",  "-", 10,                                                                   \
        1e7,           400, "steps over which the mean stress must be within tolerance",          \
        &S::hold_steps},                                                                          \
-      {"servo_inertial_number", "-", 1e-5, 0.1, 2e-3,                                            \
+      {"servo_inertial_number",                                                                  \
+       "-",                                                                                      \
+       1e-5,                                                                                     \
+       0.1,                                                                                      \
+       2e-3,                                                                                     \
        "inertial number of the wall at its target (quasi-static; docs/lab-tests.md)",            \
        &S::servo_inertial_number},                                                               \
-      {"approach_inertial_number", "-", 0.0, 0.1, 1e-2,                                          \
-       "inertial number of the approach far from the target; 0 = no approach (controller only)", \
+      {"approach_inertial_number",                                                               \
+       "-",                                                                                      \
+       0.0,                                                                                      \
+       0.1,                                                                                      \
+       0.0,                                                                                      \
+       "inertial number of the approach far from the target; 0 = no approach (the default: it "  \
+       "changes the cycle stiffnesses, docs/lab-tests.md)",                                      \
        &S::approach_inertial_number},                                                            \
   {                                                                                              \
     "max_phase_time", "s", 0.0, 1e4, 0.0,                                                        \
-        "simulated time limit of one servo phase; 0 = by the rule of docs/lab-tests.md",     \
+        "simulated time limit of one servo phase; 0 = by the rule of docs/lab-tests.md",         \
         &S::max_phase_time                                                                       \
   }
 
@@ -84,9 +93,9 @@ struct ServoRequest {
 };
 template <class S>
 ServoRequest servo_request(const S& s) {
-  return {s.servo_max_speed, s.servo_kp,       s.servo_ki,
-          s.servo_kd,        s.servo_tolerance, s.hold_steps,
-          s.max_phase_time,  s.servo_inertial_number, s.approach_inertial_number};
+  return {s.servo_max_speed,         s.servo_kp,   s.servo_ki,       s.servo_kd,
+          s.servo_tolerance,         s.hold_steps, s.max_phase_time, s.servo_inertial_number,
+          s.approach_inertial_number};
 }
 
 /// Servo settings from the exposed values: automatic speed limit (the inertial number

@@ -42,8 +42,7 @@ PhaseCost PhaseClock::stop(const sim::World& world, std::string name, std::strin
   c.target = std::move(target);
   c.steps = world.step_count - steps0_;
   c.simulated_time = world.time - time0_;
-  c.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+  c.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
   c.reached = reached;
   return c;
 }

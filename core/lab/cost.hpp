@@ -44,8 +44,7 @@ class PhaseClock {
   explicit PhaseClock(const sim::World& world);
   /// Starts at step 0, time 0: for the phase that creates the world.
   PhaseClock();
-  PhaseCost stop(const sim::World& world, std::string name, std::string target,
-                 bool reached) const;
+  PhaseCost stop(const sim::World& world, std::string name, std::string target, bool reached) const;
 
  private:
   std::int64_t steps0_ = 0;

@@ -212,7 +212,8 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
       ++n;
       centri = centri && centrifuging(w, radius);
     });
-    out.add_phase(rpm_clock.stop(w, std::to_string(rpm) + " rpm", "area_time of turning", true), {});
+    out.add_phase(rpm_clock.stop(w, std::to_string(rpm) + " rpm", "area_time of turning", true),
+                  {});
     const double csa = n ? sum / n : 0.0;
     out.metrics["csa_occupied_" + std::to_string(rpm)] = csa;
     out.metrics["centrifuging_" + std::to_string(rpm)] = centri ? 1.0 : 0.0;

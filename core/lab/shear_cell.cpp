@@ -101,6 +101,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
 
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.0;
+  settle_spec.rest_stress = kShearPreKPa * 1e3 * s.stress_scale;
   const PhaseCost settled = settle(w, settle_spec, limits);
 
   // The head: its disk half a diameter above the bed top, vanes reaching into the bed's top.
@@ -226,9 +227,8 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
     std::snprintf(step_name, sizeof step_name, "shear step %g kPa", kShearNormalKPa[k]);
     out.add_phase(step_clock.stop(v, step_name, "yield: tips moved 1.5 diameters within the time",
                                   angle * r_head >= 1.5 * d),
-                  {"yield_locus_slope", "yield_locus_intercept", "ffc",
-                   "effective_friction_angle", "mohr_consistent", "unconfined_yield_strength",
-                   "major_consolidation_stress"});
+                  {"yield_locus_slope", "yield_locus_intercept", "ffc", "effective_friction_angle",
+                   "mohr_consistent", "unconfined_yield_strength", "major_consolidation_stress"});
     points.rows.push_back({sigma_x / 1e3, sig_at_max / 1e3, tau_max / 1e3});
     // The locus uses the normal stress measured on the floor at the yield point.
     xs.push_back(sig_at_max / 1e3);

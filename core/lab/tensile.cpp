@@ -68,17 +68,17 @@ LabOutput run_tensile(const MaterialModel& material, const Settings& values,
   const auto adhesive_law = simulated_law(material, adhesive);
   const auto die_law = simulated_law(material, die);
 
-  PistonBed bed = make_piston_bed(material, static_cast<std::size_t>(s.particles),
-                                  s.time_step_safety, options, [&](sim::World& w) {
-                                    w.set_wall_law(kWallPiston, 0, adhesive_law);
-                                    w.set_wall_law(kWallBottom, 0, adhesive_law);
-                                    w.set_wall_law(kWallDie, 0, die_law);
-                                  });
+  PistonBed bed =
+      make_piston_bed(material, static_cast<std::size_t>(s.particles), s.time_step_safety,
+                      s.consolidation_stress * fs, options, [&](sim::World& w) {
+                        w.set_wall_law(kWallPiston, 0, adhesive_law);
+                        w.set_wall_law(kWallBottom, 0, adhesive_law);
+                        w.set_wall_law(kWallDie, 0, die_law);
+                      });
   sim::World& w = bed.world;
   LabOutput out;
   add_bed_phases(out, bed, {});
-  const ServoSettings servo =
-      make_servo(w, bed.h0, s.consolidation_stress * fs, servo_request(s));
+  const ServoSettings servo = make_servo(w, bed.h0, s.consolidation_stress * fs, servo_request(s));
   auto phase = [&](double target_real) {
     ServoSettings ps = servo;
     ps.tolerance = std::max(servo.tolerance * target_real, 2e-3 * s.consolidation_stress) * fs;

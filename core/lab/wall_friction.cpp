@@ -34,18 +34,18 @@ LabOutput run_wall_friction(const MaterialModel& material, const Settings& value
   bottom_spec.tangential.params["mu_s"] = s.bottom_friction;
   const auto piston_law = simulated_law(material, piston_spec);
   const auto bottom_law = simulated_law(material, bottom_spec);
-  PistonBed bed = make_piston_bed(material, static_cast<std::size_t>(s.particles),
-                                  s.time_step_safety, options, [&](sim::World& w) {
-                                    w.set_wall_law(kWallPiston, 0, piston_law);
-                                    w.set_wall_law(kWallBottom, 0, bottom_law);
-                                  });
+  PistonBed bed = make_piston_bed(
+      material, static_cast<std::size_t>(s.particles), s.time_step_safety,
+      wall_friction_stresses().back() * s.stress_factor * fs, options, [&](sim::World& w) {
+        w.set_wall_law(kWallPiston, 0, piston_law);
+        w.set_wall_law(kWallBottom, 0, bottom_law);
+      });
   sim::World& w = bed.world;
   LabOutput out;
   add_bed_phases(out, bed, {});
   const auto& stresses = wall_friction_stresses();
   const double s_max = stresses.back() * s.stress_factor * fs;
-  const ServoSettings servo =
-      make_servo(w, bed.h0, s_max, servo_request(s));
+  const ServoSettings servo = make_servo(w, bed.h0, s_max, servo_request(s));
   double d_mean = 0.0;
   for (double r : w.particles.radius) d_mean += 2.0 * r;
   d_mean /= static_cast<double>(w.particles.size());
@@ -69,7 +69,8 @@ LabOutput run_wall_friction(const MaterialModel& material, const Settings& value
     ps.retreat_limit = floor_z;
     piston.omega = {};
     const std::string at = stress_text(sigma_real * s.stress_factor);
-    add_servo_phase(out, servo_phase(w, bottom, bed.piston, {0, 0, 1}, bed.area, target, ps, bed.limits),
+    add_servo_phase(out,
+                    servo_phase(w, bottom, bed.piston, {0, 0, 1}, bed.area, target, ps, bed.limits),
                     "press " + at, {"wall_friction_angle"});
     // Turn at constant normal stress: the same servo runs through the whole turn (a tolerance
     // that always holds, a hold time of the turn), torque averaged over its second half.
