@@ -1,0 +1,84 @@
+// Where the time of a lab test goes (the cost block) and phases that must reach their targets:
+// every phase is recorded with its steps and times, a phase that misses its target flags the
+// metrics computed from it, and the seed-000 lactose material (LH220 of examples/) reaches every
+// target of a confined compression with the default protocol.
+#include <gtest/gtest.h>
+
+#include <numeric>
+
+#include "core/io/yaml_node.hpp"
+#include "core/lab/lab_spec.hpp"
+#include "lab_test_util.hpp"
+
+namespace demcal::lab {
+namespace {
+
+Settings one_cycle(double particles) {
+  return {{"particles", particles}, {"cycles", 1}, {"wall_stiffness_factor", 1}};
+}
+
+TEST(PhaseCost, EveryPhaseOfAConfinedCompressionIsRecorded) {
+  const LabOutput out =
+      run_lab_test("confined_compression", testing::soft_luding(), one_cycle(120), {});
+  const RunCost& c = out.cost;
+  EXPECT_GT(c.time_step, 0.0);
+  EXPECT_NE(c.time_step_limit.find("sqrt(m/k)"), std::string::npos) << c.time_step_limit;
+  EXPECT_EQ(c.particles, 120u);
+  std::vector<std::string> names;
+  std::int64_t steps = 0;
+  for (const auto& p : c.phases) {
+    names.push_back(p.name);
+    steps += p.steps;
+    EXPECT_TRUE(p.reached) << p.name << ": " << p.target;
+    EXPECT_FALSE(p.target.empty());
+    EXPECT_GE(p.wall_seconds, 0.0);
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"fill", "settle", "load 1", "unload 1", "load 2",
+                                             "final unload"}));
+  EXPECT_EQ(c.steps, steps);
+  EXPECT_NEAR(c.simulated_time, static_cast<double>(steps) * c.time_step, 1e-9 * c.simulated_time);
+  EXPECT_GT(c.wall_seconds, 0.0);
+  EXPECT_GT(c.particle_steps_per_second(), 0.0);
+  EXPECT_TRUE(out.flags.empty());
+}
+
+TEST(PhaseCost, APhaseShortOfItsTargetFlagsItsMetrics) {
+  // A time limit of 200 steps: the first load cannot reach 15 kPa, so every metric computed
+  // from it is flagged with the phase's name, and the final unload's metric is not.
+  Settings s = one_cycle(120);
+  s["max_phase_time"] = 1e-4;
+  const LabOutput out = run_lab_test("confined_compression", testing::soft_luding(), s, {});
+  const PhaseCost& load = out.cost.phases.at(2);
+  ASSERT_EQ(load.name, "load 1");
+  EXPECT_FALSE(load.reached);
+  for (const char* m : {"compressibility", "k_load", "k_unload", "confined_modulus"}) {
+    ASSERT_TRUE(out.flags.count(m)) << m;
+    EXPECT_NE(out.flags.at(m).find("'load 1' did not reach stress"), std::string::npos)
+        << out.flags.at(m);
+  }
+  const bool final_reached = out.cost.phases.back().reached;
+  EXPECT_EQ(out.flags.count("final_solid_fraction") == 0, final_reached);
+}
+
+TEST(PhaseCost, Lh220ReachesEveryTargetOfAConfinedCompression) {
+  // The material of examples/lh220_diagnosis_campaign.yaml (seed 000 Tables 4-6, SF 10).
+  const auto material = read_material(io::YamlNode::load_string(R"(
+particle_law:
+  normal: {model: luding, youngs_modulus: 3.0e7, k2_ratio: 16, kc_ratio: 0.2, phi_f: 0.02, restitution: 0.65}
+  cohesion: {model: van_der_waals, hamaker: 5.0e-18, d_min: 4.0e-10, d_max: 1.0e-7}
+  tangential: {model: history, mu_s: 0.6, mu_d_ratio: 0.75, kt_ratio: 0.6, gamma_t_ratio: 0.6}
+  rolling: {model: cdt, mu_r: 0.1}
+sizes: {monodisperse: {radius: 1.0e-4}}
+density: 1545
+scaling: {law: kottlan2018, factor: 10}
+)"));
+  Settings s = one_cycle(100);
+  s["wall_stiffness_factor"] = 3;
+  const LabOutput out = run_lab_test("confined_compression", material, s, {});
+  for (const auto& p : out.cost.phases) EXPECT_TRUE(p.reached) << p.name << ": " << p.target;
+  EXPECT_TRUE(out.flags.empty());
+  EXPECT_GT(out.metrics.at("compressibility"), 5.0);
+}
+
+}  // namespace
+}  // namespace demcal::lab
