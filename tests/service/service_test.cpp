@@ -3,6 +3,7 @@
 // Complete from an expired lease, invalid specs, missing or wrong tokens, and the CLI end to
 // end. Leases and heartbeats are short (flags); every wait is bounded.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <sqlite3.h>
 
 #include <filesystem>
@@ -408,6 +409,16 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
   EXPECT_GE(jobs_by_worker["embedded-1"], 1) << out;
   EXPECT_GE(jobs_by_worker["embedded-2"], 1) << out;
   EXPECT_EQ(jobs_by_worker["embedded-1"] + jobs_by_worker["embedded-2"], 6);  // 5 runs + verify
+  // Every stored result carries the worker's cost block, with its phases and steps.
+  int with_cost = 0;
+  each_row(path("work/campaign.db"), "SELECT cost_json FROM results", [&](sqlite3_stmt* st) {
+    const auto cost =
+        nlohmann::json::parse(reinterpret_cast<const char*>(sqlite3_column_text(st, 0)));
+    EXPECT_GT(std::stoll(cost.at("steps").get<std::string>()), 0) << cost.dump();
+    EXPECT_EQ(cost.at("phases").at(1).at("name"), "settle") << cost.dump();
+    ++with_cost;
+  });
+  EXPECT_EQ(with_cost, 6);
   // A bad spec is refused before anything runs, naming the file, line and field.
   std::string bad = tiny_spec(60);
   bad.replace(bad.find("density: 2500"), 13, "densty: 2500");

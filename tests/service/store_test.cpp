@@ -60,6 +60,24 @@ TEST(Store, LeasesInRunOrderAndStoresAResultExactlyOnce) {
   EXPECT_EQ(s.campaign(id)->state, "done");
 }
 
+TEST(Store, KeepsTheFlagsAndTheCostOfAResult) {
+  Store s(":memory:");
+  s.create_campaign("c", "{}", "{}", jobs(2), 0.0);
+  const auto a = s.lease("w1", 1.0);
+  ASSERT_TRUE(a);
+  const std::string flags = R"({"x":"phase 'load 1' did not reach stress 150 Pa"})";
+  const std::string cost = R"({"steps":"12","phases":[{"name":"settle","reached":true}]})";
+  EXPECT_TRUE(s.complete(a->id, 1, "w1", R"({"x":1})", 0.5, 2.0, flags, cost));
+  EXPECT_EQ(s.job(a->id)->flags_json, flags);
+  EXPECT_EQ(s.job(a->id)->cost_json, cost);
+  // A result stored without them reads as empty objects.
+  const auto b = s.lease("w2", 3.0);
+  ASSERT_TRUE(b);
+  EXPECT_TRUE(s.complete(b->id, 1, "w2", "{}", 0.5, 4.0));
+  EXPECT_EQ(s.job(b->id)->flags_json, "{}");
+  EXPECT_EQ(s.job(b->id)->cost_json, "{}");
+}
+
 TEST(Store, LateCompleteOfAnExpiredLeaseIsRefusedAndTheNewLeaseWins) {
   Store s(":memory:", {10.0, 3});
   s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
