@@ -1,10 +1,10 @@
 #include "server/services.hpp"
 
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "core/common/error.hpp"
@@ -351,8 +351,8 @@ grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::Com
   if (const std::string error = result_extras_error(*req); !error.empty())
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
   std::map<std::string, double> metrics(req->metrics().begin(), req->metrics().end());
-  const nlohmann::json flags(std::map<std::string, std::string>(req->flags().begin(),
-                                                                 req->flags().end()));
+  const nlohmann::json flags(
+      std::map<std::string, std::string>(req->flags().begin(), req->flags().end()));
   if (!store_.complete(req->job_id(), req->attempt(), req->worker(), metrics_to_json(metrics),
                        req->wall_seconds(), now_seconds(), flags.dump(), to_json(req->cost()))) {
     spdlog::warn("job {}: result of attempt {} from {} rejected (not the current lease)",

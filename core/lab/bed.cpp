@@ -155,7 +155,10 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
     volume += 4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3);
   }
   const double rho = volume > 0.0 ? mass / volume : 0.0;
-  const double sigma = spec.rest_stress > 0.0 ? spec.rest_stress : weight_stress(w);
+  // The bed height the tests start from is read at rest under the bed's own weight: the
+  // reference is that weight stress, or the test's stress level where it is lower.
+  const double weight = weight_stress(w);
+  const double sigma = spec.rest_stress > 0.0 ? std::min(spec.rest_stress, weight) : weight;
   // rho <v^2> < I^2 sigma with <v^2> = 2 KE / M.
   const double ke_limit =
       0.5 * mass * spec.rest_inertial_number * spec.rest_inertial_number * sigma / rho;

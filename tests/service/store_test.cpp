@@ -230,7 +230,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 2);
+    EXPECT_EQ(Store::latest_schema_version(), 3);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
@@ -248,6 +248,8 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
     ASSERT_TRUE(js[0].metrics_json);
     EXPECT_EQ(*js[0].metrics_json, R"({"solid_fraction":0.61})");
     EXPECT_DOUBLE_EQ(js[0].wall_seconds, 12.5);
+    EXPECT_EQ(js[0].flags_json, "{}");  // a result from before flags and costs: none recorded
+    EXPECT_EQ(js[0].cost_json, "{}");
     EXPECT_EQ(s.result_count(1), 1);
 
     const auto ids = s.add_jobs(1, {{1, 1, "packing", "diagnose:shape", "{}"}});
@@ -262,7 +264,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());  // reopening does not migrate again
-    EXPECT_EQ(s.schema_version(), 2);
+    EXPECT_EQ(s.schema_version(), 3);
     EXPECT_EQ(s.jobs(1).size(), 2u);
   }
   std::filesystem::remove(path);
