@@ -1,12 +1,23 @@
 #include "core/io/scene_yaml.hpp"
 
+#include <filesystem>
+
 #include "core/common/rng.hpp"
 #include "core/io/contact_law_yaml.hpp"
+#include "core/io/liggghts_data.hpp"
+#include "core/io/stl.hpp"
 #include "core/particles/insertion.hpp"
 #include "core/sim/time_step.hpp"
 
 namespace demcal::io {
 namespace {
+
+/// A path from the scene, relative to the scene file's folder unless absolute.
+std::string scene_path(const YamlNode& n) {
+  const std::filesystem::path p = n.as_string();
+  if (p.is_absolute() || !std::filesystem::exists(n.file())) return p.string();
+  return (std::filesystem::path(n.file()).parent_path() / p).string();
+}
 
 walls::Shape read_shape(const YamlNode& n) {
   if (auto p = n.child("plane")) {
@@ -26,11 +37,16 @@ walls::Shape read_shape(const YamlNode& n) {
     return walls::Disk{(*d)["centre"].as_vec3(), normalized((*d)["normal"].as_vec3()),
                        (*d)["radius"].as_number()};
   }
-  n.fail("a wall needs one of: plane, cylinder, disk");
+  if (auto m = n.child("mesh")) {
+    m->expect_only({"stl", "scale"});
+    return read_stl(scene_path((*m)["stl"]), m->number("scale", 1.0));
+  }
+  n.fail("a wall needs one of: plane, cylinder, disk, mesh");
 }
 
 walls::Wall read_wall(const YamlNode& n) {
-  n.expect_only({"name", "plane", "cylinder", "disk", "velocity", "angular_velocity", "pivot"});
+  n.expect_only(
+      {"name", "plane", "cylinder", "disk", "mesh", "velocity", "angular_velocity", "pivot"});
   walls::Wall w = walls::make_wall(n["name"].as_string(), read_shape(n));
   if (auto v = n.child("velocity")) w.velocity = v->as_vec3();
   if (auto o = n.child("angular_velocity")) w.omega = o->as_vec3();
@@ -52,8 +68,10 @@ particles::Region read_region(const YamlNode& n) {
 }
 
 void read_particles(const YamlNode& n, sim::World& world, double density, Rng& rng) {
-  n.expect_only({"lattice", "random", "list"});
-  if (auto list = n.child("list")) {
+  n.expect_only({"lattice", "random", "list", "data_file"});
+  if (auto file = n.child("data_file")) {
+    read_liggghts_data(scene_path(*file), world.particles);
+  } else if (auto list = n.child("list")) {
     for (const auto& item : list->items()) {
       item.expect_only({"radius", "position", "velocity", "angular_velocity", "density"});
       const double r = item["radius"].as_number();
@@ -81,7 +99,7 @@ void read_particles(const YamlNode& n, sim::World& world, double density, Rng& r
     req.gap = r->number("gap", 0.0);
     particles::insert_random(world.particles, req, rng);
   } else {
-    n.fail("particles need one of: lattice, random, list");
+    n.fail("particles need one of: lattice, random, list, data_file");
   }
 }
 
@@ -144,9 +162,11 @@ Scene read_scene(const YamlNode& root) {
     w.dt = sim::recommended_time_step(w, root.number("time_step_safety", 0.2));
   }
   for (const auto& item : root["phases"].items()) {
-    item.expect_only({"name", "steps"});
-    scene.phases.push_back(
-        {item["name"].as_string(), static_cast<long>(item["steps"].as_number())});
+    item.expect_only({"name", "steps", "record_every"});
+    scene.phases.push_back({item["name"].as_string(),
+                            static_cast<long>(item["steps"].as_number()),
+                            static_cast<long>(item.number("record_every", 0))});
+    if (scene.phases.back().record_every < 0) item["record_every"].fail("must be >= 0");
   }
   return scene;
 }

@@ -4,12 +4,15 @@
 //   domain: {lo, hi, periodic: [bool, bool, bool]}
 //   density, contact_law, wall_contact_law (default: contact_law)
 //   walls: [{name, plane: {point, normal}} | {name, cylinder: {point, axis, radius, lo, hi}}
-//           | {name, disk: {centre, normal, radius}}, optional velocity, angular_velocity]
+//           | {name, disk: {centre, normal, radius}} | {name, mesh: {stl, scale}},
+//           optional velocity, angular_velocity]
 //   particles: {lattice: {origin, spacing, counts, radius, jitter}}
 //            | {random: {region: {box: {lo, hi}} | {cylinder: {centre, radius, z_lo, z_hi}},
 //                        count, sizes}}
 //            | {list: [{radius, position, velocity, angular_velocity, density}]}
-//   phases: [{name, steps}]
+//            | {data_file: PATH}  (LIGGGHTS data file, core/io/liggghts_data.hpp)
+//   phases: [{name, steps, record_every}]  (record_every: steps between wall records, 0 = none)
+// File paths (stl, data_file) are relative to the scene file's folder.
 #include <string>
 #include <vector>
 
@@ -22,6 +25,7 @@ namespace demcal::io {
 struct Phase {
   std::string name;
   long steps = 0;
+  long record_every = 0;  ///< steps between records of every wall's force and displacement
 };
 
 struct Scene {

@@ -38,6 +38,8 @@ class YamlNode {
   std::string string(const std::string& key, const std::string& fallback) const;
 
   const std::string& path() const { return path_; }
+  /// The file this node was read from ("<string>" or the given name for a string).
+  const std::string& file() const { return file_; }
   /// "file:line: path" for error messages.
   std::string where() const;
   [[noreturn]] void fail(const std::string& what) const;

@@ -12,6 +12,17 @@ void Mesh::append(const Mesh& other) {
   vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());
   for (const auto& t : other.triangles)
     triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  fitted = false;
+}
+
+void Mesh::fit_bounds() {
+  lo = hi = vertices.empty() ? Vec3{} : vertices.front();
+  for (const auto& v : vertices)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], v[k]);
+      hi[k] = std::max(hi[k], v[k]);
+    }
+  fitted = true;
 }
 
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
@@ -65,6 +76,9 @@ int mesh_contacts(const Mesh& mesh, const Vec3& x, double r, double range, WallG
   std::array<Candidate, kMaxCandidates> cand;
   int n_cand = 0;
   const double reach = r + range;
+  if (mesh.fitted)
+    for (int k = 0; k < 3; ++k)
+      if (x[k] + reach < mesh.lo[k] || x[k] - reach > mesh.hi[k]) return 0;
   const auto& v = mesh.vertices;
   for (const auto& t : mesh.triangles) {
     const Vec3 &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];

@@ -29,10 +29,17 @@ struct Mesh {
   static constexpr int kMaxContacts = 4;  ///< contacts kept per particle (nearest first)
   std::vector<Vec3> vertices;
   std::vector<std::array<int, 3>> triangles;
+  /// Bounding box of the vertices, valid while `fitted`: a sphere out of its reach is rejected
+  /// with one test instead of one per triangle. make_wall() and advance() keep a wall's mesh
+  /// fitted; a mesh never fitted (or appended to since) tests every triangle.
+  Vec3 lo, hi;
+  bool fitted = false;
 
   std::size_t size() const { return triangles.size(); }
-  /// Appends another mesh's triangles.
+  /// Appends another mesh's triangles (the mesh is no longer fitted).
   void append(const Mesh& other);
+  /// Sets lo, hi to the vertices' bounding box.
+  void fit_bounds();
 };
 
 /// Nearest point on triangle (a, b, c) to p; `feature` 0 = face, 1..3 = edge ab, bc, ca,

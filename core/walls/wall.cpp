@@ -87,6 +87,7 @@ Wall make_wall(std::string name, Shape shape, std::uint16_t material) {
       },
       shape);
   w.shape = std::move(shape);
+  if (auto* mesh = std::get_if<Mesh>(&w.shape)) mesh->fit_bounds();
   w.material = material;
   return w;
 }
@@ -119,6 +120,7 @@ void advance(Wall& wall, double dt) {
           turn(s.normal);
         } else {
           for (auto& v : s.vertices) move_point(v);
+          if (s.fitted) s.fit_bounds();
         }
       },
       wall.shape);
