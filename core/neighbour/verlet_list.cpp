@@ -158,14 +158,4 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
   ++builds_;
 }
 
-bool VerletList::needs_rebuild(const std::vector<Vec3>& x, double skin, int threads) const {
-  if (x.size() != x_at_build_.size()) return true;
-  const double limit = 0.25 * skin * skin;
-  const int n = static_cast<int>(x.size());
-  double worst = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : worst) num_threads(threads)
-  for (int i = 0; i < n; ++i) worst = std::max(worst, norm2(x[i] - x_at_build_[i]));
-  return worst > limit;
-}
-
 }  // namespace demcal::neighbour

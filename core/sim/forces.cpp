@@ -24,8 +24,139 @@ TypedLaw<N, C, T, R> typed(const contact::ContactLaw& law) {
           std::get<R>(law.rolling)};
 }
 
+/// A force and a torque, e.g. the particles' push on a wall.
+struct Wrench {
+  Vec3 force, torque;
+};
+
+/// Adds the contact forces of wall `wall_index` to the particles [lo, hi) and their reaction to
+/// `on_wall`.
 template <class N, class C, class T, class R>
-void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
+void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wall, const N&,
+                 const C&, const T&, const R&) {
+  using Law = TypedLaw<N, C, T, R>;
+  constexpr int kStride = contact::History<N, C, T, R>::kSize;
+  walls::Wall& wall = w.walls[wall_index];
+  std::vector<Law> laws;
+  for (int m = 0; m < w.materials(); ++m)
+    laws.push_back(typed<N, C, T, R>(w.wall_law(wall.material, m)));
+  double range = 0.0;
+  for (const auto& l : laws) range = std::max(range, l.c.range());
+
+  auto& p = w.particles;
+  double* hist = w.wall_history[wall_index].data();
+  const walls::Mesh* mesh = std::get_if<walls::Mesh>(&wall.shape);
+  {
+    Vec3 wf{}, wt{};
+    auto apply = [&](int i, const walls::WallGeometry& g, double* h) {
+      contact::PairInput in;
+      in.n = g.n;
+      in.delta = g.delta;
+      in.r_i = p.radius[i];
+      in.r_j = 0.0;
+      in.r_star = p.radius[i];
+      in.m_star = p.mass[i];
+      const Vec3 v_rel = p.v[i] - wall.velocity_at(g.point);
+      in.vn = dot(v_rel, in.n);
+      in.vt = v_rel - in.n * in.vn + cross(p.omega[i] * p.radius[i], in.n);
+      in.w_rel = p.omega[i] - wall.omega;
+      in.dt = w.dt;
+      const contact::PairOutput out = laws[p.material[i]].evaluate(in, h);
+      p.f[i] += out.force;
+      p.torque[i] += out.torque_i;
+      wf -= out.force;
+      wt += cross(g.point - wall.pivot, -out.force) + out.torque_j;
+    };
+    if (!mesh) {
+      // Plane, cylinder, disk: at most one contact per particle, one history per particle.
+for (int i = lo; i < hi; ++i) {
+        double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
+        walls::WallGeometry g;
+        if (!walls::wall_geometry(wall.shape, p.x[i], p.radius[i], range, g)) {
+          for (int s = 0; s < kStride; ++s) h[s] = 0.0;
+          continue;
+        }
+        apply(i, g, h);
+      }
+    } else {
+      // Mesh: up to kMaxContacts contacts per particle, each continuing the history slot whose
+      // last normal is nearest its own (within 45 deg), so a contact keeps its tangential spring
+      // while it slides across triangles of one surface or rolls round an edge (mesh.hpp).
+      // Slot layout: [law history (kStride) | last normal (3)]; a zero normal marks a free slot.
+      constexpr int kSlots = walls::Mesh::kMaxContacts;
+      constexpr int kSlot = kStride + 3;
+      constexpr double kSameContact = 0.7071;
+for (int i = lo; i < hi; ++i) {
+        double* h = hist + static_cast<std::ptrdiff_t>(i) * kSlots * kSlot;
+        walls::WallGeometry g[kSlots];
+        const int found = walls::mesh_contacts(*mesh, p.x[i], p.radius[i], range, g);
+        bool used[kSlots] = {};
+        int slot_of[kSlots];
+        for (int c = 0; c < found; ++c) {
+          int best = -1;
+          double best_dot = kSameContact;
+          for (int s = 0; s < kSlots; ++s) {
+            if (used[s]) continue;
+            const double* hn = h + s * kSlot + kStride;
+            const double d = hn[0] * g[c].n.x + hn[1] * g[c].n.y + hn[2] * g[c].n.z;
+            if (d > best_dot) {
+              best_dot = d;
+              best = s;
+            }
+          }
+          slot_of[c] = best;
+          if (best >= 0) used[best] = true;
+        }
+        // New contacts take free slots (a slot not continued this step starts afresh).
+        for (int c = 0; c < found; ++c) {
+          if (slot_of[c] >= 0) continue;
+          for (int s = 0; s < kSlots; ++s)
+            if (!used[s]) {
+              slot_of[c] = s;
+              used[s] = true;
+              for (int k = 0; k < kStride; ++k) h[s * kSlot + k] = 0.0;
+              break;
+            }
+        }
+        for (int s = 0; s < kSlots; ++s)
+          if (!used[s])
+            for (int k = 0; k < kSlot; ++k) h[s * kSlot + k] = 0.0;
+        for (int c = 0; c < found; ++c) {
+          double* hs = h + slot_of[c] * kSlot;
+          hs[kStride] = g[c].n.x;
+          hs[kStride + 1] = g[c].n.y;
+          hs[kStride + 2] = g[c].n.z;
+          apply(i, g[c], hs);
+        }
+      }
+    }
+    on_wall = {wf, wt};
+  }
+}
+
+void add_wall_forces(World& w, std::size_t k, int lo, int hi, Wrench& on_wall) {
+  const int m0 = w.particles.material[0];
+  contact::visit(w.wall_law(w.walls[k].material, m0),
+                 [&](const auto& n, const auto& c, const auto& t, const auto& r) {
+                   wall_kernel(w, k, lo, hi, on_wall, n, c, t, r);
+                 });
+}
+
+/// The wall's force and torque: the threads' parts in thread order.
+void sum_wall_wrench(walls::Wall& wall, const std::vector<Wrench>& parts) {
+  wall.force = {};
+  wall.torque = {};
+  for (const Wrench& part : parts) {
+    wall.force += part.force;
+    wall.torque += part.torque;
+  }
+}
+
+
+/// The force region: every thread resets and sums the forces of the particles it owns (pairs,
+/// then walls), then runs `after` on them.
+template <class N, class C, class T, class R>
+void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, const T&, const R&) {
   using Law = TypedLaw<N, C, T, R>;
   constexpr int kStride = contact::History<N, C, T, R>::kSize;
   const int n_mat = w.materials();
@@ -44,6 +175,8 @@ void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
   const bool periodic = w.domain.any_periodic();
   const double dt = w.dt;
   const int threads = w.threads;
+  // Each wall's force and torque, per thread, summed in thread order after the region.
+  std::vector<std::vector<Wrench>> on_walls(w.walls.size(), std::vector<Wrench>(threads));
 
   if (static_cast<int>(w.deferred.size()) != threads) w.deferred.assign(threads, {});
 
@@ -54,8 +187,7 @@ void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
 #pragma omp parallel num_threads(threads)
   {
     const int tid = omp_get_thread_num();
-    const int lo = static_cast<int>(static_cast<long>(n) * tid / threads);
-    const int hi = static_cast<int>(static_cast<long>(n) * (tid + 1) / threads);
+    const auto [lo, hi] = owned_range(n, tid, threads);
     auto& deferred = w.deferred[tid];
     deferred.clear();
     for (int i = lo; i < hi; ++i) {
@@ -112,142 +244,23 @@ void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
           p.f[c.particle] += c.force;
           p.torque[c.particle] += c.torque;
         }
+    for (std::size_t k = 0; k < w.walls.size(); ++k) add_wall_forces(w, k, lo, hi, on_walls[k][tid]);
+    if (after) after(lo, hi);
   }
-}
-
-template <class N, class C, class T, class R>
-void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&, const R&) {
-  using Law = TypedLaw<N, C, T, R>;
-  constexpr int kStride = contact::History<N, C, T, R>::kSize;
-  walls::Wall& wall = w.walls[wall_index];
-  std::vector<Law> laws;
-  for (int m = 0; m < w.materials(); ++m)
-    laws.push_back(typed<N, C, T, R>(w.wall_law(wall.material, m)));
-  double range = 0.0;
-  for (const auto& l : laws) range = std::max(range, l.c.range());
-
-  auto& p = w.particles;
-  const int n = static_cast<int>(p.size());
-  double* hist = w.wall_history[wall_index].data();
-  const int threads = w.threads;
-  std::vector<Vec3> part_force(threads), part_torque(threads);
-
-  const walls::Mesh* mesh = std::get_if<walls::Mesh>(&wall.shape);
-
-#pragma omp parallel num_threads(threads)
-  {
-    const int tid = omp_get_thread_num();
-    Vec3 wf{}, wt{};
-    auto apply = [&](int i, const walls::WallGeometry& g, double* h) {
-      contact::PairInput in;
-      in.n = g.n;
-      in.delta = g.delta;
-      in.r_i = p.radius[i];
-      in.r_j = 0.0;
-      in.r_star = p.radius[i];
-      in.m_star = p.mass[i];
-      const Vec3 v_rel = p.v[i] - wall.velocity_at(g.point);
-      in.vn = dot(v_rel, in.n);
-      in.vt = v_rel - in.n * in.vn + cross(p.omega[i] * p.radius[i], in.n);
-      in.w_rel = p.omega[i] - wall.omega;
-      in.dt = w.dt;
-      const contact::PairOutput out = laws[p.material[i]].evaluate(in, h);
-      p.f[i] += out.force;
-      p.torque[i] += out.torque_i;
-      wf -= out.force;
-      wt += cross(g.point - wall.pivot, -out.force) + out.torque_j;
-    };
-    if (!mesh) {
-      // Plane, cylinder, disk: at most one contact per particle, one history per particle.
-#pragma omp for schedule(static)
-      for (int i = 0; i < n; ++i) {
-        double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
-        walls::WallGeometry g;
-        if (!walls::wall_geometry(wall.shape, p.x[i], p.radius[i], range, g)) {
-          for (int s = 0; s < kStride; ++s) h[s] = 0.0;
-          continue;
-        }
-        apply(i, g, h);
-      }
-    } else {
-      // Mesh: up to kMaxContacts contacts per particle, each continuing the history slot whose
-      // last normal is nearest its own (within 45 deg), so a contact keeps its tangential spring
-      // while it slides across triangles of one surface or rolls round an edge (mesh.hpp).
-      // Slot layout: [law history (kStride) | last normal (3)]; a zero normal marks a free slot.
-      constexpr int kSlots = walls::Mesh::kMaxContacts;
-      constexpr int kSlot = kStride + 3;
-      constexpr double kSameContact = 0.7071;
-#pragma omp for schedule(static)
-      for (int i = 0; i < n; ++i) {
-        double* h = hist + static_cast<std::ptrdiff_t>(i) * kSlots * kSlot;
-        walls::WallGeometry g[kSlots];
-        const int found = walls::mesh_contacts(*mesh, p.x[i], p.radius[i], range, g);
-        bool used[kSlots] = {};
-        int slot_of[kSlots];
-        for (int c = 0; c < found; ++c) {
-          int best = -1;
-          double best_dot = kSameContact;
-          for (int s = 0; s < kSlots; ++s) {
-            if (used[s]) continue;
-            const double* hn = h + s * kSlot + kStride;
-            const double d = hn[0] * g[c].n.x + hn[1] * g[c].n.y + hn[2] * g[c].n.z;
-            if (d > best_dot) {
-              best_dot = d;
-              best = s;
-            }
-          }
-          slot_of[c] = best;
-          if (best >= 0) used[best] = true;
-        }
-        // New contacts take free slots (a slot not continued this step starts afresh).
-        for (int c = 0; c < found; ++c) {
-          if (slot_of[c] >= 0) continue;
-          for (int s = 0; s < kSlots; ++s)
-            if (!used[s]) {
-              slot_of[c] = s;
-              used[s] = true;
-              for (int k = 0; k < kStride; ++k) h[s * kSlot + k] = 0.0;
-              break;
-            }
-        }
-        for (int s = 0; s < kSlots; ++s)
-          if (!used[s])
-            for (int k = 0; k < kSlot; ++k) h[s * kSlot + k] = 0.0;
-        for (int c = 0; c < found; ++c) {
-          double* hs = h + slot_of[c] * kSlot;
-          hs[kStride] = g[c].n.x;
-          hs[kStride + 1] = g[c].n.y;
-          hs[kStride + 2] = g[c].n.z;
-          apply(i, g[c], hs);
-        }
-      }
-    }
-    part_force[tid] = wf;
-    part_torque[tid] = wt;
-  }
-  wall.force = {};
-  wall.torque = {};
-  for (int t = 0; t < threads; ++t) {
-    wall.force += part_force[t];
-    wall.torque += part_torque[t];
-  }
+  for (std::size_t k = 0; k < w.walls.size(); ++k) sum_wall_wrench(w.walls[k], on_walls[k]);
 }
 
 }  // namespace
 
-void compute_pair_forces(World& world) {
-  if (world.particles.size() == 0) return;
-  contact::visit(world.pair_law(0, 0), [&](const auto& n, const auto& c, const auto& t,
-                                           const auto& r) { pair_kernel(world, n, c, t, r); });
-}
-
-void compute_wall_forces(World& world) {
-  const int m0 = world.particles.size() ? world.particles.material[0] : 0;
-  for (std::size_t k = 0; k < world.walls.size(); ++k)
-    contact::visit(world.wall_law(world.walls[k].material, m0),
-                   [&](const auto& n, const auto& c, const auto& t, const auto& r) {
-                     wall_kernel(world, k, n, c, t, r);
-                   });
+void compute_forces(World& world, const OwnedRangeTask& after) {
+  if (world.particles.size() == 0) {
+    for (auto& wall : world.walls) wall.force = wall.torque = {};
+    return;
+  }
+  contact::visit(world.pair_law(0, 0),
+                 [&](const auto& n, const auto& c, const auto& t, const auto& r) {
+                   force_region(world, after, n, c, t, r);
+                 });
 }
 
 }  // namespace demcal::sim
