@@ -108,6 +108,7 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
   old_nbr.swap(nbr);
   row_start.assign(n + 1, 0);
 
+  const MinimumImage image(domain);
   auto for_each_partner = [&](int i, auto&& visit) {
     std::array<int, 27> cells;
     const int nc =
@@ -117,7 +118,7 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
         const int j = cell_items_[k];
         if (j <= i || (body && body[i] >= 0 && body[i] == body[j])) continue;
         const double cut = radius[i] + radius[j] + reach;
-        if (norm2(domain.separation(x[i], x[j])) < cut * cut) visit(j);
+        if (norm2(image(x[j] - x[i])) < cut * cut) visit(j);
       }
   };
 

@@ -24,6 +24,16 @@ TypedLaw<N, C, T, R> typed(const contact::ContactLaw& law) {
           std::get<R>(law.rolling)};
 }
 
+/// Clears the history of a pair beyond reach. Most such pairs were not touching before either:
+/// their history is only read, not written again every step.
+template <int kStride>
+void clear_history(double* h) {
+  bool set = false;
+  for (int s = 0; s < kStride; ++s) set |= h[s] != 0.0;
+  if (set)
+    for (int s = 0; s < kStride; ++s) h[s] = 0.0;
+}
+
 /// A force and a torque, e.g. the particles' push on a wall.
 struct Wrench {
   Vec3 force, torque;
@@ -208,17 +218,20 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
         const double reach = ri + rj + range;
         const double dist2 = norm2(d);
         if (dist2 >= reach * reach) {
-          for (int s = 0; s < kStride; ++s) h[s] = 0.0;
+          clear_history<kStride>(h);
           continue;
         }
         const double dist = std::sqrt(dist2);
+        const double mj = p.mass[j];
+        // R* = ri rj / (ri + rj) and m* = mi mj / (mi + mj) share one division.
+        const double inv_sums = 1.0 / ((ri + rj) * (mi + mj));
         contact::PairInput in;
         in.n = d * (1.0 / dist);
         in.delta = ri + rj - dist;
         in.r_i = ri;
         in.r_j = rj;
-        in.r_star = ri * rj / (ri + rj);
-        in.m_star = mi * p.mass[j] / (mi + p.mass[j]);
+        in.r_star = ri * rj * (mi + mj) * inv_sums;
+        in.m_star = mi * mj * (ri + rj) * inv_sums;
         const Vec3 v_rel = vi - p.v[j];
         in.vn = dot(v_rel, in.n);
         in.vt = v_rel - in.n * in.vn + cross(wi * ri + p.omega[j] * rj, in.n);
