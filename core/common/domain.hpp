@@ -35,25 +35,27 @@ struct Domain {
   }
 };
 
-/// The minimum-image map of a domain with its box lengths and their inverses precomputed, for
-/// the pair loop (a multiply instead of a divide per axis and pair).
+/// The minimum-image map of a domain with its box lengths, half lengths and inverses
+/// precomputed, for the hot loops. Most separations are shorter than half the box and are
+/// returned as they are after one compare; only the others are rounded (a library call where the
+/// target has no rounding instruction), with the same result as rounding every one.
 class MinimumImage {
  public:
-  explicit MinimumImage(const Domain& d) : periodic_(d.periodic) {
+  explicit MinimumImage(const Domain& d) {
     for (int k = 0; k < 3; ++k) {
       len_[k] = d.hi[k] - d.lo[k];
-      inv_len_[k] = periodic_[k] ? 1.0 / len_[k] : 0.0;
+      half_[k] = d.periodic[k] ? 0.5 * len_[k] : 1e300;  // a closed axis is never rounded
+      inv_len_[k] = d.periodic[k] ? 1.0 / len_[k] : 0.0;
     }
   }
   Vec3 operator()(Vec3 d) const {
     for (int k = 0; k < 3; ++k)
-      if (periodic_[k]) d[k] -= len_[k] * std::nearbyint(d[k] * inv_len_[k]);
+      if (std::abs(d[k]) > half_[k]) d[k] -= len_[k] * std::nearbyint(d[k] * inv_len_[k]);
     return d;
   }
 
  private:
-  std::array<bool, 3> periodic_;
-  Vec3 len_, inv_len_;
+  Vec3 len_, half_, inv_len_;
 };
 
 }  // namespace demcal

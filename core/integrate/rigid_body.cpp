@@ -55,11 +55,11 @@ void kick_body(particles::ParticleStore& p, std::size_t b, const Vec3& gravity, 
 }  // namespace
 
 void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, const Vec3& gravity,
-                      double dt, int threads) {
+                      double dt) {
   auto& c = p.clumps;
   const int n = static_cast<int>(c.size());
   const double half = 0.5 * dt;
-#pragma omp parallel for schedule(static) num_threads(threads)
+#pragma omp for schedule(static)
   for (int b = 0; b < n; ++b) {
     if (c.parked[b]) continue;
     kick_body(p, b, gravity, half);
@@ -74,10 +74,10 @@ void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, const V
   }
 }
 
-void clump_kick(particles::ParticleStore& p, const Vec3& gravity, double half_dt, int threads) {
+void clump_kick(particles::ParticleStore& p, const Vec3& gravity, double half_dt) {
   auto& c = p.clumps;
   const int n = static_cast<int>(c.size());
-#pragma omp parallel for schedule(static) num_threads(threads)
+#pragma omp for schedule(static)
   for (int b = 0; b < n; ++b) {
     if (c.parked[b]) continue;
     kick_body(p, b, gravity, half_dt);

@@ -19,10 +19,12 @@ namespace demcal::integrate {
 
 /// First half of a step for the clumps: kick with the members' last forces, drift, turn, and
 /// place the members (positions wrapped into periodic boxes, velocities v + omega x R b).
+/// Both halves share the bodies among the threads of the enclosing parallel region (an
+/// orphaned `omp for`, ending in a barrier); called outside one, a single thread does all.
 void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, const Vec3& gravity,
-                      double dt, int threads);
+                      double dt);
 /// Second half: kick with the members' new forces and update the members' velocities.
-void clump_kick(particles::ParticleStore& p, const Vec3& gravity, double half_dt, int threads);
+void clump_kick(particles::ParticleStore& p, const Vec3& gravity, double half_dt);
 /// The angular velocity of body b from its angular momentum and orientation.
 Vec3 body_angular_velocity(const particles::Clumps& c, std::size_t b);
 

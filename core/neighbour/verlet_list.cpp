@@ -108,6 +108,7 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
   old_nbr.swap(nbr);
   row_start.assign(n + 1, 0);
 
+  const MinimumImage image(domain);
   auto for_each_partner = [&](int i, auto&& visit) {
     std::array<int, 27> cells;
     const int nc =
@@ -117,7 +118,7 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
         const int j = cell_items_[k];
         if (j <= i || (body && body[i] >= 0 && body[i] == body[j])) continue;
         const double cut = radius[i] + radius[j] + reach;
-        if (norm2(domain.separation(x[i], x[j])) < cut * cut) visit(j);
+        if (norm2(image(x[j] - x[i])) < cut * cut) visit(j);
       }
   };
 
@@ -156,16 +157,6 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
   history.swap(new_history);
   x_at_build_ = x;
   ++builds_;
-}
-
-bool VerletList::needs_rebuild(const std::vector<Vec3>& x, double skin, int threads) const {
-  if (x.size() != x_at_build_.size()) return true;
-  const double limit = 0.25 * skin * skin;
-  const int n = static_cast<int>(x.size());
-  double worst = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : worst) num_threads(threads)
-  for (int i = 0; i < n; ++i) worst = std::max(worst, norm2(x[i] - x_at_build_[i]));
-  return worst > limit;
 }
 
 }  // namespace demcal::neighbour

@@ -23,9 +23,9 @@ class VerletList {
              double reach, int threads, std::vector<double>& history, int stride,
              const std::int32_t* body = nullptr);
 
-  /// True when some particle has moved more than half the skin since the last build, the
-  /// displacement after which a pair outside the list could have come into range.
-  bool needs_rebuild(const std::vector<Vec3>& x, double skin, int threads) const;
+  /// Squared displacement of particle i, now at x, since the last build. Once some particle has
+  /// moved more than half the skin, a pair outside the list could have come into range.
+  double displacement2(int i, const Vec3& x) const { return norm2(x - x_at_build_[i]); }
 
   std::size_t pairs() const { return nbr.size(); }
   std::size_t builds() const { return builds_; }

@@ -24,99 +24,26 @@ TypedLaw<N, C, T, R> typed(const contact::ContactLaw& law) {
           std::get<R>(law.rolling)};
 }
 
-template <class N, class C, class T, class R>
-void pair_kernel(World& w, const N&, const C&, const T&, const R&) {
-  using Law = TypedLaw<N, C, T, R>;
-  constexpr int kStride = contact::History<N, C, T, R>::kSize;
-  const int n_mat = w.materials();
-  std::vector<Law> laws;
-  laws.reserve(n_mat * n_mat);
-  for (int a = 0; a < n_mat; ++a)
-    for (int b = 0; b < n_mat; ++b) laws.push_back(typed<N, C, T, R>(w.pair_law(a, b)));
-  const double range = w.interaction_range();
-
-  auto& p = w.particles;
-  const int n = static_cast<int>(p.size());
-  const auto& start = w.list.row_start;
-  const auto& nbr = w.list.nbr;
-  double* hist = w.pair_history.data();
-  const MinimumImage image(w.domain);
-  const bool periodic = w.domain.any_periodic();
-  const double dt = w.dt;
-  const int threads = w.threads;
-
-  if (static_cast<int>(w.deferred.size()) != threads) w.deferred.assign(threads, {});
-
-    // Each thread owns a contiguous range of particles and evaluates the pairs of its rows. A pair
-    // force on a partner j inside the own range is added directly; one on a partner owned by a
-    // later thread is deferred and added after the loop, in thread order. No two threads write the
-    // same particle, and the order of every sum is fixed for a given thread count.
-#pragma omp parallel num_threads(threads)
-  {
-    const int tid = omp_get_thread_num();
-    const int lo = static_cast<int>(static_cast<long>(n) * tid / threads);
-    const int hi = static_cast<int>(static_cast<long>(n) * (tid + 1) / threads);
-    auto& deferred = w.deferred[tid];
-    deferred.clear();
-    for (int i = lo; i < hi; ++i) {
-      // A clump's weight acts at its centre of mass (rigid_body.hpp), not through its members.
-      p.f[i] = p.motion[i] == particles::Motion::kClumpMember ? Vec3{} : w.gravity * p.mass[i];
-      p.torque[i] = {};
-    }
-    for (int i = lo; i < hi; ++i) {
-      const Vec3 xi = p.x[i], vi = p.v[i], wi = p.omega[i];
-      const double ri = p.radius[i], mi = p.mass[i];
-      const Law* law_row = &laws[p.material[i] * n_mat];
-      Vec3 fi{}, ti{};
-      for (int k = start[i]; k < start[i + 1]; ++k) {
-        const int j = nbr[k];
-        double* h = hist + static_cast<std::ptrdiff_t>(k) * kStride;
-        const Vec3 d = periodic ? image(p.x[j] - xi) : p.x[j] - xi;
-        const double rj = p.radius[j];
-        const double reach = ri + rj + range;
-        const double dist2 = norm2(d);
-        if (dist2 >= reach * reach) {
-          for (int s = 0; s < kStride; ++s) h[s] = 0.0;
-          continue;
-        }
-        const double dist = std::sqrt(dist2);
-        contact::PairInput in;
-        in.n = d * (1.0 / dist);
-        in.delta = ri + rj - dist;
-        in.r_i = ri;
-        in.r_j = rj;
-        in.r_star = ri * rj / (ri + rj);
-        in.m_star = mi * p.mass[j] / (mi + p.mass[j]);
-        const Vec3 v_rel = vi - p.v[j];
-        in.vn = dot(v_rel, in.n);
-        in.vt = v_rel - in.n * in.vn + cross(wi * ri + p.omega[j] * rj, in.n);
-        in.w_rel = wi - p.omega[j];
-        in.dt = dt;
-        const contact::PairOutput out = law_row[p.material[j]].evaluate(in, h);
-        fi += out.force;
-        ti += out.torque_i;
-        if (j < hi) {
-          p.f[j] -= out.force;
-          p.torque[j] += out.torque_j;
-        } else {
-          deferred.push_back({j, -out.force, out.torque_j});
-        }
-      }
-      p.f[i] += fi;
-      p.torque[i] += ti;
-    }
-#pragma omp barrier
-    for (int b = 0; b < tid; ++b)
-      for (const auto& c : w.deferred[b])
-        if (c.particle >= lo && c.particle < hi) {
-          p.f[c.particle] += c.force;
-          p.torque[c.particle] += c.torque;
-        }
-  }
+/// Clears the history of a pair beyond reach. Most such pairs were not touching before either:
+/// their history is only read, not written again every step.
+template <int kStride>
+void clear_history(double* h) {
+  bool set = false;
+  for (int s = 0; s < kStride; ++s) set |= h[s] != 0.0;
+  if (set)
+    for (int s = 0; s < kStride; ++s) h[s] = 0.0;
 }
 
+/// A force and a torque, e.g. the particles' push on a wall.
+struct Wrench {
+  Vec3 force, torque;
+};
+
+/// Adds the contact forces of wall `wall_index` to the particles [lo, hi) and their reaction to
+/// `on_wall`.
 template <class N, class C, class T, class R>
-void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&, const R&) {
+void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wall, const N&,
+                 const C&, const T&, const R&) {
   using Law = TypedLaw<N, C, T, R>;
   constexpr int kStride = contact::History<N, C, T, R>::kSize;
   walls::Wall& wall = w.walls[wall_index];
@@ -127,16 +54,9 @@ void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&,
   for (const auto& l : laws) range = std::max(range, l.c.range());
 
   auto& p = w.particles;
-  const int n = static_cast<int>(p.size());
   double* hist = w.wall_history[wall_index].data();
-  const int threads = w.threads;
-  std::vector<Vec3> part_force(threads), part_torque(threads);
-
   const walls::Mesh* mesh = std::get_if<walls::Mesh>(&wall.shape);
-
-#pragma omp parallel num_threads(threads)
   {
-    const int tid = omp_get_thread_num();
     Vec3 wf{}, wt{};
     auto apply = [&](int i, const walls::WallGeometry& g, double* h) {
       contact::PairInput in;
@@ -159,8 +79,7 @@ void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&,
     };
     if (!mesh) {
       // Plane, cylinder, disk: at most one contact per particle, one history per particle.
-#pragma omp for schedule(static)
-      for (int i = 0; i < n; ++i) {
+for (int i = lo; i < hi; ++i) {
         double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
         walls::WallGeometry g;
         if (!walls::wall_geometry(wall.shape, p.x[i], p.radius[i], range, g)) {
@@ -177,8 +96,7 @@ void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&,
       constexpr int kSlots = walls::Mesh::kMaxContacts;
       constexpr int kSlot = kStride + 3;
       constexpr double kSameContact = 0.7071;
-#pragma omp for schedule(static)
-      for (int i = 0; i < n; ++i) {
+for (int i = lo; i < hi; ++i) {
         double* h = hist + static_cast<std::ptrdiff_t>(i) * kSlots * kSlot;
         walls::WallGeometry g[kSlots];
         const int found = walls::mesh_contacts(*mesh, p.x[i], p.radius[i], range, g);
@@ -222,32 +140,140 @@ void wall_kernel(World& w, std::size_t wall_index, const N&, const C&, const T&,
         }
       }
     }
-    part_force[tid] = wf;
-    part_torque[tid] = wt;
+    on_wall = {wf, wt};
   }
+}
+
+void add_wall_forces(World& w, std::size_t k, int lo, int hi, Wrench& on_wall) {
+  const int m0 = w.particles.material[0];
+  contact::visit(w.wall_law(w.walls[k].material, m0),
+                 [&](const auto& n, const auto& c, const auto& t, const auto& r) {
+                   wall_kernel(w, k, lo, hi, on_wall, n, c, t, r);
+                 });
+}
+
+/// The wall's force and torque: the threads' parts in thread order.
+void sum_wall_wrench(walls::Wall& wall, const std::vector<Wrench>& parts) {
   wall.force = {};
   wall.torque = {};
-  for (int t = 0; t < threads; ++t) {
-    wall.force += part_force[t];
-    wall.torque += part_torque[t];
+  for (const Wrench& part : parts) {
+    wall.force += part.force;
+    wall.torque += part.torque;
   }
+}
+
+
+/// The force region: every thread resets and sums the forces of the particles it owns (pairs,
+/// then walls), then runs `after` on them.
+template <class N, class C, class T, class R>
+void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, const T&, const R&) {
+  using Law = TypedLaw<N, C, T, R>;
+  constexpr int kStride = contact::History<N, C, T, R>::kSize;
+  const int n_mat = w.materials();
+  std::vector<Law> laws;
+  laws.reserve(n_mat * n_mat);
+  for (int a = 0; a < n_mat; ++a)
+    for (int b = 0; b < n_mat; ++b) laws.push_back(typed<N, C, T, R>(w.pair_law(a, b)));
+  const double range = w.interaction_range();
+
+  auto& p = w.particles;
+  const int n = static_cast<int>(p.size());
+  const auto& start = w.list.row_start;
+  const auto& nbr = w.list.nbr;
+  double* hist = w.pair_history.data();
+  const MinimumImage image(w.domain);
+  const bool periodic = w.domain.any_periodic();
+  const double dt = w.dt;
+  const int threads = w.threads;
+  // Each wall's force and torque, per thread, summed in thread order after the region.
+  std::vector<std::vector<Wrench>> on_walls(w.walls.size(), std::vector<Wrench>(threads));
+
+  if (static_cast<int>(w.deferred.size()) != threads) w.deferred.assign(threads, {});
+
+    // Each thread owns a contiguous range of particles and evaluates the pairs of its rows. A pair
+    // force on a partner j inside the own range is added directly; one on a partner owned by a
+    // later thread is deferred and added after the loop, in thread order. No two threads write the
+    // same particle, and the order of every sum is fixed for a given thread count.
+#pragma omp parallel num_threads(threads)
+  {
+    const int tid = omp_get_thread_num();
+    const auto [lo, hi] = owned_range(n, tid, threads);
+    auto& deferred = w.deferred[tid];
+    deferred.clear();
+    for (int i = lo; i < hi; ++i) {
+      // A clump's weight acts at its centre of mass (rigid_body.hpp), not through its members.
+      p.f[i] = p.motion[i] == particles::Motion::kClumpMember ? Vec3{} : w.gravity * p.mass[i];
+      p.torque[i] = {};
+    }
+    for (int i = lo; i < hi; ++i) {
+      const Vec3 xi = p.x[i], vi = p.v[i], wi = p.omega[i];
+      const double ri = p.radius[i], mi = p.mass[i];
+      const Law* law_row = &laws[p.material[i] * n_mat];
+      Vec3 fi{}, ti{};
+      for (int k = start[i]; k < start[i + 1]; ++k) {
+        const int j = nbr[k];
+        double* h = hist + static_cast<std::ptrdiff_t>(k) * kStride;
+        const Vec3 d = periodic ? image(p.x[j] - xi) : p.x[j] - xi;
+        const double rj = p.radius[j];
+        const double reach = ri + rj + range;
+        const double dist2 = norm2(d);
+        if (dist2 >= reach * reach) {
+          clear_history<kStride>(h);
+          continue;
+        }
+        const double dist = std::sqrt(dist2);
+        const double mj = p.mass[j];
+        // R* = ri rj / (ri + rj) and m* = mi mj / (mi + mj) share one division.
+        const double inv_sums = 1.0 / ((ri + rj) * (mi + mj));
+        contact::PairInput in;
+        in.n = d * (1.0 / dist);
+        in.delta = ri + rj - dist;
+        in.r_i = ri;
+        in.r_j = rj;
+        in.r_star = ri * rj * (mi + mj) * inv_sums;
+        in.m_star = mi * mj * (ri + rj) * inv_sums;
+        const Vec3 v_rel = vi - p.v[j];
+        in.vn = dot(v_rel, in.n);
+        in.vt = v_rel - in.n * in.vn + cross(wi * ri + p.omega[j] * rj, in.n);
+        in.w_rel = wi - p.omega[j];
+        in.dt = dt;
+        const contact::PairOutput out = law_row[p.material[j]].evaluate(in, h);
+        fi += out.force;
+        ti += out.torque_i;
+        if (j < hi) {
+          p.f[j] -= out.force;
+          p.torque[j] += out.torque_j;
+        } else {
+          deferred.push_back({j, -out.force, out.torque_j});
+        }
+      }
+      p.f[i] += fi;
+      p.torque[i] += ti;
+    }
+#pragma omp barrier
+    for (int b = 0; b < tid; ++b)
+      for (const auto& c : w.deferred[b])
+        if (c.particle >= lo && c.particle < hi) {
+          p.f[c.particle] += c.force;
+          p.torque[c.particle] += c.torque;
+        }
+    for (std::size_t k = 0; k < w.walls.size(); ++k) add_wall_forces(w, k, lo, hi, on_walls[k][tid]);
+    if (after) after(lo, hi);
+  }
+  for (std::size_t k = 0; k < w.walls.size(); ++k) sum_wall_wrench(w.walls[k], on_walls[k]);
 }
 
 }  // namespace
 
-void compute_pair_forces(World& world) {
-  if (world.particles.size() == 0) return;
-  contact::visit(world.pair_law(0, 0), [&](const auto& n, const auto& c, const auto& t,
-                                           const auto& r) { pair_kernel(world, n, c, t, r); });
-}
-
-void compute_wall_forces(World& world) {
-  const int m0 = world.particles.size() ? world.particles.material[0] : 0;
-  for (std::size_t k = 0; k < world.walls.size(); ++k)
-    contact::visit(world.wall_law(world.walls[k].material, m0),
-                   [&](const auto& n, const auto& c, const auto& t, const auto& r) {
-                     wall_kernel(world, k, n, c, t, r);
-                   });
+void compute_forces(World& world, const OwnedRangeTask& after) {
+  if (world.particles.size() == 0) {
+    for (auto& wall : world.walls) wall.force = wall.torque = {};
+    return;
+  }
+  contact::visit(world.pair_law(0, 0),
+                 [&](const auto& n, const auto& c, const auto& t, const auto& r) {
+                   force_region(world, after, n, c, t, r);
+                 });
 }
 
 }  // namespace demcal::sim

@@ -1,14 +1,26 @@
 #pragma once
-// The force stages of the step: gravity + particle-particle contacts, and particle-wall contacts.
+// The force stage of the step: gravity, particle-particle and particle-wall contacts, in one
+// parallel region in which each thread owns a contiguous range of particles.
+#include <functional>
+#include <utility>
+
 #include "core/sim/world.hpp"
 
 namespace demcal::sim {
 
-/// Sets every particle's force to m g plus its pair contact forces, and its torque to the pair
-/// torques. Deterministic for a given thread count (see the owner ranges in forces.cpp).
-void compute_pair_forces(World& world);
+/// The particles [lo, hi) thread `tid` of `threads` owns, in every parallel loop of the step.
+inline std::pair<int, int> owned_range(int n, int tid, int threads) {
+  return {static_cast<int>(static_cast<long>(n) * tid / threads),
+          static_cast<int>(static_cast<long>(n) * (tid + 1) / threads)};
+}
 
-/// Adds particle-wall contact forces to the particles and stores each wall's force and torque.
-void compute_wall_forces(World& world);
+/// Work a thread does on the particles it owns, [lo, hi), once their forces are final.
+using OwnedRangeTask = std::function<void(int lo, int hi)>;
+
+/// Sets every particle's force to m g plus its pair and wall contact forces, its torque to the
+/// contact torques, and each wall's force and torque; then every thread runs `after` on the
+/// particles it owns, still inside the region (the step's second half kick). Deterministic for a
+/// given thread count (see the owner ranges in forces.cpp).
+void compute_forces(World& world, const OwnedRangeTask& after = {});
 
 }  // namespace demcal::sim

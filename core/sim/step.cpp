@@ -1,10 +1,43 @@
 #include "core/sim/step.hpp"
 
+#include <omp.h>
+
+#include <algorithm>
+
 #include "core/integrate/rigid_body.hpp"
 #include "core/integrate/velocity_verlet.hpp"
 #include "core/sim/forces.hpp"
 
 namespace demcal::sim {
+namespace {
+
+/// The first half kick and the drift (rigid clumps kick, drift and turn as bodies and place their
+/// member spheres), in one parallel region; returns whether some particle moved more than half
+/// the skin since the last neighbour-list build.
+bool kick_drift(World& w) {
+  auto& p = w.particles;
+  const int n = static_cast<int>(p.size());
+  const bool clumps = p.clumps.size() > 0;
+  const double half_skin = 0.5 * w.effective_skin();
+  double worst = 0.0;
+#pragma omp parallel num_threads(w.threads) reduction(max : worst)
+  {
+    const auto [lo, hi] = owned_range(n, omp_get_thread_num(), omp_get_num_threads());
+    integrate::kick_drift(p, w.dt, lo, hi);
+    if (clumps) integrate::clump_kick_drift(p, w.domain, w.gravity, w.dt);
+    for (int i = lo; i < hi; ++i) worst = std::max(worst, w.list.displacement2(i, p.x[i]));
+  }
+  return worst > half_skin * half_skin;
+}
+
+void rebuild_neighbour_list(World& w) {
+  for (auto& x : w.particles.x) w.domain.wrap(x);
+  w.list.build(w.particles.x, w.particles.radius, w.domain,
+               w.interaction_range() + w.effective_skin(), w.threads, w.pair_history,
+               w.pair_stride(), w.clump_bodies());
+}
+
+}  // namespace
 
 void step(World& w) {
   if (!w.prepared() || w.list.row_start.size() != w.particles.size() + 1 ||
@@ -14,32 +47,28 @@ void step(World& w) {
     w.prepare();
   }
   const double half = 0.5 * w.dt;
+  auto& p = w.particles;
+  const bool clumps = p.clumps.size() > 0;
 
-  // 1. First half kick with the forces of the last step, then drift (velocity Verlet); rigid
-  //    clumps kick, drift and turn as bodies and place their member spheres.
-  integrate::kick_drift(w.particles, w.dt, w.threads);
-  integrate::clump_kick_drift(w.particles, w.domain, w.gravity, w.dt, w.threads);
-
-  // 2. Walls move with their prescribed or controlled velocities.
+  // 1. Walls move with their prescribed or controlled velocities (nothing in them depends on
+  //    the particles' drift).
   for (auto& wall : w.walls) walls::advance(wall, w.dt);
 
+  // 2. First half kick with the forces of the last step, then drift (velocity Verlet).
   // 3. Neighbour list: rebuilt only once some particle moved more than half the skin; the
   //    history of pairs still in range is carried to the new list.
-  if (w.list.needs_rebuild(w.particles.x, w.effective_skin(), w.threads)) {
-    for (auto& x : w.particles.x) w.domain.wrap(x);
-    w.list.build(w.particles.x, w.particles.radius, w.domain,
-                 w.interaction_range() + w.effective_skin(), w.threads, w.pair_history,
-                 w.pair_stride(), w.clump_bodies());
-  }
+  if (kick_drift(w)) rebuild_neighbour_list(w);
 
-  // 4. Forces: gravity and particle-particle contacts, then particle-wall contacts (which also
-  //    give each wall its force and torque).
-  compute_pair_forces(w);
-  compute_wall_forces(w);
-
-  // 5. Second half kick with the new forces (clumps: with the sums over their members).
-  integrate::kick(w.particles, half, w.threads);
-  integrate::clump_kick(w.particles, w.gravity, half, w.threads);
+  // 4. Forces: gravity, particle-particle and particle-wall contacts (which also give each wall
+  //    its force and torque); 5. in the same region, the second half kick with the new forces
+  //    (clumps: with the sums over their members, once every member's force is final).
+  compute_forces(w, [&](int lo, int hi) {
+    integrate::kick(p, half, lo, hi);
+    if (clumps) {
+#pragma omp barrier
+      integrate::clump_kick(p, w.gravity, half);
+    }
+  });
 
   w.time += w.dt;
   ++w.step_count;

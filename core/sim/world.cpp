@@ -117,8 +117,7 @@ void World::prepare() {
   prepared_ = true;
   // The forces of this configuration, for the first half kick of the next step: step() relies on
   // them whether it called prepare() itself or the caller did.
-  compute_pair_forces(*this);
-  compute_wall_forces(*this);
+  compute_forces(*this);
 }
 
 void World::remove_particles(const std::vector<char>& flags) {

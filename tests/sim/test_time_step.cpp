@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/common/error.hpp"
+#include "core/particles/clump_shape.hpp"
 #include "core/sim/step.hpp"
 #include "core/sim/time_step.hpp"
 
@@ -50,6 +51,44 @@ TEST(SimTimeStep, HertzBoundIsTheRayleighTimeOfTheSmallestSphere) {
   EXPECT_NEAR(limit.critical, 8.6543e-5, 1e-9);  // the number itself, for this Y, nu, rho, R
   EXPECT_NE(limit.basis.find("Rayleigh"), std::string::npos) << limit.basis;
   EXPECT_NEAR(sim::recommended_time_step(w, 0.2), 0.2 * expected, 1e-12 * expected);
+}
+
+TEST(SimTimeStep, ClumpBoundUsesTheBodysEffectiveMassAtTheMember) {
+  const double y = 1e7, nu = 0.3, rho = 2500, r = 0.001;
+  const auto hertz = law({"hertz", {{"youngs_modulus", y}, {"poisson_ratio", nu}}});
+  sim::World w;
+  w.set_pair_law(0, 0, hertz);
+  particles::ShapeSpec rod;
+  rod.kind = particles::ShapeKind::kRod;
+  rod.aspect_ratio = 2.0;
+  w.particles.add_clump({0, 0, 0.01}, Quat{}, particles::make_template(rod), r, rho, 0);
+  const auto& p = w.particles;
+  const auto& c = p.clumps;
+  ASSERT_GE(p.size(), 3u);
+  // Brute force over directions n: the smallest 1 / (1/M + (a x n) . I^-1 (a x n)) of any member.
+  double m_eff = c.mass[0];
+  std::size_t worst = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (int t = 0; t <= 180; ++t)
+      for (int f = 0; f < 360; ++f) {
+        const double th = t * M_PI / 180, ph = f * M_PI / 180;
+        const Vec3 n{std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
+        const Vec3 u = cross(p.body_offset[i], n);
+        const Vec3& in = c.inertia[0];
+        const double m = 1.0 / (1.0 / c.mass[0] + u.x * u.x / in.x + u.y * u.y / in.y +
+                                u.z * u.z / in.z);
+        if (m < m_eff) m_eff = m, worst = i;
+      }
+  // The body moves as a whole: more mass than the member's share, less than the body's.
+  EXPECT_GT(m_eff, p.mass[worst]);
+  EXPECT_LT(m_eff, c.mass[0]);
+  const double rm = p.radius[worst];
+  const double g = y / (2.0 * (1.0 + nu));
+  const double expected =
+      M_PI * rm * std::sqrt(m_eff / (4.0 / 3.0 * M_PI * rm * rm * rm) / g) / (0.163 * nu + 0.8766);
+  EXPECT_NEAR(sim::critical_time_step(w).critical, expected, 1e-3 * expected);
+  std::printf("rod AR 2: member radius %.3g r, member mass share %.3g M, effective mass %.3g M\n",
+              rm / r, p.mass[worst] / c.mass[0], m_eff / c.mass[0]);
 }
 
 TEST(SimTimeStep, LinearBoundIsSqrtOfLightestMassOverStiffestSpring) {

@@ -43,12 +43,12 @@ struct History {
     rotate_into_plane(xi, in.n);
     xi += in.vt * in.dt;
     Vec3 ft = -(xi * kt) - in.vt * gamma_t;
-    const double ft_mag = norm(ft);
-    if (ft_mag > mu_s * f_coulomb) {
-      if (ft_mag > 0.0) {
-        ft *= mu_d_ratio * mu_s * f_coulomb / ft_mag;
-        xi = kt > 0.0 ? -(ft + in.vt * gamma_t) / kt : Vec3{};
-      }
+    // Squares compared: a sticking contact needs no square root (the limit is >= 0).
+    const double limit = mu_s * f_coulomb;
+    const double ft_mag2 = norm2(ft);
+    if (ft_mag2 > limit * limit) {
+      ft *= mu_d_ratio * limit / std::sqrt(ft_mag2);
+      xi = kt > 0.0 ? -(ft + in.vt * gamma_t) / kt : Vec3{};
     }
     store_vec(history, xi);
     return ft;
