@@ -21,7 +21,8 @@
 # compressions (whole processes, summed over the seeds; 2 threads vs 2 ranks, then 1 vs 1) and,
 # last, "ratio: X" = LIGGGHTS wall time / demcal wall time, 2 threads vs 2 ranks. The
 # environment passes through (e.g. OMP_WAIT_POLICY for demcal's OpenMP threads).
-# Usage: bench/lab_vs_liggghts.sh [seeds...]   (default 1 2 3); DEMCAL=path/to/demcal
+# Usage: bench/lab_vs_liggghts.sh [seeds...]   (default 1 2 3; a spread needs 2 or more);
+#        DEMCAL=path/to/demcal
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 demcal=${DEMCAL:-$root/build/client/demcal}

@@ -36,16 +36,19 @@ struct SimulateOptions {
 /// whole opening.
 constexpr int kPistonSegments = 64;
 
-/// A disk facing down at the bed top that covers the die, the scene's first cylinder wall (its
-/// axis along z).
-walls::Mesh piston_over_die(const sim::World& w) {
+/// The die: the scene's first cylinder wall (its axis along z).
+const walls::Cylinder& find_die(const sim::World& w) {
   for (const auto& wall : w.walls)
-    if (const auto* die = std::get_if<walls::Cylinder>(&wall.shape)) {
-      const Vec3 centre{die->point.x, die->point.y, metrics::bed_top(w)};
-      const double radius = die->radius / std::cos(M_PI / kPistonSegments);
-      return walls::make_disk(centre, {0.0, 0.0, -1.0}, radius, kPistonSegments);
-    }
+    if (const auto* die = std::get_if<walls::Cylinder>(&wall.shape)) return *die;
   throw InputError("--piston-stl", "the scene has no cylinder wall (die) to cover");
+}
+
+/// A disk facing down at the bed top that covers the die.
+walls::Mesh piston_over_die(const sim::World& w) {
+  const walls::Cylinder& die = find_die(w);
+  const Vec3 centre{die.point.x, die.point.y, metrics::bed_top(w)};
+  const double radius = die.radius / std::cos(M_PI / kPistonSegments);
+  return walls::make_disk(centre, {0.0, 0.0, -1.0}, radius, kPistonSegments);
 }
 
 /// The scene's domain as the data file's box; LIGGGHTS needs a finite one.
@@ -83,6 +86,10 @@ void run_simulate(const SimulateOptions& opt) {
   auto scene = io::read_scene(io::YamlNode::load_file(opt.spec));
   auto& w = scene.world;
   if (opt.threads > 0) w.threads = opt.threads;
+  // What the outputs need is checked before the run, not after it.
+  std::optional<io::DataBox> box;
+  if (!opt.bed_data.empty()) box = finite_box(w);
+  if (!opt.piston_stl.empty()) find_die(w);
   nlohmann::json report;
   report["particles"] = w.particles.size();
   report["threads"] = w.threads;
@@ -118,7 +125,7 @@ void run_simulate(const SimulateOptions& opt) {
     io::write_walls_vtk(opt.out_dir + "/walls.vtk", w, 0.05);
     report["vtk"] = {opt.out_dir + "/particles.vtk", opt.out_dir + "/walls.vtk"};
   }
-  if (!opt.bed_data.empty()) io::write_liggghts_data(opt.bed_data, w.particles, finite_box(w), false);
+  if (box) io::write_liggghts_data(opt.bed_data, w.particles, *box, false);
   if (!opt.piston_stl.empty()) io::write_stl_ascii(opt.piston_stl, piston_over_die(w), "piston");
   std::cout << report.dump(2) << "\n";
 }

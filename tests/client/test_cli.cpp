@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +10,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
+#include <string>
 
 #include "core/common/rng.hpp"
 
@@ -148,6 +151,83 @@ phases:
   std::getline(vtk, first);
   EXPECT_EQ(first, "# vtk DataFile Version 3.0");
   EXPECT_TRUE(fs::exists(dir / "vtk" / "walls.vtk"));
+  fs::remove_all(dir);
+}
+
+// A settled bed handed over as a LIGGGHTS data file and a piston STL, then compressed by that
+// piston read back as a mesh wall moving down: the bed file holds every particle, the piston sits
+// at the bed top and covers the die, and the force series ends with the bed pushing the piston up.
+TEST(Cli, SimulateWritesABedAndPistonThatASceneCompresses) {
+  const fs::path dir = scratch_dir("bed");
+  const std::string law = R"(
+density: 2500
+time_step: 1.0e-5
+domain: {lo: [-0.0105, -0.0105, -0.001], hi: [0.0105, 0.0105, 0.03]}
+contact_law:
+  normal: {model: hertz, youngs_modulus: 1.0e7, poisson_ratio: 0.3, restitution: 0.5}
+  tangential: {model: history, mu_s: 0.5, kt_ratio: 1.0}
+walls:
+  - {name: floor, plane: {point: [0, 0, 0], normal: [0, 0, 1]}}
+  - {name: die, cylinder: {point: [0, 0, 0], axis: [0, 0, 1], radius: 0.01}}
+)";
+  std::ofstream(dir / "bed.yaml") << law << R"(
+particles:
+  random: {region: {cylinder: {centre: [0, 0, 0], radius: 0.0089, z_lo: 0.0011, z_hi: 0.012}},
+           count: 150, sizes: {monodisperse: {radius: 0.001}}}
+phases:
+  - {name: settle, steps: 8000}
+)";
+  const Result bed = demcal("simulate " + (dir / "bed.yaml").string() + " --bed " +
+                            (dir / "bed.data").string() + " --piston-stl " +
+                            (dir / "piston.stl").string());
+  ASSERT_EQ(bed.exit_code, 0) << bed.out;
+  const double top = nlohmann::json::parse(bed.out)["metrics"]["bed_top"].get<double>();
+  std::ifstream data(dir / "bed.data");
+  std::string line;
+  int atoms = 0;
+  for (bool in_atoms = false; std::getline(data, line);) {
+    if (in_atoms && !line.empty()) ++atoms;
+    in_atoms = in_atoms || line == "Atoms";
+  }
+  EXPECT_EQ(atoms, 150);
+  std::ifstream stl(dir / "piston.stl");
+  double max_r = 0.0;
+  for (std::string word; stl >> word;)
+    if (word == "vertex") {
+      double x, y, z;
+      stl >> x >> y >> z;
+      EXPECT_DOUBLE_EQ(z, top);
+      max_r = std::max(max_r, std::hypot(x, y));
+    }
+  EXPECT_GT(max_r, 0.01) << "the piston covers the die";
+
+  std::ofstream(dir / "press.yaml") << law << R"(
+  - {name: piston, mesh: {stl: piston.stl}, velocity: [0, 0, -0.05]}
+particles: {data_file: bed.data}
+phases:
+  - {name: press, steps: 3000, record_every: 500}
+)";
+  const Result press = demcal("simulate " + (dir / "press.yaml").string() + " --walls-csv " +
+                              (dir / "walls.csv").string());
+  ASSERT_EQ(press.exit_code, 0) << press.out;
+  EXPECT_EQ(nlohmann::json::parse(press.out)["walls"][2], "piston");
+  std::ifstream csv(dir / "walls.csv");
+  std::getline(csv, line);
+  EXPECT_EQ(line, "phase,step,time,wall,dx,dy,dz,fx,fy,fz");
+  int rows = 0;
+  std::string last;
+  while (std::getline(csv, line)) {
+    ++rows;
+    last = line;
+  }
+  EXPECT_EQ(rows, 6 * 3) << "a row per wall every 500 steps";
+  double values[10];
+  std::replace(last.begin(), last.end(), ',', ' ');
+  std::istringstream(last) >> values[0] >> values[1] >> values[2] >> values[3] >> values[4] >>
+      values[5] >> values[6] >> values[7] >> values[8] >> values[9];
+  EXPECT_EQ(values[3], 2.0);
+  EXPECT_NEAR(values[6], -0.05 * 3000 * 1e-5, 1e-12);
+  EXPECT_GT(values[9], 0.0) << "the bed pushes the piston up";
   fs::remove_all(dir);
 }
 
