@@ -1,51 +1,50 @@
 #!/usr/bin/env bash
-# Run time of each lab test (packing, confined_compression, tensile, wall_friction; shear_cell,
-# rotating_drum, hopper) at
-# 2,000 and 10,000 particles: bench/lab.sh [BUILD_DIR] [COUNTS] [THREADS]
-#   e.g. bench/lab.sh build 2000,10000 2
-# Soft Luding spheres of 1 mm radius (the material of tests/lab), seed-000 defaults otherwise
-# except wall_stiffness_factor 3 and one compression cycle (state them when you quote numbers).
-# Not part of ctest: the 10,000-particle runs take long. TESTS="packing tensile" runs a subset.
+# Run time and cost of each lab test at given particle counts for one material:
+#   bench/lab.sh [BUILD_DIR] [COUNTS] [THREADS]      e.g. bench/lab.sh build 1000 2
+# MATERIAL=lh220 (default; bench/materials/NAME.yaml: lh220, lh100, hertz) and
+# TESTS="packing confined_compression ..." (default: all seven) select what runs.
+# Piston tests use wall_stiffness_factor 3 and the tensile test wall_k2_factor 1, as
+# examples/lh220_diagnosis_campaign.yaml; everything else is each test's default (five
+# compression cycles included). Prints per test: wall time, steps, particle-steps/s, phases
+# short of their target, flagged metrics, and the metrics. Not part of ctest.
 set -euo pipefail
-BUILD=${1:-build}
-COUNTS=${2:-2000,10000}
-THREADS=${3:-1}
+root=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=${1:-$root/build}
+COUNTS=${2:-1000}
+THREADS=${3:-2}
+MATERIAL=${MATERIAL:-lh220}
 DEMCAL="$BUILD/client/demcal"
 [ -x "$DEMCAL" ] || { echo "no $DEMCAL; build the demcal target first" >&2; exit 1; }
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
-material() {
-  cat <<YAML
-material:
-  particle_law:
-    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, kc_ratio: $1, phi_f: 0.05, restitution: 0.3}
-    $2
-    tangential: {model: history, mu_s: 0.3}
-  sizes: {monodisperse: {radius: 0.001}}
-  density: 1500
-YAML
-}
-COH="cohesion: {model: van_der_waals, hamaker: 1.0e-18, d_max: 1.0e-5}"
-printf "%-22s %10s %12s  %s\n" test particles wall_time_s metrics
+echo "material $MATERIAL ($root/bench/materials/$MATERIAL.yaml), $THREADS threads"
+printf "%-22s %9s %8s %10s %12s %7s  %s\n" test particles wall_s steps p-steps/s short metrics
 for n in ${COUNTS//,/ }; do
   for test in ${TESTS:-packing confined_compression tensile wall_friction shear_cell rotating_drum hopper}; do
     case $test in
-      packing) settings="{particles: $n}"; mat=$(material 0 "") ;;
-      confined_compression) settings="{particles: $n, cycles: 1, wall_stiffness_factor: 3}"; mat=$(material 0 "") ;;
-      tensile) settings="{particles: $n, wall_stiffness_factor: 3, wall_hamaker_factor: 10, wall_k2_factor: 1, pull_distance: 1}"; mat=$(material 0.5 "$COH") ;;
-      wall_friction) settings="{particles: $n, wall_stiffness_factor: 3}"; mat=$(material 0 "") ;;
-      # Issue 5 (lab tests II): defaults of each test's settings table.
-      shear_cell|rotating_drum|hopper) settings="{particles: $n}"; mat=$(material 0 "") ;;
+      confined_compression|wall_friction) settings="{particles: $n, wall_stiffness_factor: 3}" ;;
+      tensile) settings="{particles: $n, wall_stiffness_factor: 3, wall_k2_factor: 1}" ;;
+      *) settings="{particles: $n}" ;;
     esac
     spec="$TMP/$test-$n.yaml"
-    printf "test: %s\nsettings: %s\nseed: 1\nthreads: %s\n%s\n" "$test" "$settings" "$THREADS" "$mat" > "$spec"
+    { printf "test: %s\nsettings: %s\nseed: 1\nthreads: %s\n" "$test" "$settings" "$THREADS"
+      grep -v '^#' "$root/bench/materials/$MATERIAL.yaml"; } > "$spec"
     start=$(date +%s.%N)
-    if out=$("$DEMCAL" lab run "$spec" 2>&1); then status=""; else status=" FAILED"; fi
+    if "$DEMCAL" lab run "$spec" > "$TMP/out.json" 2> "$TMP/err"; then status=""; else status=" FAILED: $(tail -1 "$TMP/err")"; fi
     end=$(date +%s.%N)
-    metrics=$(echo "$out" | python3 -c 'import json,sys
+    line=$(python3 - "$TMP/out.json" <<'PY' 2>/dev/null || true
+import json, sys
 try:
-  j=json.load(sys.stdin); print(" ".join("%s=%.4g"%(k,v) for k,v in j["metrics"].items()))
-except Exception: print("")' 2>/dev/null || true)
-    printf "%-22s %10s %12.1f  %s%s\n" "$test" "$n" "$(echo "$end - $start" | bc)" "$metrics" "$status"
+    j = json.load(open(sys.argv[1]))
+except Exception:
+    sys.exit(0)
+c = j["cost"]
+short = sum(1 for p in c["phases"] if not p["reached"])
+m = " ".join("%s=%.4g" % (k, v) for k, v in j["metrics"].items())
+flags = (" flagged: " + ",".join(j["flags"])) if j.get("flags") else ""
+print("%10d %12.4g %7d  %s%s" % (c["steps"], c["particle_steps_per_second"], short, m, flags))
+PY
+)
+    printf "%-22s %9s %8.1f %s%s\n" "$test" "$n" "$(echo "$end - $start" | bc)" "$line" "$status"
   done
 done

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "core/lab/wall_friction.hpp"
@@ -11,13 +12,21 @@
 namespace demcal::lab {
 namespace {
 
+/// The angle of a 120-particle bed, the mean over two beds (lab seeds): one bed of this size
+/// scatters by about a degree.
 double angle(double mu_wall) {
   const Settings s = {{"particles", 120}, {"wall_stiffness_factor", 1}};
   // Interparticle friction above the wall's, so the bed slips at the piston (seed 000 §2.7.5
   // measures the wall, not internal shear).
   auto m = testing::soft_luding(1e7, 5.0, 0.0, 0.0, mu_wall);
   m.particle_law.tangential.params["mu_s"] = 0.5;
-  return run_lab_test("wall_friction", m, s, {}).metrics.at("wall_friction_angle");
+  double sum = 0.0;
+  for (std::uint64_t seed : {1, 2}) {
+    RunOptions o;
+    o.seed = seed;
+    sum += run_lab_test("wall_friction", m, s, o).metrics.at("wall_friction_angle");
+  }
+  return 0.5 * sum;
 }
 
 TEST(WallFriction, TorqueToShearStressAndRegression) {
@@ -28,7 +37,9 @@ TEST(WallFriction, TorqueToShearStressAndRegression) {
 }
 
 TEST(WallFriction, RisesWithWallFriction) {
-  const double a = angle(0.1), b = angle(0.2), c = angle(0.3);
+  // Up to mu_wall 0.2: above it this small bed no longer slips at the piston alone (at 0.3 three
+  // beds gave 7.8-12.2 deg, below atan(0.3) = 16.7 deg), a limit docs/lab-tests.md states.
+  const double a = angle(0.05), b = angle(0.1), c = angle(0.2);
   EXPECT_GT(a, 0.0);
   EXPECT_GT(b, a);
   EXPECT_GT(c, b);
@@ -43,7 +54,9 @@ TEST(WallFriction, TwoPointCalibrationHitsTarget) {
   const double mu = two_point_calibration(0.1, a, 0.2, c, target);
   EXPECT_GT(mu, 0.1);
   EXPECT_LT(mu, 0.2);
-  EXPECT_NEAR(angle(mu), target, 0.15 * target);
+  // Two beds of 120 particles scatter by about a degree at 0.15-0.3 (three beds at 0.3:
+  // 7.8-12.2 deg), so 20 % of ~8 deg is about two standard errors of the two-bed mean.
+  EXPECT_NEAR(angle(mu), target, 0.2 * target);
 }
 
 TEST(WallFriction, BottomServoStopsAtTheFloor) {
