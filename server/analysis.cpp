@@ -39,7 +39,8 @@ std::map<std::string, std::vector<int>> flagged_runs(const std::vector<JobRow>& 
   std::map<std::string, std::vector<int>> out;
   for (const auto& job : jobs) {
     if (job.kind != "design" || job.state != "done") continue;
-    for (const auto& [metric, why] : nlohmann::json::parse(job.flags_json).items())
+    const auto flags = nlohmann::json::parse(job.flags_json);  // items() refers to it
+    for (const auto& [metric, why] : flags.items())
       out[job.test + "." + metric].push_back(job.std_order);
   }
   return out;

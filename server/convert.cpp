@@ -355,8 +355,8 @@ v1::JobResult job_message(const JobRow& job) {
   r.set_error(job.error);
   r.set_worker(job.worker);
   r.set_wall_seconds(job.wall_seconds);
-  for (const auto& [k, v] : nlohmann::json::parse(job.flags_json).items())
-    (*r.mutable_flags())[k] = v.get<std::string>();
+  const auto flags = nlohmann::json::parse(job.flags_json);  // items() refers to it
+  for (const auto& [k, v] : flags.items()) (*r.mutable_flags())[k] = v.get<std::string>();
   from_json(job.cost_json, *r.mutable_cost());
   return r;
 }

@@ -132,7 +132,11 @@ grpc::Status CampaignServiceImpl::GetResults(grpc::ServerContext* ctx, const v1:
                                              v1::ResultsReply* reply) {
   DEMCAL_AUTHORIZE(ctx);
   if (!store_.campaign(req->id())) return not_found(req->id());
-  for (const auto& job : store_.jobs(req->id())) *reply->add_jobs() = job_message(job);
+  try {
+    for (const auto& job : store_.jobs(req->id())) *reply->add_jobs() = job_message(job);
+  } catch (const std::exception& e) {
+    return internal(e);
+  }
   return grpc::Status::OK;
 }
 

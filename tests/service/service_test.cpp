@@ -109,7 +109,8 @@ class Service : public ::testing::Test {
     v1::GetRequest req;
     req.set_id(id);
     v1::ResultsReply r;
-    EXPECT_TRUE(campaigns_->GetResults(ctx().get(), req, &r).ok());
+    const auto status = campaigns_->GetResults(ctx().get(), req, &r);
+    EXPECT_TRUE(status.ok()) << status.error_message();
     return r;
   }
 
