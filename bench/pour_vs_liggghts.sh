@@ -5,8 +5,13 @@
 # 2 MPI ranks, one after the other in this run. Prints each throughput (particle-steps per second
 # of the timed phase), the ratio demcal / LIGGGHTS of the 1-vs-1 case and, last, "ratio: X" of the
 # 2-threads-vs-2-ranks case.
+# demcal's threads wait passively at barriers (OMP_WAIT_POLICY=passive) unless the caller sets
+# OMP_WAIT_POLICY: on a shared machine GOMP's default spinning lets a waiting thread hold a core
+# that the thread it waits for needs (the pour on 2 threads measured 9x slower in wall time with
+# spinning than with passive waiting while other jobs ran). LIGGGHTS runs with Open MPI's defaults.
 # Usage: bench/pour_vs_liggghts.sh [nbench]   (default 20000 timed steps)
 set -euo pipefail
+wait_policy=${OMP_WAIT_POLICY:-passive}
 root=$(cd "$(dirname "$0")/.." && pwd)
 demcal=${DEMCAL:-$root/build/client/demcal}
 nbench=${1:-20000}
@@ -21,7 +26,7 @@ cp "$root/bench/liggghts/in.bench_pour" "$work/"
 
 # demcal_rate THREADS: particle-steps per second of the timed phase.
 demcal_rate() {
-  "$demcal" simulate "$work/pour.yaml" --threads "$1" |
+  OMP_WAIT_POLICY=$wait_policy "$demcal" simulate "$work/pour.yaml" --threads "$1" |
     python3 -c 'import json,sys; r=json.load(sys.stdin); print([p for p in r["phases"] if p["name"]=="timed"][0]["particle_steps_per_second"])'
 }
 
@@ -41,6 +46,7 @@ liggghts_rate() {
   python3 -c "print($natoms * $nbench / $loop)"
 }
 
+echo "demcal OMP_WAIT_POLICY=$wait_policy, $nbench timed steps"
 d1=$(demcal_rate 1)
 l1=$(liggghts_rate 1)
 d2=$(demcal_rate 2)

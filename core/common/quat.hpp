@@ -21,8 +21,8 @@ struct Quat {
   /// The inverse rotation: world frame to body frame.
   Vec3 unrotate(const Vec3& v) const { return conjugate().rotate(v); }
   Quat normalized() const {
-    const double n = std::sqrt(w * w + x * x + y * y + z * z);
-    return {w / n, x / n, y / n, z / n};
+    const double inv = 1.0 / std::sqrt(w * w + x * x + y * y + z * z);
+    return {w * inv, x * inv, y * inv, z * inv};
   }
 };
 

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include <omp.h>
+
 #include "core/common/error.hpp"
 
 namespace demcal::neighbour {
@@ -23,6 +25,9 @@ struct Grid {
   int index(int cx, int cy, int cz) const { return (cz * n[1] + cy) * n[0] + cx; }
   int cells() const { return n[0] * n[1] * n[2]; }
 
+  /// True when some periodic axis has fewer than 3 cells, so that a stencil meets a cell twice.
+  bool stencil_repeats = false;
+
   /// The distinct cells around (cx, cy, cz); fewer than 27 where a periodic axis has < 3 cells.
   int stencil(int cx, int cy, int cz, std::array<int, 27>& out) const {
     int count = 0;
@@ -40,7 +45,8 @@ struct Grid {
           }
           if (!inside) continue;
           const int id = index(c[0], c[1], c[2]);
-          if (std::find(out.begin(), out.begin() + count, id) == out.begin() + count)
+          if (!stencil_repeats ||
+              std::find(out.begin(), out.begin() + count, id) == out.begin() + count)
             out[count++] = id;
         }
     return count;
@@ -74,7 +80,10 @@ Grid make_grid(const std::vector<Vec3>& x, const Domain& domain, double cell,
       }
       total *= g.n[k];
     }
-    if (total <= max_cells) return g;
+    if (total <= max_cells) {
+      for (int k = 0; k < 3; ++k) g.stencil_repeats |= g.periodic[k] && g.n[k] < 3;
+      return g;
+    }
     cell *= std::cbrt(total / max_cells) * 1.01;
   }
 }
@@ -122,37 +131,49 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
       }
   };
 
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int i = 0; i < n; ++i) {
-    int count = 0;
-    for_each_partner(i, [&](int) { ++count; });
-    row_start[i + 1] = count;
-  }
-  for (int i = 0; i < n; ++i) row_start[i + 1] += row_start[i];
-  nbr.resize(row_start[n]);
-
-  std::vector<double> new_history(static_cast<std::size_t>(nbr.size()) * stride, 0.0);
+  // One pass over the candidates: each thread lists the partners of its own rows, sorted, in a
+  // buffer of its own; the buffers are then laid end to end in thread order (= row order).
   const bool carry = stride > 0 && old_start.size() == static_cast<std::size_t>(n + 1);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int i = 0; i < n; ++i) {
-    int pos = row_start[i];
-    for_each_partner(i, [&](int j) { nbr[pos++] = j; });
-    std::sort(nbr.begin() + row_start[i], nbr.begin() + row_start[i + 1]);
-    if (!carry) continue;
-    // Merge the sorted old and new rows of i: a pair found in both keeps its history.
-    int a = old_start[i], b = row_start[i];
-    while (a < old_start[i + 1] && b < row_start[i + 1]) {
-      if (old_nbr[a] < nbr[b]) {
-        ++a;
-      } else if (nbr[b] < old_nbr[a]) {
-        ++b;
-      } else {
-        std::copy_n(history.begin() + static_cast<std::ptrdiff_t>(a) * stride, stride,
-                    new_history.begin() + static_cast<std::ptrdiff_t>(b) * stride);
-        ++a;
-        ++b;
-      }
+  std::vector<double> new_history;
+  if (static_cast<int>(partners_.size()) < threads) partners_.resize(threads);
+#pragma omp parallel num_threads(threads)
+  {
+    const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
+    const int lo = static_cast<int>(static_cast<long>(n) * tid / nt);
+    const int hi = static_cast<int>(static_cast<long>(n) * (tid + 1) / nt);
+    auto& mine = partners_[tid];
+    mine.clear();
+    for (int i = lo; i < hi; ++i) {
+      const auto row_begin = static_cast<std::ptrdiff_t>(mine.size());
+      for_each_partner(i, [&](int j) { mine.push_back(j); });
+      std::sort(mine.begin() + row_begin, mine.end());
+      row_start[i + 1] = static_cast<int>(static_cast<std::ptrdiff_t>(mine.size()) - row_begin);
     }
+#pragma omp barrier
+#pragma omp single
+    {
+      for (int i = 0; i < n; ++i) row_start[i + 1] += row_start[i];
+      nbr.resize(row_start[n]);
+      new_history.assign(static_cast<std::size_t>(nbr.size()) * stride, 0.0);
+    }
+    std::copy(mine.begin(), mine.end(), nbr.begin() + row_start[lo]);
+    if (carry)
+      for (int i = lo; i < hi; ++i) {
+        // Merge the sorted old and new rows of i: a pair found in both keeps its history.
+        int a = old_start[i], b = row_start[i];
+        while (a < old_start[i + 1] && b < row_start[i + 1]) {
+          if (old_nbr[a] < nbr[b]) {
+            ++a;
+          } else if (nbr[b] < old_nbr[a]) {
+            ++b;
+          } else {
+            std::copy_n(history.begin() + static_cast<std::ptrdiff_t>(a) * stride, stride,
+                        new_history.begin() + static_cast<std::ptrdiff_t>(b) * stride);
+            ++a;
+            ++b;
+          }
+        }
+      }
   }
   history.swap(new_history);
   x_at_build_ = x;
