@@ -257,7 +257,8 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
           p.f[c.particle] += c.force;
           p.torque[c.particle] += c.torque;
         }
-    for (std::size_t k = 0; k < w.walls.size(); ++k) add_wall_forces(w, k, lo, hi, on_walls[k][tid]);
+    for (std::size_t k = 0; k < w.walls.size(); ++k)
+      add_wall_forces(w, k, lo, hi, on_walls[k][tid]);
     if (after) after(lo, hi);
   }
   for (std::size_t k = 0; k < w.walls.size(); ++k) sum_wall_wrench(w.walls[k], on_walls[k]);
