@@ -19,9 +19,10 @@ struct BedSpec {
       0.0;  ///< height of the insertion region (m); 0 = from a loose fraction 0.25
   double time_step_safety = 0.2;  ///< dt = safety * critical time step
   /// At rest when the kinetic stress of the residual motion, rho_p <v^2> (mass-weighted mean),
-  /// is below rest_inertial_number^2 times the stress level of the test (docs/lab-tests.md,
-  /// "Settling"): 1e-2 = the motion carries 1e-4 of the stress the test works at.
-  double rest_inertial_number = 1e-2;
+  /// is below rest_inertial_number^2 times the reference stress (docs/lab-tests.md,
+  /// "Settling"): the bed's weight stress, or the test's stress level where that is lower.
+  /// 2e-3 is the servo's quasi-static inertial number.
+  double rest_inertial_number = 2e-3;
   double rest_stress = 0.0;      ///< stress level of the test (Pa, simulated); 0 = the bed's weight
   double max_settle_time = 2.0;  ///< (s) of simulated time
 };
