@@ -3,6 +3,8 @@
 // the drum speed (eq. 20); a bed driven far beyond Froude number 1 is reported as centrifuging.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+
 #include "core/lab/lab_test.hpp"
 
 namespace demcal::lab {
@@ -22,10 +24,17 @@ MaterialModel granules(double mu_s, double mu_r) {
 
 const Settings kShort = {{"particles", 350}, {"angle_time", 0.8}, {"area_time", 0.05}};
 
+/// The mean angle of two beds (lab seeds 1, 2): one short run of 350 granules scatters by a few
+/// degrees with the rounding of the build (25.7 deg at mu_s 0.15 in one portable build).
 double angle(double mu_s, double mu_r) {
-  RunOptions opt;
-  return run_lab_test("rotating_drum", granules(mu_s, mu_r), kShort, opt)
-      .metrics.at("dynamic_angle_of_repose");
+  double sum = 0.0;
+  for (std::uint64_t seed : {1, 2}) {
+    RunOptions opt;
+    opt.seed = seed;
+    sum += run_lab_test("rotating_drum", granules(mu_s, mu_r), kShort, opt)
+               .metrics.at("dynamic_angle_of_repose");
+  }
+  return 0.5 * sum;
 }
 
 TEST(LabRotatingDrum, AngleRisesWithSlidingFriction) {
