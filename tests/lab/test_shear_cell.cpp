@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <map>
 
 #include "core/lab/lab_test.hpp"
 #include "core/lab/shear_cell.hpp"
@@ -28,6 +30,18 @@ const Settings kFast = {{"particles", 250},
                         {"torque_ramp_time", 0.15},
                         {"consolidation_time", 0.03}};
 
+/// The metrics of two beds (lab seeds 1, 2), averaged: the yield-locus slope of one bed of 250
+/// particles scatters by more than 0.1 (0.32 at mu_s 0.7 against 0.46 at 0.1 in one build).
+std::map<std::string, double> mean_metrics(const MaterialModel& m) {
+  std::map<std::string, double> sum;
+  for (std::uint64_t seed : {1, 2}) {
+    RunOptions opt;
+    opt.seed = seed;
+    for (const auto& [k, v] : run_lab_test("shear_cell", m, kFast, opt).metrics) sum[k] += 0.5 * v;
+  }
+  return sum;
+}
+
 TEST(LabShearCell, MohrEvaluationOfAConsistentAndAnInconsistentLocus) {
   // tau = 0.6 sigma + 0.2 with the pre-shear point on a circle touching it.
   const double k = 0.6, c = 0.2, phi = std::atan(k);
@@ -50,9 +64,8 @@ TEST(LabShearCell, MohrEvaluationOfAConsistentAndAnInconsistentLocus) {
 }
 
 TEST(LabShearCell, PreShearStressAndSlopeRiseWithFrictionAndYieldStressWithSigmaX) {
-  RunOptions opt;
-  const auto low = run_lab_test("shear_cell", powder(0.1, 1e-20), kFast, opt).metrics;
-  const auto high = run_lab_test("shear_cell", powder(0.7, 1e-20), kFast, opt).metrics;
+  const auto low = mean_metrics(powder(0.1, 1e-20));
+  const auto high = mean_metrics(powder(0.7, 1e-20));
   EXPECT_GT(high.at("pre_shear_stress"), 1.2 * low.at("pre_shear_stress"));
   EXPECT_GT(high.at("yield_locus_slope"), low.at("yield_locus_slope"));
   for (const auto* m : {&low, &high}) {
