@@ -98,8 +98,8 @@ void run_simulate(const SimulateOptions& opt) {
   for (const auto& wall : w.walls) report["walls"].push_back(wall.name);
   std::optional<io::CsvWriter> csv;
   if (!opt.walls_csv.empty())
-    csv.emplace(opt.walls_csv, std::vector<std::string>{"phase", "step", "time", "wall", "dx",
-                                                        "dy", "dz", "fx", "fy", "fz"});
+    csv.emplace(opt.walls_csv, std::vector<std::string>{"phase", "step", "time", "wall", "dx", "dy",
+                                                        "dz", "fx", "fy", "fz"});
   std::int64_t step = 0;
   for (std::size_t p = 0; p < scene.phases.size(); ++p) {
     const auto& phase = scene.phases[p];
@@ -141,8 +141,9 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--threads", opt->threads, "override the scene's thread count");
   cmd->add_option("--walls-csv", opt->walls_csv,
                   "CSV of every wall's displacement and force at each phase's record_every");
-  cmd->add_option("--bed", opt->bed_data,
-                  "write the final particles at rest as a LIGGGHTS data file (atom_style granular)");
+  cmd->add_option(
+      "--bed", opt->bed_data,
+      "write the final particles at rest as a LIGGGHTS data file (atom_style granular)");
   cmd->add_option("--piston-stl", opt->piston_stl,
                   "write an STL disk facing down at the bed top covering the die (first cylinder)");
   cmd->callback([opt] { run_simulate(*opt); });

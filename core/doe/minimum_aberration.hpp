@@ -2,7 +2,7 @@
 // Minimum-aberration 2^(k-p) generators (Fries and Hunter 1980): among all regular fractions
 // the one whose word-length pattern (A_3, A_4, ...) is smallest in lexicographic order; ties
 // are broken by the larger number of clear 2FIs (FrF2's MaxC2 criterion, Groemping 2014).
-// Two FrF2 catalogue entries are stored verbatim (those of ../shared/reference/doe-oracle/);
+// Two FrF2 catalogue entries are stored verbatim (those of tests/data/doe-oracle/);
 // everything else comes from an exhaustive branch-and-bound search whose result carries
 // whether it completed (proven minimum aberration) or hit its node budget.
 #include <cstdint>

@@ -2,7 +2,7 @@
 // Effects of a two-level design as bit masks: bit i set = factor i takes part. A main effect
 // has one bit, a two-factor interaction (2FI) two, a defining word as many as its length.
 // Letters follow FrF2 (Groemping 2014): A, B, ..., skipping I, so that output can be compared
-// with ../shared/reference/doe-oracle/ letter for letter.
+// with tests/data/doe-oracle/ letter for letter.
 #include <bit>
 #include <cstdint>
 #include <string>

@@ -81,8 +81,7 @@ void clump_kick_drift(particles::ParticleStore& p, const Domain& domain, const V
     domain.wrap(c.x[b]);
     const Vec3 omega0 = angular_velocity(r0, inv_inertia, c.angular_momentum[b]);
     const Quat q_mid = (rotation_quat(omega0 * half) * c.q[b]).normalized();
-    const Vec3 omega_mid =
-        angular_velocity(rotation_of(q_mid), inv_inertia, c.angular_momentum[b]);
+    const Vec3 omega_mid = angular_velocity(rotation_of(q_mid), inv_inertia, c.angular_momentum[b]);
     c.q[b] = (rotation_quat(omega_mid * dt) * c.q[b]).normalized();
     const Rotation r = rotation_of(c.q[b]);
     c.omega[b] = angular_velocity(r, inv_inertia, c.angular_momentum[b]);

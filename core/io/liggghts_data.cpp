@@ -56,8 +56,9 @@ class DataReader {
         read_velocity(line, atoms);
       }
     }
-    if (atoms.size() != expected_) fail("expected " + std::to_string(expected_) + " atoms, read " +
-                                        std::to_string(atoms.size()));
+    if (atoms.size() != expected_)
+      fail("expected " + std::to_string(expected_) + " atoms, read " +
+           std::to_string(atoms.size()));
     return box_;
   }
 
@@ -146,9 +147,8 @@ void write_liggghts_data(const std::string& path, const particles::ParticleStore
   std::fprintf(f, "\nAtoms\n\n");
   for (std::size_t i = 0; i < store.size(); ++i) {
     const double r = store.radius[i];
-    std::fprintf(f, "%zu %d %.17g %.17g %.17g %.17g %.17g\n", i + 1, store.material[i] + 1,
-                 2.0 * r, sphere_density(store.mass[i], r), store.x[i].x, store.x[i].y,
-                 store.x[i].z);
+    std::fprintf(f, "%zu %d %.17g %.17g %.17g %.17g %.17g\n", i + 1, store.material[i] + 1, 2.0 * r,
+                 sphere_density(store.mass[i], r), store.x[i].x, store.x[i].y, store.x[i].z);
   }
   if (with_velocities) {
     std::fprintf(f, "\nVelocities\n\n");
@@ -164,8 +164,8 @@ DataBox read_liggghts_data(const std::string& path, particles::ParticleStore& st
   std::map<long, Atom> atoms;
   const DataBox box = DataReader(path).read(atoms);
   for (const auto& [id, a] : atoms) {
-    const auto i = store.add_sphere(a.x, 0.5 * a.diameter, a.density,
-                                    static_cast<std::uint16_t>(a.type - 1));
+    const auto i =
+        store.add_sphere(a.x, 0.5 * a.diameter, a.density, static_cast<std::uint16_t>(a.type - 1));
     store.v[i] = a.v;
     store.omega[i] = a.omega;
   }

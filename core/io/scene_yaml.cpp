@@ -163,8 +163,7 @@ Scene read_scene(const YamlNode& root) {
   }
   for (const auto& item : root["phases"].items()) {
     item.expect_only({"name", "steps", "record_every"});
-    scene.phases.push_back({item["name"].as_string(),
-                            static_cast<long>(item["steps"].as_number()),
+    scene.phases.push_back({item["name"].as_string(), static_cast<long>(item["steps"].as_number()),
                             static_cast<long>(item.number("record_every", 0))});
     if (scene.phases.back().record_every < 0) item["record_every"].fail("must be >= 0");
   }

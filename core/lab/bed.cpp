@@ -243,15 +243,15 @@ double phase_time_limit(const ServoSettings& s, double target, double start) {
 
 /// Moves the driven wall towards the target until the stress (a running mean over a quarter of
 /// the hold time, so one rattling contact does not end it) has made three quarters of its way
-/// to it, or the wall reaches its retreat limit, or max_time passes. Nothing to do when the stress is already within tolerance.
-/// Returns the hold time of the phase: at least four transits of a stress wave through the bed,
-/// c = sqrt(E / rho_b) with E the secant modulus the approach measured (the bed must carry the
-/// wall's stress through its height before the stress counts as held), at most a tenth of the
-/// phase's time limit, at least ServoSettings::hold_time.
+/// to it, or the wall reaches its retreat limit, or max_time passes. Nothing to do when the stress
+/// is already within tolerance. Returns the hold time of the phase: at least four transits of a
+/// stress wave through the bed, c = sqrt(E / rho_b) with E the secant modulus the approach measured
+/// (the bed must carry the wall's stress through its height before the stress counts as held), at
+/// most a tenth of the phase's time limit, at least ServoSettings::hold_time.
 template <class StressOf, class Record>
 double approach_target(sim::World& world, std::size_t driven, Vec3 axis, double target,
-                     double time_limit, const ServoSettings& s, const sim::HealthLimits& limits,
-                     const StressOf& stress_of, const Record& record, int record_every) {
+                       double time_limit, const ServoSettings& s, const sim::HealthLimits& limits,
+                       const StressOf& stress_of, const Record& record, int record_every) {
   const double start = stress_of(world);
   if (s.speed_scale <= 0.0 || std::abs(start - target) <= s.tolerance) return s.hold_time;
   const double z0 = axial_position(world.walls[driven]);
@@ -308,7 +308,7 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
   const double t0 = world.time;
   const double time_limit = phase_time_limit(s, target, stress_of(world));
   const double hold_time = approach_target(world, driven, axis, target, time_limit, s, limits,
-                                          stress_of, record, record_every);
+                                           stress_of, record, record_every);
   // The stress on a piston is carried by a few tens of contacts and rattles; the phase ends when
   // the mean over a block of hold_time is within tolerance of the target.
   double block_start = world.time, sum_s = 0.0, sum_z = 0.0;

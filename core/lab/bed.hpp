@@ -116,7 +116,7 @@ struct ServoSettings {
   /// from the target to inertial_number at it, until the stress crosses the target.
   /// speed_scale = h / (d sqrt(rho)); 0 = no approach (the controller alone).
   double speed_scale = 0.0;
-  double height = 0.0;  ///< bed height h the speeds and the time-limit rule refer to (m)
+  double height = 0.0;        ///< bed height h the speeds and the time-limit rule refer to (m)
   double bulk_density = 0.0;  ///< rho_b of the bed (kg/m^3), for the stress-wave transit time
   double inertial_number = 0.0;
   double approach_inertial_number = 0.0;

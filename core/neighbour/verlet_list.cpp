@@ -1,10 +1,10 @@
 #include "core/neighbour/verlet_list.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
-
-#include <omp.h>
 
 #include "core/common/error.hpp"
 

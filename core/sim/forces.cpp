@@ -79,7 +79,7 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
     };
     if (!mesh) {
       // Plane, cylinder, disk: at most one contact per particle, one history per particle.
-for (int i = lo; i < hi; ++i) {
+      for (int i = lo; i < hi; ++i) {
         double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
         walls::WallGeometry g;
         if (!walls::wall_geometry(wall.shape, p.x[i], p.radius[i], range, g)) {
@@ -96,7 +96,7 @@ for (int i = lo; i < hi; ++i) {
       constexpr int kSlots = walls::Mesh::kMaxContacts;
       constexpr int kSlot = kStride + 3;
       constexpr double kSameContact = 0.7071;
-for (int i = lo; i < hi; ++i) {
+      for (int i = lo; i < hi; ++i) {
         double* h = hist + static_cast<std::ptrdiff_t>(i) * kSlots * kSlot;
         walls::WallGeometry g[kSlots];
         const int found = walls::mesh_contacts(*mesh, p.x[i], p.radius[i], range, g);
@@ -161,7 +161,6 @@ void sum_wall_wrench(walls::Wall& wall, const std::vector<Wrench>& parts) {
     wall.torque += part.torque;
   }
 }
-
 
 /// The force region: every thread resets and sums the forces of the particles it owns (pairs,
 /// then walls), then runs `after` on them.

@@ -97,7 +97,8 @@ TEST(Cli, ContactPrintsTheSummaryAndWritesTheSeries) {
                           (dir / "series.csv").string());
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
-  // LIGGGHTS 3.8 measures 0.499965884831271 for this collision (../shared/peers).
+  // LIGGGHTS 3.8 measures 0.499965884831271 for this collision
+  // (tests/data/liggghts/in.collision_hertz).
   EXPECT_NEAR(j["restitution"].get<double>(), 0.499965884831271, 1e-9);
   std::ifstream series(dir / "series.csv");
   std::string header;
@@ -177,9 +178,9 @@ particles:
 phases:
   - {name: settle, steps: 8000}
 )";
-  const Result bed = demcal("simulate " + (dir / "bed.yaml").string() + " --bed " +
-                            (dir / "bed.data").string() + " --piston-stl " +
-                            (dir / "piston.stl").string());
+  const Result bed =
+      demcal("simulate " + (dir / "bed.yaml").string() + " --bed " + (dir / "bed.data").string() +
+             " --piston-stl " + (dir / "piston.stl").string());
   ASSERT_EQ(bed.exit_code, 0) << bed.out;
   const double top = nlohmann::json::parse(bed.out)["metrics"]["bed_top"].get<double>();
   std::ifstream data(dir / "bed.data");

@@ -21,7 +21,7 @@ inline lab::SingleContactSummary run_contact(
 }
 
 /// The Luding load/unload/reload path of examples/contact_luding_path.yaml (the path of
-/// ../shared/peers/liggghts/in.luding_cycle), sampled at every step.
+/// tests/data/liggghts/in.luding_cycle), sampled at every step.
 inline lab::SingleContactSpec luding_path_example() {
   auto spec = lab::read_single_contact(io::YamlNode::load_file(
       std::string(DEMCAL_SOURCE_DIR) + "/examples/contact_luding_path.yaml"));

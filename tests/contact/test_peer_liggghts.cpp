@@ -1,5 +1,5 @@
 // Peer test: LIGGGHTS 3.8 (Debian's `liggghts`) and `demcal contact` run the same single-contact
-// experiments (the scripts of ../shared/peers/liggghts/) and must agree to 1e-6 relative.
+// experiments (the scripts of tests/data/liggghts/, copied from the shared peer folder) and must agree to 1e-6 relative.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -28,7 +28,7 @@ std::string run_command(const std::string& cmd) {
 }
 
 fs::path peer_dir() {
-  return fs::path(DEMCAL_SOURCE_DIR) / ".." / "shared" / "peers" / "liggghts";
+  return fs::path(DEMCAL_SOURCE_DIR) / "tests" / "data" / "liggghts";
 }
 
 /// Runs a LIGGGHTS input in a scratch directory (its output goes to ../out relative to it).

@@ -1,4 +1,4 @@
-// Designs against the FrF2 oracle in ../shared/reference/doe-oracle/ (FrF2 2.3.4 output).
+// Designs against the FrF2 oracle in tests/data/doe-oracle/ (FrF2 2.3.4 output).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,7 +15,7 @@
 namespace demcal::doe {
 namespace {
 
-const std::string kOracle = std::string(DEMCAL_SOURCE_DIR) + "/../shared/reference/doe-oracle/";
+const std::string kOracle = std::string(DEMCAL_SOURCE_DIR) + "/tests/data/doe-oracle/";
 
 /// An oracle file, open; a missing one is an error naming its path (the test fails, no crash).
 std::ifstream open_oracle(const std::string& file) {

@@ -3,13 +3,13 @@
 // Complete from an expired lease, invalid specs, missing or wrong tokens, and the CLI end to
 // end. Leases and heartbeats are short (flags); every wait is bounded.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <sqlite3.h>
 
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <set>
 
 #include "client/spec_yaml.hpp"

@@ -75,8 +75,8 @@ TEST(SimTimeStep, ClumpBoundUsesTheBodysEffectiveMassAtTheMember) {
         const Vec3 n{std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
         const Vec3 u = cross(p.body_offset[i], n);
         const Vec3& in = c.inertia[0];
-        const double m = 1.0 / (1.0 / c.mass[0] + u.x * u.x / in.x + u.y * u.y / in.y +
-                                u.z * u.z / in.z);
+        const double m =
+            1.0 / (1.0 / c.mass[0] + u.x * u.x / in.x + u.y * u.y / in.y + u.z * u.z / in.z);
         if (m < m_eff) m_eff = m, worst = i;
       }
   // The body moves as a whole: more mass than the member's share, less than the body's.
