@@ -130,48 +130,32 @@ long run_checked(sim::World& world, long steps, const sim::HealthLimits& limits,
   return steps;
 }
 
-namespace {
-/// Order of the weight stress at the bottom of the bed (Pa): its height times rho_p g 0.6.
-double weight_stress(const sim::World& w) {
-  const auto& p = w.particles;
-  double bottom = std::numeric_limits<double>::infinity(), top = -bottom, rho = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    bottom = std::min(bottom, p.x[i].z - p.radius[i]);
-    top = std::max(top, p.x[i].z + p.radius[i]);
-    rho += p.mass[i] / (4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3));
-  }
-  rho /= static_cast<double>(std::max<std::size_t>(p.size(), 1));
-  constexpr double kSolidFraction = 0.6;  // a settled bed, for the order of its weight stress
-  return kSolidFraction * rho * norm(w.gravity) * std::max(top - bottom, 0.0);
-}
-}  // namespace
-
 PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limits) {
   const PhaseClock clock(w);
   const auto& p = w.particles;
   double mass = 0.0, volume = 0.0;
+  double bottom = std::numeric_limits<double>::infinity(), top = -bottom;
   for (std::size_t i = 0; i < p.size(); ++i) {
     mass += p.mass[i];
     volume += 4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3);
+    bottom = std::min(bottom, p.x[i].z - p.radius[i]);
+    top = std::max(top, p.x[i].z + p.radius[i]);
   }
   const double rho = volume > 0.0 ? mass / volume : 0.0;
+  const double height = std::max(top - bottom, 0.0);
+  const double g = norm(w.gravity);
   // The bed height the tests start from is read at rest under the bed's own weight: the
-  // reference is that weight stress, or the test's stress level where it is lower.
-  const double weight = weight_stress(w);
+  // reference is the order of that weight stress (solid fraction 0.6 over the column), or the
+  // test's stress level where it is lower.
+  constexpr double kSolidFraction = 0.6;
+  const double weight = kSolidFraction * rho * g * height;
   const double sigma = spec.rest_stress > 0.0 ? std::min(spec.rest_stress, weight) : weight;
   // rho <v^2> < I^2 sigma with <v^2> = 2 KE / M.
   const double ke_limit =
       0.5 * mass * spec.rest_inertial_number * spec.rest_inertial_number * sigma / rho;
   // Freshly inserted particles are at rest before they fall: the criterion counts only after
   // the free-fall time of the column they were inserted in.
-  double bottom = std::numeric_limits<double>::infinity(), top = -bottom;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    bottom = std::min(bottom, p.x[i].z - p.radius[i]);
-    top = std::max(top, p.x[i].z + p.radius[i]);
-  }
-  const double fall = norm(w.gravity) > 0.0 && top > bottom
-                          ? std::sqrt(2.0 * (top - bottom) / norm(w.gravity))
-                          : 0.0;
+  const double fall = g > 0.0 ? std::sqrt(2.0 * height / g) : 0.0;
   const double t0 = w.time;
   const long chunk = std::max<long>(200, std::lround(0.002 / w.dt));
   bool rest = false;
@@ -233,12 +217,15 @@ double approach_speed(const ServoSettings& s, double target, double stress) {
   return inertial * s.speed_scale * std::sqrt(ref);
 }
 
-/// The phase's simulated time limit: the given one, or (rule) half the bed height at the
-/// quasi-static speed of the larger of the start and target stresses, plus 50 hold times.
+/// The phase's simulated time limit: the given one, or (rule) the whole bed height at the
+/// quasi-static speed of the larger of the start and target stresses (no phase compacts a bed by
+/// more than its height), plus 50 hold times. Without an inertial-number scale, the speed limit.
 double phase_time_limit(const ServoSettings& s, double target, double start) {
   if (s.max_time > 0.0) return s.max_time;
-  const double v = s.inertial_number * s.speed_scale * std::sqrt(std::max(target, std::abs(start)));
-  return 0.5 * s.height / v + 50.0 * s.hold_time;
+  const double v = s.speed_scale > 0.0 ? s.inertial_number * s.speed_scale *
+                                             std::sqrt(std::max(target, std::abs(start)))
+                                       : s.max_speed;
+  return s.height / v + 50.0 * s.hold_time;
 }
 
 /// Moves the driven wall towards the target until the stress (a running mean over a quarter of
@@ -253,7 +240,8 @@ double approach_target(sim::World& world, std::size_t driven, Vec3 axis, double 
                        double time_limit, const ServoSettings& s, const sim::HealthLimits& limits,
                        const StressOf& stress_of, const Record& record, int record_every) {
   const double start = stress_of(world);
-  if (s.speed_scale <= 0.0 || std::abs(start - target) <= s.tolerance) return s.hold_time;
+  if (s.approach_inertial_number <= 0.0 || std::abs(start - target) <= s.tolerance)
+    return s.hold_time;
   const double z0 = axial_position(world.walls[driven]);
   const double direction = target > start ? 1.0 : -1.0;
   // The approach hands over to the controller a quarter of the stress change before the target,

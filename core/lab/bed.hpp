@@ -114,7 +114,8 @@ struct ServoSettings {
   /// The approach before the controller holds (docs/lab-tests.md, "Servo phases"): the wall
   /// moves at v = I h sqrt(sigma_ref / rho) / d, I blending from approach_inertial_number far
   /// from the target to inertial_number at it, until the stress crosses the target.
-  /// speed_scale = h / (d sqrt(rho)); 0 = no approach (the controller alone).
+  /// speed_scale = h / (d sqrt(rho)); approach_inertial_number 0 = no approach (the controller
+  /// alone).
   double speed_scale = 0.0;
   double height = 0.0;        ///< bed height h the speeds and the time-limit rule refer to (m)
   double bulk_density = 0.0;  ///< rho_b of the bed (kg/m^3), for the stress-wave transit time

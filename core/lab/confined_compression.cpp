@@ -34,7 +34,6 @@ ServoSettings make_servo(const sim::World& w, double h, double stress_max, const
   s.approach_inertial_number = r.approach_inertial_number;
   s.max_speed =
       r.max_speed > 0.0 ? r.max_speed : r.inertial_number * s.speed_scale * std::sqrt(stress_max);
-  if (r.approach_inertial_number <= 0.0) s.speed_scale = 0.0;
   // Full speed at an error of the whole largest stress: slow enough that the loop stays well
   // behind the bed's elastic wave transit time for usual bulk stiffnesses.
   s.kp = r.kp > 0.0 ? r.kp : s.max_speed / stress_max;
