@@ -3,8 +3,10 @@
 
 #include "client/commands.hpp"
 #include "core/common/error.hpp"
+#include "core/sim/threads.hpp"
 
 int main(int argc, char** argv) {
+  demcal::sim::wait_passively(argv);
   CLI::App app{"demcal - calibrate DEM contact models against measured bulk tests"};
   app.require_subcommand(1);
   demcal::cli::add_contact_command(app);

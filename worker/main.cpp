@@ -8,9 +8,11 @@
 #include <fstream>
 #include <thread>
 
+#include "core/sim/threads.hpp"
 #include "worker/worker.hpp"
 
 int main(int argc, char** argv) {
+  demcal::sim::wait_passively(argv);
   demcal::worker::WorkerOptions o;
   std::string token_file;
   CLI::App app{"demcal-worker - runs demcal lab-test jobs for a coordinator"};

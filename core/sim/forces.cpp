@@ -183,7 +183,7 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
   const MinimumImage image(w.domain);
   const bool periodic = w.domain.any_periodic();
   const double dt = w.dt;
-  const int threads = w.threads;
+  const int threads = w.active_threads();
   // Each wall's force and torque, per thread, summed in thread order after the region.
   std::vector<std::vector<Wrench>> on_walls(w.walls.size(), std::vector<Wrench>(threads));
 

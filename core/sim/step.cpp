@@ -20,7 +20,7 @@ bool kick_drift(World& w) {
   const bool clumps = p.clumps.size() > 0;
   const double half_skin = 0.5 * w.effective_skin();
   double worst = 0.0;
-#pragma omp parallel num_threads(w.threads) reduction(max : worst)
+#pragma omp parallel num_threads(w.active_threads()) reduction(max : worst)
   {
     const auto [lo, hi] = owned_range(n, omp_get_thread_num(), omp_get_num_threads());
     integrate::kick_drift(p, w.dt, lo, hi);
@@ -33,7 +33,7 @@ bool kick_drift(World& w) {
 void rebuild_neighbour_list(World& w) {
   for (auto& x : w.particles.x) w.domain.wrap(x);
   w.list.build(w.particles.x, w.particles.radius, w.domain,
-               w.interaction_range() + w.effective_skin(), w.threads, w.pair_history,
+               w.interaction_range() + w.effective_skin(), w.active_threads(), w.pair_history,
                w.pair_stride(), w.clump_bodies());
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // The simulated system: particles, walls, the contact laws per pair type, and the state the
 // step function carries from one step to the next (neighbour list, per-contact history).
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -20,7 +21,18 @@ class World {
   Vec3 gravity{0.0, 0.0, -9.81};
   double dt = 0.0;    ///< time step (s)
   double skin = 0.0;  ///< Verlet skin (m); 0 = 10 % of the smallest particle radius
-  int threads = 1;    ///< OpenMP threads; results are bitwise identical for a given count
+  int threads = 1;    ///< OpenMP threads at most; see active_threads()
+  /// The fewest particles a thread is given: a smaller system runs on fewer threads than asked.
+  /// Below a few thousand particles a step is too short to pay for the barriers between threads
+  /// (docs/engine.md, "Threads"); tests of the threaded paths set it to 1.
+  int particles_per_thread = kParticlesPerThread;
+  static constexpr int kParticlesPerThread = 2000;
+  /// The threads a step runs on: `threads`, or fewer so that each has particles_per_thread.
+  /// Results are bitwise identical for a given number of active threads.
+  int active_threads() const {
+    const auto by_size = particles.size() / static_cast<std::size_t>(std::max(1, particles_per_thread));
+    return static_cast<int>(std::clamp<std::size_t>(by_size, 1, static_cast<std::size_t>(std::max(1, threads))));
+  }
   double time = 0.0;
   std::int64_t step_count = 0;
 

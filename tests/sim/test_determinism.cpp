@@ -62,6 +62,7 @@ phases: []
 sim::World load(const std::string& yaml, int threads, double skin = 0.0) {
   auto scene = io::read_scene(io::YamlNode::load_string(yaml, "scene.yaml"));
   scene.world.threads = threads;
+  scene.world.particles_per_thread = 1;  // the 180-particle pour runs on every thread asked for
   if (skin > 0.0) scene.world.skin = skin;
   return std::move(scene.world);
 }
@@ -82,6 +83,7 @@ std::size_t bit_differences(const sim::World& a, const sim::World& b) {
 TEST(SimDeterminism, SameThreadCountGivesBitwiseIdenticalRuns) {
   for (int threads : {2, 1}) {
     sim::World a = load(kPeriodicPour, threads), b = load(kPeriodicPour, threads);
+    ASSERT_EQ(a.active_threads(), threads);
     sim::run(a, 4000);
     sim::run(b, 4000);
     EXPECT_EQ(bit_differences(a, b), 0u) << threads << " threads";
@@ -91,6 +93,20 @@ TEST(SimDeterminism, SameThreadCountGivesBitwiseIdenticalRuns) {
     EXPECT_LT(a.walls[0].force.z, 0.0);
     EXPECT_GT(a.list.builds(), 5u);
   }
+}
+
+TEST(SimThreads, SmallSystemsRunOnFewerThreadsThanAsked) {
+  sim::World w = load(kPeriodicPour, 2);
+  w.particles_per_thread = sim::World::kParticlesPerThread;
+  EXPECT_EQ(w.active_threads(), 1) << "180 particles";
+  w.particles_per_thread = 50;
+  EXPECT_EQ(w.active_threads(), 2);
+  w.threads = 8;
+  EXPECT_EQ(w.active_threads(), 3) << "180 particles at 50 per thread";
+  w.particles_per_thread = 0;
+  EXPECT_EQ(w.active_threads(), 8) << "no grain: every thread asked for";
+  w.threads = 0;
+  EXPECT_EQ(w.active_threads(), 1);
 }
 
 TEST(SimDeterminism, SkinDoesNotChangeOneBitBecauseHistorySurvivesRebuilds) {
