@@ -30,8 +30,10 @@ class World {
   /// The threads a step runs on: `threads`, or fewer so that each has particles_per_thread.
   /// Results are bitwise identical for a given number of active threads.
   int active_threads() const {
-    const auto by_size = particles.size() / static_cast<std::size_t>(std::max(1, particles_per_thread));
-    return static_cast<int>(std::clamp<std::size_t>(by_size, 1, static_cast<std::size_t>(std::max(1, threads))));
+    const auto by_size =
+        particles.size() / static_cast<std::size_t>(std::max(1, particles_per_thread));
+    return static_cast<int>(
+        std::clamp<std::size_t>(by_size, 1, static_cast<std::size_t>(std::max(1, threads))));
   }
   double time = 0.0;
   std::int64_t step_count = 0;
