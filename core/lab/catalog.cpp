@@ -111,16 +111,19 @@ LabTestInfo rotating_drum_info() {
 
 // hopper: seed 000 §2.7.6 (runner in hopper.cpp).
 LabTestInfo hopper_info() {
-  return {"hopper",
-          "wedge hopper slice with periodic front and back: fill and settle with the gate closed, "
-          "open it, discharge rate from the mass-time curve, arching, ratio to Beverloo's slot "
-          "law (hydraulic-diameter form) W = (4 sqrt 2 / pi) C rho_b sqrt(g) L (b - k d)^1.5 with "
-          "C = 0.58, k = 1.5",
-          "seed 000 §2.7.6",
-          {{"discharge_rate", "kg/s", "slope of the discharged mass over time after start-up"},
-           {"arched", "0/1", "1 when no particle left for arch_time before the hopper emptied"},
-           {"beverloo_ratio", "-", "discharge_rate over Beverloo's slot-form rate"}},
-          settings_docs<HopperSettings>()};
+  return {
+      "hopper",
+      "wedge hopper slice with periodic front and back: fill and settle with the gate closed, "
+      "open it, discharge rate from the mass-time curve, arching, ratio to Beverloo's slot "
+      "law (hydraulic-diameter form) W = (4 sqrt 2 / pi) C rho_b sqrt(g) L (b - k d)^1.5 with "
+      "C = 0.58, k = 1.5, times Rose and Tanaka's factor (tan theta tan 45 deg)^-0.35 for walls "
+      "steeper than 45 deg",
+      "seed 000 §2.7.6",
+      {{"discharge_rate", "kg/s", "slope of the discharged mass over time after start-up"},
+       {"arched", "0/1", "1 when no particle left for arch_time before the hopper emptied"},
+       {"beverloo_rate", "kg/s", "Beverloo's slot-form rate with the wall factor"},
+       {"beverloo_ratio", "-", "discharge_rate over beverloo_rate"}},
+      settings_docs<HopperSettings>()};
 }
 
 const std::vector<LabTestInfo>& lab_catalog() {

@@ -1,16 +1,25 @@
 // hopper (seed 000 §2.7.6): a wedge hopper slice with periodic front and back is filled with the
 // gate closed, the bed settles, the gate opens, and the discharged mass is recorded over time.
 //
-// Beverloo's law (C = 0.58, k = 1.5, the circular-orifice constants) in its slot form through the
-// hydraulic diameter: the circular law W = C rho_b sqrt(g) D^(5/2) written as
-// W = (4/pi) C rho_b sqrt(g) A sqrt(D_h) (A = pi D^2/4, D_h = D) holds for any orifice with its
-// area A and hydraulic diameter D_h = 4 A / perimeter, both shrunk by the empty annulus k d. A
-// slot of width b and length L >> b (here L is the periodic slice depth, no end walls) has
-// A = L (b - k d) and D_h = 2 (b - k d), so
-//   W_B = (4 sqrt(2) / pi) C rho_b sqrt(g) L (b - k d)^(3/2)   (= 1.04 rho_b sqrt(g) L (b-kd)^1.5,
-// close to the slot coefficient 1.03 of Myers and Sellers). rho_b is the bulk density of the
-// settled bed (measured: solid fraction in a box in the middle of the bed times the particle
-// density) and d the largest particle diameter.
+// The reference rate is Beverloo's law for the outlet used, corrected for the converging walls:
+//
+// 1. Beverloo (C = 0.58, k = 1.5, the circular-orifice constants) in its slot form through the
+//    hydraulic diameter: the circular law W = C rho_b sqrt(g) D^(5/2) written as
+//    W = (4/pi) C rho_b sqrt(g) A sqrt(D_h) (A = pi D^2/4, D_h = D) holds for any orifice with
+//    its area A and hydraulic diameter D_h = 4 A / perimeter, both shrunk by the empty annulus
+//    k d. A slot of width b and length L >> b (here L is the periodic slice depth, no end walls)
+//    has A = L (b - k d) and D_h = 2 (b - k d), so
+//      W_B = (4 sqrt(2) / pi) C rho_b sqrt(g) L (b - k d)^(3/2)
+//    (= 1.04 rho_b sqrt(g) L (b-kd)^1.5, close to the slot coefficient 1.03 of Myers and
+//    Sellers). rho_b is the bulk density of the settled bed (measured: solid fraction in a box in
+//    the middle of the bed times the particle density) and d the largest particle diameter.
+// 2. Beverloo's law is for a flat-bottomed bin, where the flowing core is bounded by stagnant
+//    material at about phi_d from the horizontal. Walls steeper than that boundary (half angle
+//    theta from the vertical < 90 deg - phi_d) speed the flow up by Rose and Tanaka's factor
+//      F = (tan theta tan phi_d)^(-0.35),   F = 1 otherwise
+//    (Rose & Tanaka 1956; Nedderman, Statics and Kinematics of Granular Materials, 1992, ch. 10),
+//    with phi_d = 45 deg, the usual value for a flat bottom. The 20 deg default wedge has
+//    F = 1.42.
 #include "core/lab/hopper.hpp"
 
 #include <algorithm>
@@ -29,6 +38,12 @@ namespace demcal::lab {
 
 namespace {
 constexpr double kBeverlooC = 0.58, kBeverlooK = 1.5;
+constexpr double kStagnantZoneAngle = 45.0 * M_PI / 180.0;  // phi_d from the horizontal
+}  // namespace
+
+double rose_tanaka_factor(double half_angle) {
+  if (half_angle >= 0.5 * M_PI - kStagnantZoneAngle) return 1.0;
+  return std::pow(std::tan(half_angle) * std::tan(kStagnantZoneAngle), -0.35);
 }
 
 LabOutput run_hopper(const MaterialModel& material, const Settings& values,
@@ -163,13 +178,14 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
   else if (curve.rows.size() >= 2 && curve.rows.back()[0] > 0.0)
     rate = m_end / curve.rows.back()[0];
 
-  // Beverloo slot form (header comment).
+  // Beverloo slot form with the hopper's wall factor (header comment).
   const double g = norm(w.gravity);
   const double opening = std::max(0.0, b - kBeverlooK * d);
   const double beverloo = 4.0 * std::sqrt(2.0) / M_PI * kBeverlooC * rho_b * std::sqrt(g) * depth *
-                          std::pow(opening, 1.5);
+                          std::pow(opening, 1.5) * rose_tanaka_factor(theta);
   out.metrics["discharge_rate"] = rate;
   out.metrics["arched"] = arched ? 1.0 : 0.0;
+  out.metrics["beverloo_rate"] = beverloo;
   out.metrics["beverloo_ratio"] = beverloo > 0.0 ? rate / beverloo : 0.0;
   out.metrics["discharged_fraction"] = m_end / total_mass;
   out.metrics["bulk_density"] = rho_b;

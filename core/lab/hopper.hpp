@@ -35,6 +35,10 @@ struct HopperSettings {
   void finalize(const std::string&) {}
 };
 
+/// Rose and Tanaka's factor on Beverloo's rate for walls at `half_angle` (rad) from the vertical:
+/// (tan theta tan 45 deg)^-0.35 below 45 deg, 1 above (hopper.cpp).
+double rose_tanaka_factor(double half_angle);
+
 LabTestInfo hopper_info();  ///< in catalog.cpp
 LabOutput run_hopper(const MaterialModel& material, const Settings& settings,
                      const RunOptions& options);
