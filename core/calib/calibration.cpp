@@ -124,6 +124,8 @@ void validate(const CalibrationProblem& problem) {
       throw InputError(where + ".uncertainty", "must be positive");
     }
     if (!m.uncertainty && !(m.weight >= 0.0)) throw InputError(where + ".weight", "must be >= 0");
+    if (!(std::isfinite(m.noise_sd) && m.noise_sd >= 0.0))
+      throw InputError(where + ".noise_sd", "must be finite and >= 0");
     if (m.target == 0.0 && !m.uncertainty) {
       throw InputError(where + ".target",
                        "is 0: a relative error is undefined; give an "
@@ -132,7 +134,32 @@ void validate(const CalibrationProblem& problem) {
   }
 }
 
+/// Whether the box reaches the target: an envelope that misses it by no more than the
+/// tolerance still reaches it, since noise and measurement error cover the gap.
+void state_reach(MetricOutcome& o) {
+  const std::string range = "[" + number(o.envelope.min) + ", " + number(o.envelope.max) + "]";
+  const std::string within =
+      o.tolerance > 0.0 ? " (tolerance +-" + number(o.tolerance) + ": uncertainty and noise)" : "";
+  const std::string head = "target " + number(o.target) + " of " + o.name;
+  if (o.target > o.envelope.max + o.tolerance) {
+    o.reachable = false;
+    o.statement = head + " lies above the largest value reachable in the box, " +
+                  number(o.envelope.max) + within + ": unreachable with these factor ranges";
+  } else if (o.target < o.envelope.min - o.tolerance) {
+    o.reachable = false;
+    o.statement = head + " lies below the smallest value reachable in the box, " +
+                  number(o.envelope.min) + within + ": unreachable with these factor ranges";
+  } else {
+    o.statement = head + " is within reach " + range + within;
+  }
+}
+
 }  // namespace
+
+double tolerance(const MetricTarget& m) {
+  const double u = m.uncertainty ? *m.uncertainty : 0.0;
+  return std::hypot(u, m.noise_sd);
+}
 
 double effective_weight(const MetricTarget& m) {
   return m.uncertainty ? std::pow(m.target / *m.uncertainty, 2) : m.weight;
@@ -203,20 +230,8 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const Calibration
     o.relative_error =
         m.target != 0.0 ? (o.predicted - m.target) / std::abs(m.target) : std::nan("");
     o.envelope = reachable_envelope(m.model, options);
-    const std::string range = "[" + number(o.envelope.min) + ", " + number(o.envelope.max) + "]";
-    if (m.target > o.envelope.max) {
-      o.reachable = false;
-      o.statement = "target " + number(m.target) + " of " + m.name +
-                    " lies above the largest value reachable in the box, " +
-                    number(o.envelope.max) + ": unreachable with these factor ranges";
-    } else if (m.target < o.envelope.min) {
-      o.reachable = false;
-      o.statement = "target " + number(m.target) + " of " + m.name +
-                    " lies below the smallest value reachable in the box, " +
-                    number(o.envelope.min) + ": unreachable with these factor ranges";
-    } else {
-      o.statement = "target " + number(m.target) + " of " + m.name + " is within reach " + range;
-    }
+    o.tolerance = tolerance(m);
+    state_reach(o);
     out.metrics.push_back(o);
   }
   return out;

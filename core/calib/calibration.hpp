@@ -25,7 +25,13 @@ struct MetricTarget {
   double target = 0.0;
   double weight = 1.0;
   std::optional<double> uncertainty;
+  double noise_sd = 0.0;  ///< run-to-run noise of the simulated metric; 0 = none known
 };
+
+/// How far a simulated value may lie from the target and still match it: the measurement's
+/// uncertainty and the simulation's noise combined as independent errors,
+/// sqrt(uncertainty^2 + noise_sd^2); 0 when neither is known.
+double tolerance(const MetricTarget& metric);
 
 struct CalibrationProblem {
   std::vector<doe::Factor> factors;
@@ -55,9 +61,11 @@ struct MetricOutcome {
   double target = 0.0;
   double predicted = 0.0;
   double relative_error = 0.0;  ///< (predicted - target) / |target|
+  double tolerance = 0.0;       ///< see tolerance(MetricTarget)
   Envelope envelope;
   bool reachable = true;
-  std::string statement;  ///< plain words: within reach, or above/below what the box reaches
+  /// Plain words: within reach, or above/below what the box reaches by more than the tolerance.
+  std::string statement;
 };
 
 struct CalibrationResult {

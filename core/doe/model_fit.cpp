@@ -237,4 +237,45 @@ ModelFit fit_model(const Eigen::MatrixXd& coded, const Eigen::VectorXd& response
   return fit;
 }
 
+ModelFit refit(const ModelFit& structure, const Eigen::MatrixXd& coded,
+               const Eigen::VectorXd& response) {
+  if (coded.rows() != response.size() || coded.cols() != structure.factor_count) {
+    throw InputError("response", "refit needs one value per row and " +
+                                     std::to_string(structure.factor_count) + " columns");
+  }
+  ModelFit fit = structure;
+  fit.rows_used.clear();
+  for (Eigen::Index r = 0; r < coded.rows(); ++r) {
+    if (std::isfinite(response(r))) fit.rows_used.push_back(static_cast<int>(r));
+  }
+  const auto n = static_cast<Eigen::Index>(fit.rows_used.size());
+  const auto p = static_cast<Eigen::Index>(structure.terms.size()) + 1;
+  if (n < p) {
+    throw InputError("response",
+                     std::to_string(n) + " finite rows for " + std::to_string(p) + " coefficients");
+  }
+  Eigen::MatrixXd design(n, p);
+  Eigen::VectorXd y(n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const Eigen::VectorXd x = coded.row(fit.rows_used[std::size_t(r)]).transpose();
+    design(r, 0) = 1.0;
+    for (Eigen::Index t = 1; t < p; ++t) design(r, t) = structure.term_value(std::size_t(t - 1), x);
+    y(r) = response(fit.rows_used[std::size_t(r)]);
+  }
+  const Eigen::VectorXd beta = design.colPivHouseholderQr().solve(y);
+  fit.intercept = beta(0);
+  fit.coefficients = beta.tail(p - 1);
+  fit.fitted = design * beta;
+  fit.residuals = y - fit.fitted;
+  fit.sse = fit.residuals.squaredNorm();
+  fit.sst = (y.array() - y.mean()).matrix().squaredNorm();
+  fit.residual_df = static_cast<int>(n - p);
+  fit.r_squared = fit.sst > 0.0 ? 1.0 - fit.sse / fit.sst : 1.0;
+  // Leverage, leave-one-out and standard errors describe the design fit only.
+  fit.standard_errors.resize(0);
+  fit.leverage.resize(0);
+  fit.loo_residuals.clear();
+  return fit;
+}
+
 }  // namespace demcal::doe

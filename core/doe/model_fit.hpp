@@ -71,4 +71,12 @@ struct FitOptions {
 ModelFit fit_model(const Eigen::MatrixXd& coded, const Eigen::VectorXd& response, ModelKind kind,
                    const FitOptions& options = {});
 
+/// Refits the terms of `structure` (chosen on its design) on other rows, e.g. the design plus
+/// verification runs: the regressors are the chain means predict() uses, so points off the
+/// design inform the same model instead of splitting its alias chains. Sets the intercept,
+/// coefficients, rows_used, fitted values, residuals, sse, sst, residual_df and R^2. NaN marks
+/// a missing response; throws InputError with fewer finite rows than coefficients.
+ModelFit refit(const ModelFit& structure, const Eigen::MatrixXd& coded,
+               const Eigen::VectorXd& response);
+
 }  // namespace demcal::doe

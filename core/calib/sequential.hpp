@@ -1,0 +1,106 @@
+#pragma once
+// Sequential calibration: propose, verify by simulation, let the verified runs join the fit,
+// propose again, until every calibrated metric is within its tolerance (measurement
+// uncertainty and simulation noise, calibration.hpp) or the round budget of a stage is spent;
+// then, as seed 000 §3.3 did by hand, a second-stage design in a narrowed box around the best
+// simulated point, and the rounds again. This file only decides the next step from what has
+// been simulated so far; the caller (the coordinator, or a test with a synthetic simulator)
+// runs the simulations and calls it again. Deterministic for a seed.
+#include <Eigen/Dense>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/calib/calibration.hpp"
+#include "core/doe/design.hpp"
+#include "core/doe/factor.hpp"
+#include "core/doe/model_fit.hpp"
+
+namespace demcal::calib {
+
+struct SequentialOptions {
+  int rounds = 3;       ///< verification rounds per stage
+  int stages = 2;       ///< 1 = no second-stage design
+  double narrow = 0.3;  ///< a new stage's box spans this fraction of each factor's coded range
+  int max_jobs = 0;     ///< simulations the calibration may add; 0 = no limit
+  doe::ModelKind model = doe::ModelKind::kTwoFactor;
+  CalibrationOptions calibration;
+  /// InputError naming "<where>.rounds" etc. for a value out of range.
+  void validate(const std::string& where) const;
+};
+
+/// A calibrated metric: target, weight or uncertainty, and the simulation's noise.
+struct SequentialTarget {
+  std::string name;
+  double target = 0.0;
+  double weight = 1.0;
+  std::optional<double> uncertainty;
+  double noise_sd = 0.0;
+};
+
+/// One simulated stage design: its box and its runs (coded in that box), one response column
+/// per target (NaN = failed or not yet done).
+struct StageRuns {
+  std::vector<doe::Factor> box;
+  Eigen::MatrixXd coded;
+  Eigen::MatrixXd responses;
+};
+
+/// One verification round: where it simulated and what the models predicted there; the
+/// simulated values (one per target) once its jobs are done.
+struct VerifiedRound {
+  int stage = 1;
+  Eigen::VectorXd natural;
+  Eigen::VectorXd predicted;
+  std::optional<Eigen::VectorXd> simulated;
+};
+
+struct SequentialState {
+  std::vector<doe::Factor> factors;  ///< the campaign's box
+  std::vector<SequentialTarget> targets;
+  std::vector<StageRuns> stages;  ///< stage 1 = the campaign's design
+  std::vector<VerifiedRound> rounds;
+  int jobs_used = 0;       ///< simulations added by the calibration so far
+  int jobs_per_point = 1;  ///< simulations one parameter set costs (one per lab test)
+};
+
+/// How a simulated point compares with the targets: each metric's |simulated - target| in
+/// tolerances (relative to |target| where a metric has no tolerance), the worst of them.
+struct PointScore {
+  Eigen::VectorXd deviation;
+  double worst = 0.0;
+  int worst_metric = -1;
+  bool within = false;  ///< every metric within its tolerance
+};
+PointScore score_point(const std::vector<SequentialTarget>& targets,
+                       const Eigen::VectorXd& simulated);
+
+enum class NextStep { kVerify, kNewStage, kDone };
+
+struct SequentialDecision {
+  NextStep step = NextStep::kDone;
+  int stage = 1;  ///< the stage whose models `proposal` comes from
+  /// The current best proposal of the stage's models (what kVerify simulates next).
+  CalibrationResult proposal;
+  std::vector<doe::Factor> next_box;  ///< kNewStage: the narrowed box
+  bool within = false;
+  /// "within uncertainty after N rounds (M simulations)", or which metric is not and by how
+  /// much, or what runs next.
+  std::string conclusion;
+};
+
+/// The next step; throws InputError when a stage has too few runs to fit.
+SequentialDecision next_step(const SequentialState& state, const SequentialOptions& options);
+
+/// Models of a stage: the structure from its design, refitted on every simulated point inside
+/// the stage's box (its design, other stages' runs, verified rounds), then shifted to pass
+/// through the latest verified point inside the box (output space mapping).
+CalibrationProblem stage_problem(const SequentialState& state, std::size_t stage,
+                                 doe::ModelKind model);
+
+/// The box of a new stage: `fraction` of each coded range of `outer`, centred on `natural`
+/// and shifted to stay inside `outer`.
+std::vector<doe::Factor> narrowed_box(const std::vector<doe::Factor>& outer,
+                                      const Eigen::VectorXd& natural, double fraction);
+
+}  // namespace demcal::calib
