@@ -43,6 +43,7 @@ bool inside(const Eigen::VectorXd& coded) {
 struct Points {
   std::vector<Eigen::VectorXd> natural;
   std::vector<Eigen::VectorXd> values;
+  std::size_t first_verified = 0;  ///< points from here on are verified rounds
 };
 
 Points all_points(const SequentialState& state, std::size_t skip_stage) {
@@ -58,6 +59,7 @@ Points all_points(const SequentialState& state, std::size_t skip_stage) {
       p.values.push_back(st.responses.row(r).transpose());
     }
   }
+  p.first_verified = p.natural.size();
   for (const auto& round : state.rounds) {
     if (!round.simulated) continue;
     p.natural.push_back(round.natural);
@@ -186,6 +188,10 @@ CalibrationProblem stage_problem(const SequentialState& state, std::size_t stage
   }
   Eigen::MatrixXd coded(Eigen::Index(rows.size()), st.coded.cols());
   for (std::size_t r = 0; r < rows.size(); ++r) coded.row(Eigen::Index(r)) = rows[r].transpose();
+  Eigen::VectorXd weights = Eigen::VectorXd::Ones(coded.rows());
+  for (std::size_t e = 0; e < extra_used.size(); ++e)
+    if (extra_used[e] >= extra.first_verified)
+      weights(st.coded.rows() + Eigen::Index(e)) = kVerifiedWeight;
   CalibrationProblem problem;
   problem.factors = st.box;
   for (std::size_t m = 0; m < state.targets.size(); ++m) {
@@ -196,7 +202,7 @@ CalibrationProblem stage_problem(const SequentialState& state, std::size_t stage
     for (std::size_t e = 0; e < extra_used.size(); ++e)
       y(st.coded.rows() + Eigen::Index(e)) = extra.values[extra_used[e]](col);
     MetricTarget t = metric_target(state.targets[m]);
-    t.model = doe::refit(structure, coded, y);
+    t.model = doe::refit(structure, coded, y, weights);
     shift_through_latest(state, st.box, m, t.model);
     problem.metrics.push_back(std::move(t));
   }

@@ -18,6 +18,10 @@
 
 namespace demcal::calib {
 
+/// A verified run weighs as this many design runs when the models are refitted with it: it lies
+/// near the optimum, where the fit is used (a trust-region flavour of surrogate correction).
+constexpr double kVerifiedWeight = 10.0;
+
 struct SequentialOptions {
   int rounds = 3;       ///< verification rounds per stage
   int stages = 2;       ///< 1 = no second-stage design

@@ -238,9 +238,10 @@ ModelFit fit_model(const Eigen::MatrixXd& coded, const Eigen::VectorXd& response
 }
 
 ModelFit refit(const ModelFit& structure, const Eigen::MatrixXd& coded,
-               const Eigen::VectorXd& response) {
-  if (coded.rows() != response.size() || coded.cols() != structure.factor_count) {
-    throw InputError("response", "refit needs one value per row and " +
+               const Eigen::VectorXd& response, const Eigen::VectorXd& weights) {
+  if (coded.rows() != response.size() || coded.cols() != structure.factor_count ||
+      (weights.size() != 0 && weights.size() != response.size())) {
+    throw InputError("response", "refit needs one value (and weight) per row and " +
                                      std::to_string(structure.factor_count) + " columns");
   }
   ModelFit fit = structure;
@@ -250,19 +251,20 @@ ModelFit refit(const ModelFit& structure, const Eigen::MatrixXd& coded,
   }
   const auto n = static_cast<Eigen::Index>(fit.rows_used.size());
   const auto p = static_cast<Eigen::Index>(structure.terms.size()) + 1;
-  if (n < p) {
-    throw InputError("response",
-                     std::to_string(n) + " finite rows for " + std::to_string(p) + " coefficients");
-  }
+  if (n < 1) throw InputError("response", "no finite response to refit on");
   Eigen::MatrixXd design(n, p);
-  Eigen::VectorXd y(n);
+  Eigen::VectorXd y(n), sqrt_w(n);
   for (Eigen::Index r = 0; r < n; ++r) {
-    const Eigen::VectorXd x = coded.row(fit.rows_used[std::size_t(r)]).transpose();
+    const int row = fit.rows_used[std::size_t(r)];
+    const Eigen::VectorXd x = coded.row(row).transpose();
     design(r, 0) = 1.0;
     for (Eigen::Index t = 1; t < p; ++t) design(r, t) = structure.term_value(std::size_t(t - 1), x);
-    y(r) = response(fit.rows_used[std::size_t(r)]);
+    y(r) = response(row);
+    sqrt_w(r) = weights.size() ? std::sqrt(weights(row)) : 1.0;
   }
-  const Eigen::VectorXd beta = design.colPivHouseholderQr().solve(y);
+  const Eigen::VectorXd beta = (sqrt_w.asDiagonal() * design)
+                                   .completeOrthogonalDecomposition()
+                                   .solve(sqrt_w.asDiagonal() * y);
   fit.intercept = beta(0);
   fit.coefficients = beta.tail(p - 1);
   fit.fitted = design * beta;

@@ -73,10 +73,11 @@ ModelFit fit_model(const Eigen::MatrixXd& coded, const Eigen::VectorXd& response
 
 /// Refits the terms of `structure` (chosen on its design) on other rows, e.g. the design plus
 /// verification runs: the regressors are the chain means predict() uses, so points off the
-/// design inform the same model instead of splitting its alias chains. Sets the intercept,
-/// coefficients, rows_used, fitted values, residuals, sse, sst, residual_df and R^2. NaN marks
-/// a missing response; throws InputError with fewer finite rows than coefficients.
+/// design inform the same model instead of splitting its alias chains. Row r weighs
+/// `weights(r)` in the least squares (empty = all 1); the minimum-norm solution is taken when
+/// the rows do not determine every coefficient. Sets the intercept, coefficients, rows_used,
+/// fitted values, residuals, sse, sst, residual_df and R^2; NaN marks a missing response.
 ModelFit refit(const ModelFit& structure, const Eigen::MatrixXd& coded,
-               const Eigen::VectorXd& response);
+               const Eigen::VectorXd& response, const Eigen::VectorXd& weights = {});
 
 }  // namespace demcal::doe

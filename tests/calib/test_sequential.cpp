@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "core/calib/sequential.hpp"
 #include "core/common/error.hpp"
@@ -103,6 +104,10 @@ TEST(Sequential, HiddenTruthEndsWithinUncertaintyAfterMoreThanOneRound) {
     const Eigen::Vector2d target(y(0), y(1)), uncertainty(0.004, 0.12);
     const LoopOutcome o = run_loop(target, uncertainty, {}, 2024 + h);
     ASSERT_EQ(o.last.step, NextStep::kDone) << o.last.conclusion;
+    std::printf("hidden set %d: %s; first round %s\n", h, o.last.conclusion.c_str(),
+                score_point(o.state.targets, *o.state.rounds.front().simulated).within
+                    ? "within"
+                    : "not within");
     EXPECT_TRUE(o.last.within) << h << ": " << o.last.conclusion;
     EXPECT_EQ(o.last.conclusion.rfind("within uncertainty after ", 0), 0u) << o.last.conclusion;
     ASSERT_FALSE(o.state.rounds.empty());
