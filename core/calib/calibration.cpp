@@ -101,13 +101,6 @@ bool has_squares(const doe::ModelFit& model) {
                      [](const doe::ModelTerm& t) { return t.squared; });
 }
 
-std::string number(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
-}
-
 void validate(const CalibrationProblem& problem) {
   if (problem.factors.empty()) throw InputError("factors", "no factors to calibrate");
   if (problem.metrics.empty()) throw InputError("metrics", "no metrics to calibrate against");
@@ -137,24 +130,35 @@ void validate(const CalibrationProblem& problem) {
 /// Whether the box reaches the target: an envelope that misses it by no more than the
 /// tolerance still reaches it, since noise and measurement error cover the gap.
 void state_reach(MetricOutcome& o) {
-  const std::string range = "[" + number(o.envelope.min) + ", " + number(o.envelope.max) + "]";
-  const std::string within =
-      o.tolerance > 0.0 ? " (tolerance +-" + number(o.tolerance) + ": uncertainty and noise)" : "";
-  const std::string head = "target " + number(o.target) + " of " + o.name;
+  const std::string range =
+      "[" + statement_number(o.envelope.min) + ", " + statement_number(o.envelope.max) + "]";
+  const std::string within = o.tolerance > 0.0 ? " (tolerance +-" + statement_number(o.tolerance) +
+                                                     ": uncertainty and noise)"
+                                               : "";
+  const std::string head = "target " + statement_number(o.target) + " of " + o.name;
   if (o.target > o.envelope.max + o.tolerance) {
     o.reachable = false;
     o.statement = head + " lies above the largest value reachable in the box, " +
-                  number(o.envelope.max) + within + ": unreachable with these factor ranges";
+                  statement_number(o.envelope.max) + within +
+                  ": unreachable with these factor ranges";
   } else if (o.target < o.envelope.min - o.tolerance) {
     o.reachable = false;
     o.statement = head + " lies below the smallest value reachable in the box, " +
-                  number(o.envelope.min) + within + ": unreachable with these factor ranges";
+                  statement_number(o.envelope.min) + within +
+                  ": unreachable with these factor ranges";
   } else {
     o.statement = head + " is within reach " + range + within;
   }
 }
 
 }  // namespace
+
+std::string statement_number(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
 
 double tolerance(const MetricTarget& m) {
   const double u = m.uncertainty ? *m.uncertainty : 0.0;
@@ -240,7 +244,8 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const Calibration
 std::vector<doe::Factor> narrow_box(const std::vector<doe::Factor>& factors,
                                     const Eigen::VectorXd& natural_optimum, double percent) {
   if (!(percent > 0.0 && percent < 100.0)) {
-    throw InputError("percent", "range narrowing needs 0 < percent < 100, got " + number(percent));
+    throw InputError("percent",
+                     "range narrowing needs 0 < percent < 100, got " + statement_number(percent));
   }
   if (natural_optimum.size() != static_cast<Eigen::Index>(factors.size())) {
     throw InputError("optimum", "one value per factor needed");
@@ -249,8 +254,9 @@ std::vector<doe::Factor> narrow_box(const std::vector<doe::Factor>& factors,
   for (std::size_t i = 0; i < factors.size(); ++i) {
     const double v = natural_optimum(Eigen::Index(i));
     if (v == 0.0) {
-      throw InputError("factor " + factors[i].name,
-                       "optimum is 0: a box of +-" + number(percent) + " % around it is empty");
+      throw InputError(
+          "factor " + factors[i].name,
+          "optimum is 0: a box of +-" + statement_number(percent) + " % around it is empty");
     }
     const double a = v * (1.0 - percent / 100.0), b = v * (1.0 + percent / 100.0);
     out[i].low = std::min(a, b);

@@ -75,6 +75,9 @@ struct CalibrationResult {
   std::vector<MetricOutcome> metrics;
 };
 
+/// A number as the calibration's statements print it (6 significant digits).
+std::string statement_number(double v);
+
 /// A metric's weight in the objective: (target / uncertainty)^2 when an uncertainty is given,
 /// else its weight; its term is that weight times the squared relative error.
 double effective_weight(const MetricTarget& metric);

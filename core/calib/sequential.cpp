@@ -3,20 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "core/common/error.hpp"
 
 namespace demcal::calib {
 
 namespace {
-
-std::string number(double v) {
-  std::ostringstream s;
-  s.precision(4);
-  s << v;
-  return s.str();
-}
 
 MetricTarget metric_target(const SequentialTarget& t) {
   MetricTarget m;
@@ -122,9 +114,10 @@ std::string not_within(const SequentialState& state, const VerifiedRound* best,
   const double sim = (*best->simulated)(Eigen::Index(m));
   const double tol = tolerance(metric_target(t));
   return "not within uncertainty after " + spent(state) + ": at the best round " + t.name +
-         " simulated " + number(sim) + " against " + number(t.target) + ", off by " +
-         number(sim - t.target) +
-         (tol > 0.0 ? " (" + number(score.worst) + " x its tolerance " + number(tol) + ")"
+         " simulated " + statement_number(sim) + " against " + statement_number(t.target) +
+         ", off by " + statement_number(sim - t.target) +
+         (tol > 0.0 ? " (" + statement_number(score.worst) + " x its tolerance " +
+                          statement_number(tol) + ")"
                     : " (no uncertainty or noise known)");
 }
 

@@ -86,6 +86,19 @@ int distinct_rows(const Eigen::MatrixXd& x) {
   return static_cast<int>(std::unique(rows.begin(), rows.end()) - rows.begin());
 }
 
+/// Coefficients (intercept first) and what follows from them on the fitted rows.
+void set_solution(ModelFit& fit, const Eigen::MatrixXd& design, const Eigen::VectorXd& beta,
+                  const Eigen::VectorXd& y) {
+  fit.intercept = beta(0);
+  fit.coefficients = beta.tail(beta.size() - 1);
+  fit.fitted = design * beta;
+  fit.residuals = y - fit.fitted;
+  fit.sse = fit.residuals.squaredNorm();
+  fit.sst = (y.array() - y.mean()).matrix().squaredNorm();
+  fit.residual_df = static_cast<int>(design.rows() - design.cols());
+  fit.r_squared = fit.sst > 0.0 ? 1.0 - fit.sse / fit.sst : 1.0;
+}
+
 std::string candidate_name(const Candidate& c) {
   return word_name(c.word) + (c.squared ? "^2" : "");
 }
@@ -201,14 +214,7 @@ ModelFit fit_model(const Eigen::MatrixXd& coded, const Eigen::VectorXd& response
   design.rightCols(p - 1) = columns;
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(design);
   const Eigen::VectorXd beta = qr.solve(y);
-  fit.intercept = beta(0);
-  fit.coefficients = beta.tail(p - 1);
-  fit.fitted = design * beta;
-  fit.residuals = y - fit.fitted;
-  fit.sse = fit.residuals.squaredNorm();
-  fit.sst = (y.array() - y.mean()).matrix().squaredNorm();
-  fit.residual_df = static_cast<int>(n - p);
-  fit.r_squared = fit.sst > 0.0 ? 1.0 - fit.sse / fit.sst : 1.0;
+  set_solution(fit, design, beta, y);
   fit.adj_r_squared = fit.residual_df > 0 && fit.sst > 0.0
                           ? 1.0 - (fit.sse / fit.residual_df) / (fit.sst / double(n - 1))
                           : std::nan("");
@@ -265,14 +271,7 @@ ModelFit refit(const ModelFit& structure, const Eigen::MatrixXd& coded,
   const Eigen::VectorXd beta = (sqrt_w.asDiagonal() * design)
                                    .completeOrthogonalDecomposition()
                                    .solve(sqrt_w.asDiagonal() * y);
-  fit.intercept = beta(0);
-  fit.coefficients = beta.tail(p - 1);
-  fit.fitted = design * beta;
-  fit.residuals = y - fit.fitted;
-  fit.sse = fit.residuals.squaredNorm();
-  fit.sst = (y.array() - y.mean()).matrix().squaredNorm();
-  fit.residual_df = static_cast<int>(n - p);
-  fit.r_squared = fit.sst > 0.0 ? 1.0 - fit.sse / fit.sst : 1.0;
+  set_solution(fit, design, beta, y);
   // Leverage, leave-one-out and standard errors describe the design fit only.
   fit.standard_errors.resize(0);
   fit.leverage.resize(0);
