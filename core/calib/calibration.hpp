@@ -10,10 +10,12 @@
 #include <Eigen/Dense>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/calib/gaussian_process.hpp"
 #include "core/doe/factor.hpp"
 #include "core/doe/model_fit.hpp"
 
@@ -26,7 +28,14 @@ struct MetricTarget {
   double weight = 1.0;
   std::optional<double> uncertainty;
   double noise_sd = 0.0;  ///< run-to-run noise of the simulated metric; 0 = none known
+  /// When set, the surrogate in place of `model`: a Gaussian process over the same coded box.
+  std::shared_ptr<const GaussianProcess> gp;
 };
+
+/// The surrogate's prediction at a coded point (the GP's mean, else the polynomial).
+double predict(const MetricTarget& metric, const Eigen::VectorXd& coded);
+/// Its variance there: the GP's, 0 for a polynomial.
+double predictive_variance(const MetricTarget& metric, const Eigen::VectorXd& coded);
 
 /// How far a simulated value may lie from the target and still match it: the measurement's
 /// uncertainty and the simulation's noise combined as independent errors,
@@ -68,19 +77,42 @@ struct MetricOutcome {
   std::string statement;
 };
 
+/// Which values of a factor the surrogates predict to match every target: over a seeded sample
+/// of the box, the points where each metric's |prediction - target| <= sqrt(tolerance^2 +
+/// predictive variance), and their smallest and largest value of the factor.
+struct ParameterInterval {
+  std::string name;
+  bool available = false;        ///< false: some metric has no tolerance, or no point matches
+  double low = 0.0, high = 0.0;  ///< natural units
+  double fraction = 1.0;         ///< of the factor's coded range
+  bool pinned = false;           ///< fraction <= kPinnedFraction
+  std::string statement;         ///< plain words, a warning when not pinned
+};
+/// A factor whose matching values span more than this fraction of its range is not pinned.
+constexpr double kPinnedFraction = 0.5;
+
 struct CalibrationResult {
   Eigen::VectorXd coded;
   Eigen::VectorXd natural;
   double objective = 0.0;
   std::vector<MetricOutcome> metrics;
+  std::vector<ParameterInterval> intervals;  ///< one per factor
 };
 
 /// A number as the calibration's statements print it (6 significant digits).
 std::string statement_number(double v);
 
+/// The objective J for given values of the metrics (one per metric, in problem order).
+double objective_of(const std::vector<MetricTarget>& metrics, const Eigen::VectorXd& values);
+
 /// A metric's weight in the objective: (target / uncertainty)^2 when an uncertainty is given,
 /// else its weight; its term is that weight times the squared relative error.
 double effective_weight(const MetricTarget& metric);
+
+/// Minimises f over the coded box [-1, 1]^k by Nelder-Mead on the box-projected point, from the
+/// centre and from a seeded maximin Latin hypercube of options.starts - 1 more points.
+Eigen::VectorXd minimise_in_box(const std::function<double(const Eigen::VectorXd&)>& f, int k,
+                                const CalibrationOptions& options);
 
 /// Checks the problem (names the offending metric or factor) and solves it.
 CalibrationResult calibrate(const CalibrationProblem& problem, const CalibrationOptions& options);

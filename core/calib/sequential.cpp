@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
 
 #include "core/common/error.hpp"
+#include "core/common/rng.hpp"
 
 namespace demcal::calib {
 
@@ -77,10 +79,38 @@ void shift_through_latest(const SequentialState& state, const std::vector<doe::F
   }
 }
 
-int rounds_in_stage(const SequentialState& state, int stage) {
-  int n = 0;
-  for (const auto& r : state.rounds) n += r.stage == stage ? 1 : 0;
-  return n;
+/// Verification batches of a stage so far.
+int batches_in_stage(const SequentialState& state, int stage) {
+  std::set<int> batches;
+  for (const auto& r : state.rounds)
+    if (r.stage == stage) batches.insert(r.batch);
+  return static_cast<int>(batches.size());
+}
+
+/// The objective of every simulated point with all metrics, for expected improvement.
+double best_simulated_objective(const SequentialState& state,
+                                const std::vector<MetricTarget>& metrics) {
+  double best = std::numeric_limits<double>::infinity();
+  const Points p = all_points(state, state.stages.size());
+  for (const auto& v : p.values)
+    if (v.allFinite()) best = std::min(best, objective_of(metrics, v));
+  return best;
+}
+
+/// What the surrogates predict at a natural point.
+Eigen::VectorXd predicted_at(const CalibrationProblem& problem, const Eigen::VectorXd& natural) {
+  const Eigen::VectorXd x = coded_in(problem.factors, natural);
+  Eigen::VectorXd y(Eigen::Index(problem.metrics.size()));
+  for (std::size_t m = 0; m < problem.metrics.size(); ++m)
+    y(Eigen::Index(m)) = predict(problem.metrics[m], x);
+  return y;
+}
+
+/// A round within tolerance, if any (the first).
+const VerifiedRound* within_round(const SequentialState& state) {
+  for (const auto& r : state.rounds)
+    if (r.simulated && score_point(state.targets, *r.simulated).within) return &r;
+  return nullptr;
 }
 
 bool affordable(const SequentialState& state, const SequentialOptions& o, int points) {
@@ -121,11 +151,42 @@ std::string not_within(const SequentialState& state, const VerifiedRound* best,
                     : " (no uncertainty or noise known)");
 }
 
+SequentialDecision gp_step(const SequentialState& state, const SequentialOptions& options) {
+  SequentialDecision d;
+  const CalibrationProblem problem = gp_problem(state, options.calibration.seed);
+  d.proposal = calibrate(problem, options.calibration);
+  if (within_round(state)) {
+    d.within = true;
+    d.conclusion = "within uncertainty after " + spent(state);
+    return d;
+  }
+  if (batches_in_stage(state, 1) < options.rounds && affordable(state, options, options.batch)) {
+    d.step = NextStep::kVerify;
+    for (const auto& x :
+         expected_improvement_batch(problem, best_simulated_objective(state, problem.metrics),
+                                    options.batch, options.calibration, {d.proposal.coded})) {
+      Eigen::VectorXd nat(x.size());
+      for (Eigen::Index i = 0; i < x.size(); ++i)
+        nat(i) = problem.factors[std::size_t(i)].to_natural(x(i));
+      d.batch.push_back(nat);
+      d.batch_predicted.push_back(predicted_at(problem, nat));
+    }
+    d.conclusion = "verifying batch " + std::to_string(batches_in_stage(state, 1) + 1) + " (" +
+                   std::to_string(d.batch.size()) +
+                   " points: the predicted optimum, then by expected improvement)";
+    return d;
+  }
+  PointScore best_score;
+  d.conclusion = not_within(state, best_round(state, &best_score), best_score);
+  return d;
+}
+
 }  // namespace
 
 void SequentialOptions::validate(const std::string& where) const {
   if (rounds < 1 || rounds > 100) throw InputError(where + ".rounds", "must lie in [1, 100]");
   if (stages < 1 || stages > 10) throw InputError(where + ".stages", "must lie in [1, 10]");
+  if (batch < 1 || batch > 64) throw InputError(where + ".batch", "must lie in [1, 64]");
   if (!(std::isfinite(narrow) && narrow > 0.0 && narrow < 1.0))
     throw InputError(where + ".narrow", "must lie in (0, 1)");
   if (max_jobs < 0) throw InputError(where + ".max_jobs", "must be >= 0");
@@ -151,6 +212,64 @@ PointScore score_point(const std::vector<SequentialTarget>& targets,
     }
   }
   return s;
+}
+
+CalibrationProblem gp_problem(const SequentialState& state, std::uint64_t seed) {
+  const Points p = all_points(state, state.stages.size());
+  Eigen::MatrixXd x(Eigen::Index(p.natural.size()), Eigen::Index(state.factors.size()));
+  for (std::size_t r = 0; r < p.natural.size(); ++r)
+    x.row(Eigen::Index(r)) = coded_in(state.factors, p.natural[r]).transpose();
+  CalibrationProblem problem;
+  problem.factors = state.factors;
+  for (std::size_t m = 0; m < state.targets.size(); ++m) {
+    Eigen::VectorXd y(x.rows());
+    for (std::size_t r = 0; r < p.values.size(); ++r)
+      y(Eigen::Index(r)) = p.values[r](Eigen::Index(m));
+    MetricTarget t = metric_target(state.targets[m]);
+    t.model.factor_count = static_cast<int>(state.factors.size());
+    t.gp = std::make_shared<const GaussianProcess>(x, y, GpOptions{8, seed});
+    problem.metrics.push_back(std::move(t));
+  }
+  return problem;
+}
+
+std::vector<Eigen::VectorXd> expected_improvement_batch(const CalibrationProblem& problem,
+                                                        double best_objective, int size,
+                                                        const CalibrationOptions& options,
+                                                        std::vector<Eigen::VectorXd> chosen) {
+  constexpr int kSamples = 64;
+  const auto metrics = static_cast<Eigen::Index>(problem.metrics.size());
+  const int k = static_cast<int>(problem.factors.size());
+  Rng rng(options.seed);
+  Eigen::MatrixXd z(kSamples, metrics);
+  for (int s = 0; s < kSamples; ++s)
+    for (Eigen::Index m = 0; m < metrics; ++m) z(s, m) = rng.normal();
+  std::vector<MetricTarget> believed = problem.metrics;
+  const auto believe = [&](const Eigen::VectorXd& x) {
+    for (auto& m : believed)
+      m.gp = std::make_shared<const GaussianProcess>(m.gp->with_point(x, m.gp->mean(x)));
+  };
+  for (const auto& x : chosen) believe(x);
+  std::vector<Eigen::VectorXd> out = chosen;
+  while (static_cast<int>(out.size()) < size) {
+    const auto negative_ei = [&](const Eigen::VectorXd& x) {
+      Eigen::VectorXd mu(metrics), sd(metrics);
+      for (Eigen::Index m = 0; m < metrics; ++m) {
+        mu(m) = predict(believed[std::size_t(m)], x);
+        sd(m) = std::sqrt(predictive_variance(believed[std::size_t(m)], x));
+      }
+      double ei = 0.0;
+      for (int s = 0; s < kSamples; ++s) {
+        const Eigen::VectorXd y = mu + sd.cwiseProduct(z.row(s).transpose());
+        ei += std::max(0.0, best_objective - objective_of(believed, y));
+      }
+      return -ei / kSamples;
+    };
+    const Eigen::VectorXd x = minimise_in_box(negative_ei, k, options);
+    out.push_back(x);
+    believe(x);
+  }
+  return out;
 }
 
 std::vector<doe::Factor> narrowed_box(const std::vector<doe::Factor>& outer,
@@ -205,20 +324,25 @@ CalibrationProblem stage_problem(const SequentialState& state, std::size_t stage
 SequentialDecision next_step(const SequentialState& state, const SequentialOptions& options) {
   options.validate("calibration");
   if (state.stages.empty()) throw InputError("stages", "no stage design to calibrate from");
+  if (options.surrogate == Surrogate::kGaussianProcess) return gp_step(state, options);
   SequentialDecision d;
   d.stage = static_cast<int>(state.stages.size());
   d.proposal =
       calibrate(stage_problem(state, state.stages.size() - 1, options.model), options.calibration);
   PointScore best_score;
   const VerifiedRound* best = best_round(state, &best_score);
-  if (!state.rounds.empty() && state.rounds.back().simulated &&
-      score_point(state.targets, *state.rounds.back().simulated).within) {
+  if (within_round(state)) {
     d.within = true;
     d.conclusion = "within uncertainty after " + spent(state);
     return d;
   }
-  if (rounds_in_stage(state, d.stage) < options.rounds && affordable(state, options, 1)) {
+  if (batches_in_stage(state, d.stage) < options.rounds && affordable(state, options, 1)) {
     d.step = NextStep::kVerify;
+    Eigen::VectorXd predicted(Eigen::Index(d.proposal.metrics.size()));
+    for (std::size_t m = 0; m < d.proposal.metrics.size(); ++m)
+      predicted(Eigen::Index(m)) = d.proposal.metrics[m].predicted;
+    d.batch = {d.proposal.natural};
+    d.batch_predicted = {predicted};
     d.conclusion = "verifying round " + std::to_string(state.rounds.size() + 1) + " (stage " +
                    std::to_string(d.stage) + ")";
     return d;

@@ -22,8 +22,15 @@ namespace demcal::calib {
 /// near the optimum, where the fit is used (a trust-region flavour of surrogate correction).
 constexpr double kVerifiedWeight = 10.0;
 
+/// polynomial: the design's main/2FI models, refitted round by round, narrowed stages.
+/// gaussian_process: one GP per metric over every run of the campaign, batches by expected
+/// improvement of the calibration objective, no stages (the GP is not bound to a design).
+enum class Surrogate { kPolynomial, kGaussianProcess };
+
 struct SequentialOptions {
-  int rounds = 3;       ///< verification rounds per stage
+  Surrogate surrogate = Surrogate::kPolynomial;
+  int batch = 1;        ///< points verified per round (GP; the polynomial's proposal is one)
+  int rounds = 3;       ///< verification rounds (batches) per stage
   int stages = 2;       ///< 1 = no second-stage design
   double narrow = 0.3;  ///< a new stage's box spans this fraction of each factor's coded range
   int max_jobs = 0;     ///< simulations the calibration may add; 0 = no limit
@@ -57,6 +64,7 @@ struct VerifiedRound {
   Eigen::VectorXd natural;
   Eigen::VectorXd predicted;
   std::optional<Eigen::VectorXd> simulated;
+  int batch = 1;  ///< the round's batch (1-based); a batch verifies several points at once
 };
 
 struct SequentialState {
@@ -84,8 +92,10 @@ enum class NextStep { kVerify, kNewStage, kDone };
 struct SequentialDecision {
   NextStep step = NextStep::kDone;
   int stage = 1;  ///< the stage whose models `proposal` comes from
-  /// The current best proposal of the stage's models (what kVerify simulates next).
+  /// The current best proposal of the surrogates (the polynomial's kVerify simulates it).
   CalibrationResult proposal;
+  /// kVerify: the points to simulate (natural units) and what the surrogates predict there.
+  std::vector<Eigen::VectorXd> batch, batch_predicted;
   std::vector<doe::Factor> next_box;  ///< kNewStage: the narrowed box
   bool within = false;
   /// "within uncertainty after N rounds (M simulations)", or which metric is not and by how
@@ -101,6 +111,19 @@ SequentialDecision next_step(const SequentialState& state, const SequentialOptio
 /// through the latest verified point inside the box (output space mapping).
 CalibrationProblem stage_problem(const SequentialState& state, std::size_t stage,
                                  doe::ModelKind model);
+
+/// GP surrogates (one per metric) over every simulated point, coded in the campaign's box.
+CalibrationProblem gp_problem(const SequentialState& state, std::uint64_t seed);
+
+/// A batch of `size` coded points: those `chosen` already (the GP loop puts the predicted
+/// optimum first, to exploit), then points by expected improvement of the calibration
+/// objective over the best simulated point (Monte Carlo over the GPs' predictive
+/// distributions, common random numbers), one after another with the GPs told their own mean
+/// at the points already in the batch (kriging believer, Ginsbourger et al. 2010).
+std::vector<Eigen::VectorXd> expected_improvement_batch(const CalibrationProblem& problem,
+                                                        double best_objective, int size,
+                                                        const CalibrationOptions& options,
+                                                        std::vector<Eigen::VectorXd> chosen = {});
 
 /// The box of a new stage: `fraction` of each coded range of `outer`, centred on `natural`
 /// and shifted to stay inside `outer`.

@@ -150,3 +150,41 @@ TEST(Calibration, NarrowingBoxesAroundTheOptimum) {
 
 }  // namespace
 }  // namespace demcal::calib
+
+namespace demcal::calib {
+namespace {
+
+TEST(Calibration, IntervalsPinWhatTheDataDecidesAndWarnAboutTheRest) {
+  // One metric that depends on A only: A is pinned to a narrow interval around its solution,
+  // B is not pinned and the statement says so.
+  const std::vector<doe::Factor> box{{"A", 0.0, 1.0, doe::Scale::kLinear},
+                                     {"B", 0.0, 1.0, doe::Scale::kLinear}};
+  const doe::Design d = doe::full_factorial(2);
+  Eigen::VectorXd y(d.runs());
+  for (int r = 0; r < d.runs(); ++r) y(r) = 10.0 + 4.0 * d.coded(r, 0);
+  CalibrationProblem p{box, {}};
+  MetricTarget m;
+  m.name = "m";
+  m.model = doe::fit_model(d.coded, y, doe::ModelKind::kMain);
+  m.target = 11.0;  // A coded 0.25, natural 0.625
+  m.uncertainty = 0.2;
+  p.metrics.push_back(m);
+  const CalibrationResult r = calibrate(p, {});
+  ASSERT_EQ(r.intervals.size(), 2u);
+  const auto& a = r.intervals[0];
+  ASSERT_TRUE(a.available) << a.statement;
+  EXPECT_TRUE(a.pinned);
+  EXPECT_NEAR(a.low, 0.625 - 0.025, 0.005);  // |4 x - 1| <= 0.2 in coded units
+  EXPECT_NEAR(a.high, 0.625 + 0.025, 0.005);
+  const auto& b = r.intervals[1];
+  EXPECT_FALSE(b.pinned);
+  EXPECT_NE(b.statement.find("B is not pinned by the data"), std::string::npos) << b.statement;
+  // Without an uncertainty or noise there is no tolerance to judge by, and it says so.
+  p.metrics[0].uncertainty.reset();
+  const CalibrationResult none = calibrate(p, {});
+  EXPECT_FALSE(none.intervals[0].available);
+  EXPECT_NE(none.intervals[0].statement.find("no uncertainty or noise"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace demcal::calib

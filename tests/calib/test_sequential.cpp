@@ -79,12 +79,12 @@ LoopOutcome run_loop(const Eigen::Vector2d& target, const Eigen::Vector2d& uncer
     out.last = next_step(s, options);
     if (out.last.step == NextStep::kDone) break;
     if (out.last.step == NextStep::kVerify) {
-      VerifiedRound r{out.last.stage, out.last.proposal.natural, Eigen::VectorXd(2), {}};
-      for (int m = 0; m < 2; ++m)
-        r.predicted(m) = out.last.proposal.metrics[std::size_t(m)].predicted;
-      r.simulated = sim(r.natural);
-      s.rounds.push_back(r);
-      s.jobs_used += 1;
+      const int batch = s.rounds.empty() ? 1 : s.rounds.back().batch + 1;
+      for (std::size_t b = 0; b < out.last.batch.size(); ++b) {
+        s.rounds.push_back({out.last.stage, out.last.batch[b], out.last.batch_predicted[b],
+                            sim(out.last.batch[b]), batch});
+        s.jobs_used += 1;
+      }
     } else {
       s.stages.push_back(simulate_stage(out.last.next_box, design, sim));
       s.jobs_used += design.runs();
@@ -122,6 +122,27 @@ TEST(Sequential, HiddenTruthEndsWithinUncertaintyAfterMoreThanOneRound) {
   }
   // The first proposal of the two-level models misses the curved truth: the loop mattered.
   EXPECT_GE(missed_first, 2);
+}
+
+TEST(Sequential, GaussianProcessBatchesEndWithinUncertaintyOnTheSameHiddenTruths) {
+  // The same three hidden sets, seeds and first design; GP surrogates over all runs, batches of
+  // two points by expected improvement, up to 10 batches, no stages.
+  const double hidden_sets[3][3] = {{0.38, 0.31, 3e7}, {0.22, 0.5, 4e6}, {0.45, 0.25, 6e7}};
+  SequentialOptions opt;
+  opt.surrogate = Surrogate::kGaussianProcess;
+  opt.batch = 2;
+  opt.rounds = 10;
+  for (int h = 0; h < 3; ++h) {
+    Eigen::VectorXd hidden(3);
+    hidden << hidden_sets[h][0], hidden_sets[h][1], hidden_sets[h][2];
+    const Eigen::VectorXd y = truth(hidden);
+    const LoopOutcome o =
+        run_loop(Eigen::Vector2d(y(0), y(1)), Eigen::Vector2d(0.004, 0.12), opt, 2024 + h);
+    std::printf("gp hidden set %d: %s\n", h, o.last.conclusion.c_str());
+    EXPECT_TRUE(o.last.within) << h << ": " << o.last.conclusion;
+    EXPECT_EQ(o.state.stages.size(), 1u);
+    EXPECT_EQ(o.state.jobs_used % 2, 0);  // whole batches
+  }
 }
 
 TEST(Sequential, UnreachableTargetStopsAtTheJobBudgetAndNamesTheMetric) {
