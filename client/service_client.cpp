@@ -231,7 +231,8 @@ void print_rounds(std::ostream& out,
   if (rounds.empty()) return;
   out << "\n  calibration rounds:\n";
   for (const auto& r : rounds) {
-    out << "    round " << r.round() << " (stage " << r.stage() << "): " << r.state();
+    out << "    round " << r.round() << " (stage " << r.stage() << ", batch " << r.batch()
+        << "): " << r.state();
     if (r.state() == "done")
       out << ", " << (r.within() ? "within" : "not within") << " tolerance; worst "
           << r.worst_metric() << " at " << fmt(r.worst_deviation(), 3) << " x tolerance";
@@ -267,7 +268,10 @@ void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std
         << fmt(m.envelope_min()) << ", " << fmt(m.envelope_max()) << "]\n";
     if (!m.statement().empty()) out << "      " << m.statement() << "\n";
   }
-  out << "  tolerance = sqrt(uncertainty^2 + noise sd^2) (docs/doe.md)\n";
+  out << "  tolerance = sqrt(uncertainty^2 + noise sd^2) (docs/doe.md); surrogate " << c.surrogate()
+      << "\n";
+  if (c.intervals_size()) out << "\n  parameters predicted within tolerance:\n";
+  for (const auto& i : c.intervals()) out << "    " << i.statement() << "\n";
   print_rounds(out, c.rounds());
   out << "  verification: " << c.verification_state() << ", " << c.simulations()
       << " simulation(s) added by the calibration\n  " << c.conclusion() << "\n";

@@ -2,8 +2,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string_view>
 
 #include "core/common/error.hpp"
@@ -128,7 +130,7 @@ Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& re
   l.round_rows = store.calibration_rounds(row.id);
   l.options = calibration_options(l.spec.calibration(), "spec.calibration");
   if (!req.model().empty()) l.options.model = doe::parse_model_kind(req.model(), "model");
-  if (req.starts() < 0) throw InputError("starts", "must be >= 0");
+  if (req.starts() < 0 || req.starts() > 1000) throw InputError("starts", "must lie in [0, 1000]");
   l.options.calibration.starts = req.starts() > 0 ? req.starts() : 16;
   l.options.calibration.seed = req.seed() ? req.seed() : 1;
   if (l.plan.targets.empty())
@@ -150,23 +152,28 @@ Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& re
   for (const auto& r : l.round_rows) {
     const auto j = nlohmann::json::parse(r.proposal_json);
     s.rounds.push_back({r.stage, vector_of(j.at("natural")), vector_of(j.at("predicted")),
-                        round_values(l, columns, r.round)});
+                        round_values(l, columns, r.round), j.value("batch", r.round)});
   }
+  std::set<std::string> workers;
   for (const auto& j : l.jobs) {
+    if (!j.worker.empty()) workers.insert(j.worker);
     if (!is_calibration_job(j)) continue;
     ++s.jobs_used;
     l.pending = l.pending || is_open(j);
   }
+  // One GP batch keeps every worker busy: as many points as workers have run this campaign.
+  if (l.spec.calibration().batch() == 0)
+    l.options.batch = std::clamp(static_cast<int>(workers.size()), 1, 64);
   return l;
 }
 
-std::string proposal_json(const calib::CalibrationResult& r) {
+std::string proposal_json(const Eigen::VectorXd& natural, const Eigen::VectorXd& predicted,
+                          const std::vector<std::string>& metrics, int batch) {
   nlohmann::json j;
-  for (Eigen::Index i = 0; i < r.natural.size(); ++i) j["natural"].push_back(r.natural(i));
-  for (const auto& m : r.metrics) {
-    j["metrics"].push_back(m.name);
-    j["predicted"].push_back(m.predicted);
-  }
+  for (Eigen::Index i = 0; i < natural.size(); ++i) j["natural"].push_back(natural(i));
+  for (Eigen::Index i = 0; i < predicted.size(); ++i) j["predicted"].push_back(predicted(i));
+  j["metrics"] = metrics;
+  j["batch"] = batch;
   return j.dump();
 }
 
@@ -175,6 +182,7 @@ v1::CalibrationRound round_message(const Loaded& l, std::size_t i) {
   v1::CalibrationRound m;
   m.set_round(l.round_rows[i].round);
   m.set_stage(r.stage);
+  m.set_batch(r.batch);
   for (Eigen::Index f = 0; f < r.natural.size(); ++f) m.add_proposed_values(r.natural(f));
   for (std::size_t t = 0; t < l.responses.size(); ++t) {
     m.add_metrics(l.responses[t]);
@@ -227,6 +235,21 @@ void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
   }
 }
 
+void add_intervals(v1::CalibrateReply& reply, const Loaded& l,
+                   const calib::CalibrationResult& proposal) {
+  for (std::size_t f = 0; f < proposal.intervals.size(); ++f) {
+    const auto& p = proposal.intervals[f];
+    auto* o = reply.add_intervals();
+    o->set_factor(l.plan.factors[f].path);
+    o->set_available(p.available);
+    o->set_low(p.low);
+    o->set_high(p.high);
+    o->set_fraction(p.fraction);
+    o->set_pinned(p.pinned);
+    o->set_statement(p.statement);
+  }
+}
+
 void set_proposed(v1::CalibrateReply& reply, const Loaded& l, const Eigen::VectorXd& natural) {
   for (std::size_t f = 0; f < l.plan.factors.size(); ++f) {
     (*reply.mutable_proposed())[l.plan.factors[f].path] = natural(Eigen::Index(f));
@@ -235,18 +258,30 @@ void set_proposed(v1::CalibrateReply& reply, const Loaded& l, const Eigen::Vecto
   }
 }
 
-std::vector<std::int64_t> queue_round(Store& store, const CampaignRow& row, const Loaded& l,
-                                      const calib::SequentialDecision& d) {
-  const int round = static_cast<int>(l.round_rows.size()) + 1;
-  std::map<std::string, double> parameters;
-  for (std::size_t f = 0; f < l.plan.factors.size(); ++f)
-    parameters[l.plan.factors[f].path] = d.proposal.natural(Eigen::Index(f));
+/// Queues one round per point of the decision's batch, all with the next batch number.
+std::vector<std::int64_t> queue_rounds(Store& store, const CampaignRow& row, const Loaded& l,
+                                       const calib::SequentialDecision& d) {
+  const int batch = l.state.rounds.empty() ? 1 : l.state.rounds.back().batch + 1;
   const bool pinned = l.spec.design().simulation_seeds() == v1::Design::PINNED;
-  const auto jobs = jobs_at(l.spec, l.spec.material(), parameters, round, "verify",
-                            pinned ? 0 : kVerifySeedOffset + std::uint64_t(round));
-  spdlog::info("campaign {}: calibration round {} (stage {}) queued", row.id, round, d.stage);
-  return store.add_calibration_round(
-      row.id, {round, d.stage, proposal_json(d.proposal), now_seconds()}, jobs);
+  std::vector<std::int64_t> ids;
+  int round = static_cast<int>(l.round_rows.size());
+  for (std::size_t b = 0; b < d.batch.size(); ++b) {
+    ++round;
+    std::map<std::string, double> parameters;
+    for (std::size_t f = 0; f < l.plan.factors.size(); ++f)
+      parameters[l.plan.factors[f].path] = d.batch[b](Eigen::Index(f));
+    const auto jobs = jobs_at(l.spec, l.spec.material(), parameters, round, "verify",
+                              pinned ? 0 : kVerifySeedOffset + std::uint64_t(round));
+    const auto queued = store.add_calibration_round(
+        row.id,
+        {round, d.stage, proposal_json(d.batch[b], d.batch_predicted[b], l.responses, batch),
+         now_seconds()},
+        jobs);
+    ids.insert(ids.end(), queued.begin(), queued.end());
+  }
+  spdlog::info("campaign {}: calibration batch {} ({} round(s), stage {}) queued", row.id, batch,
+               d.batch.size(), d.stage);
+  return ids;
 }
 
 std::vector<std::int64_t> queue_stage(Store& store, const CampaignRow& row, const Loaded& l,
@@ -277,6 +312,13 @@ calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
   if (spec.stages()) o.stages = spec.stages();
   if (spec.narrow() != 0.0) o.narrow = spec.narrow();
   o.max_jobs = spec.max_jobs();
+  if (spec.surrogate() == "gp")
+    o.surrogate = calib::Surrogate::kGaussianProcess;
+  else if (!spec.surrogate().empty() && spec.surrogate() != "polynomial")
+    throw InputError(where + ".surrogate",
+                     "unknown surrogate '" + spec.surrogate() + "' (polynomial or gp)");
+  if (spec.batch() < 0) throw InputError(where + ".batch", "must be >= 0");
+  if (spec.batch() > 0) o.batch = spec.batch();
   if (!spec.model().empty()) {
     o.model = doe::parse_model_kind(spec.model(), where + ".model");
     if (o.model != doe::ModelKind::kMain && o.model != doe::ModelKind::kTwoFactor)
@@ -298,6 +340,8 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
                                       const v1::CalibrateRequest& request) {
   const Loaded l = load(store, row, request);
   v1::CalibrateReply reply;
+  reply.set_surrogate(l.options.surrogate == calib::Surrogate::kGaussianProcess ? "gp"
+                                                                                : "polynomial");
   for (std::size_t i = 0; i < l.state.rounds.size(); ++i) *reply.add_rounds() = round_message(l, i);
   if (l.pending) {
     reply.set_verification_state("running");
@@ -313,9 +357,10 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
   set_proposed(reply, l, d.proposal.natural);
   reply.set_objective(d.proposal.objective);
   add_metrics(reply, l, &d.proposal);
+  add_intervals(reply, l, d.proposal);
   std::vector<std::int64_t> queued;
   if (request.verify() && d.step == calib::NextStep::kVerify)
-    queued = queue_round(store, row, l, d);
+    queued = queue_rounds(store, row, l, d);
   if (request.verify() && d.step == calib::NextStep::kNewStage)
     queued = queue_stage(store, row, l, d);
   for (const auto id : queued) reply.add_verification_jobs(id);

@@ -207,6 +207,8 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
        "spec.tests[0].settings.particles"},
       {tiny_spec(30, 0, "", "calibration: {narrow: 1.5}\n"), "spec.calibration.narrow"},
       {tiny_spec(30, 0, "", "calibration: {model: quadratic}\n"), "spec.calibration.model"},
+      {tiny_spec(30, 0, "", "calibration: {surrogate: kriging}\n"), "spec.calibration.surrogate"},
+      {tiny_spec(30, 0, "", "calibration: {batch: -1}\n"), "spec.calibration.batch"},
   };
   for (const auto& c : cases) {
     const auto s = submit(c.yaml);
@@ -417,7 +419,7 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
   EXPECT_NE(out.find("verification: done, 1 simulation(s) added by the calibration"),
             std::string::npos)
       << out;
-  EXPECT_NE(out.find("round 1 (stage 1): done"), std::string::npos) << out;
+  EXPECT_NE(out.find("round 1 (stage 1, batch 1): done"), std::string::npos) << out;
   // Both local workers ran jobs side by side (--workers 2), by the jobs table of the file.
   std::map<std::string, int> jobs_by_worker;
   each_row(path("work/campaign.db"), "SELECT worker, COUNT(*) FROM jobs GROUP BY worker",
@@ -537,6 +539,30 @@ TEST_F(Service, CentrePointsDifferCurvatureIsTestedAndTheCalibrationRoundsAreSho
   const auto diagnosis =
       cli_json(dir_, "diagnose", {"diagnose", ids, "--no-wait", "--format", "json"}, channel_);
   EXPECT_TRUE(diagnosis.is_object() && !diagnosis.empty()) << diagnosis.dump();
+}
+
+TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(200, 2, "",
+                               "calibration: {surrogate: gp, batch: 2, rounds: 2, max_jobs: 4}\n"),
+                     &id)
+                  .ok());
+  start_worker("w");
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 90)) << workers_[0]->log();
+  const auto cal = cli_json(
+      dir_, "calibrate",
+      {"calibrate", std::to_string(id), "--verify", "--wait", "--format", "json"}, channel_);
+  EXPECT_EQ(cal.at("surrogate"), "gp");
+  const auto& rounds = cal.at("rounds");
+  ASSERT_FALSE(rounds.empty()) << cal.dump();
+  EXPECT_EQ(rounds.size() % 2, 0u) << "whole batches of two";
+  EXPECT_EQ(rounds.at(0).at("batch"), 1);
+  EXPECT_EQ(rounds.at(1).at("batch"), 1);
+  EXPECT_LE(cal.at("simulations").get<int>(), 4);
+  ASSERT_EQ(cal.at("intervals").size(), 2u);
+  for (const auto& i : cal.at("intervals"))
+    EXPECT_FALSE(i.at("statement").get<std::string>().empty()) << i.dump();
 }
 
 }  // namespace
