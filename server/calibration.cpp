@@ -34,6 +34,14 @@ struct Loaded {
   bool pending = false;  ///< calibration jobs queued or leased
 };
 
+/// The polynomial models the calibration fits: main or 2fi (two-level designs).
+doe::ModelKind polynomial_model(const std::string& text, const std::string& where) {
+  const doe::ModelKind m = doe::parse_model_kind(text, where);
+  if (m != doe::ModelKind::kMain && m != doe::ModelKind::kTwoFactor)
+    throw InputError(where, "the calibration fits main or 2fi models");
+  return m;
+}
+
 bool is_calibration_job(const JobRow& j) {
   return (j.kind == "verify" && j.std_order > 0) || j.kind.starts_with(kStagePrefix);
 }
@@ -129,7 +137,7 @@ Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& re
   l.jobs = store.jobs(row.id);
   l.round_rows = store.calibration_rounds(row.id);
   l.options = calibration_options(l.spec.calibration(), "spec.calibration");
-  if (!req.model().empty()) l.options.model = doe::parse_model_kind(req.model(), "model");
+  if (!req.model().empty()) l.options.model = polynomial_model(req.model(), "model");
   if (req.starts() < 0 || req.starts() > 1000) throw InputError("starts", "must lie in [0, 1000]");
   l.options.calibration.starts = req.starts() > 0 ? req.starts() : 16;
   l.options.calibration.seed = req.seed() ? req.seed() : 1;
@@ -319,11 +327,7 @@ calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
                      "unknown surrogate '" + spec.surrogate() + "' (polynomial or gp)");
   if (spec.batch() < 0) throw InputError(where + ".batch", "must be >= 0");
   if (spec.batch() > 0) o.batch = spec.batch();
-  if (!spec.model().empty()) {
-    o.model = doe::parse_model_kind(spec.model(), where + ".model");
-    if (o.model != doe::ModelKind::kMain && o.model != doe::ModelKind::kTwoFactor)
-      throw InputError(where + ".model", "the calibration fits main or 2fi models");
-  }
+  if (!spec.model().empty()) o.model = polynomial_model(spec.model(), where + ".model");
   o.validate(where);
   return o;
 }
