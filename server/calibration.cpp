@@ -358,9 +358,20 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
   }
   const calib::SequentialDecision d = calib::next_step(l.state, l.options);
   reply.set_stage(d.stage);
-  set_proposed(reply, l, d.proposal.natural);
   reply.set_objective(d.proposal.objective);
   add_metrics(reply, l, &d.proposal);
+  if (d.within) {
+    // The calibrated set is the verified one, with what was predicted there.
+    const auto& accepted = l.state.rounds[std::size_t(d.accepted_round)];
+    set_proposed(reply, l, accepted.natural);
+    for (int m = 0; m < reply.metrics_size(); ++m) {
+      auto* o = reply.mutable_metrics(m);
+      o->set_predicted(accepted.predicted(m));
+      o->set_relative_error((o->predicted() - o->target()) / std::abs(o->target()));
+    }
+  } else {
+    set_proposed(reply, l, d.proposal.natural);
+  }
   add_intervals(reply, l, d.proposal);
   std::vector<std::int64_t> queued;
   if (request.verify() && d.step == calib::NextStep::kVerify)

@@ -210,7 +210,8 @@ std::vector<ParameterInterval> parameter_intervals(const CalibrationProblem& pro
     p.fraction = 0.5 * (hi(Eigen::Index(i)) - lo(Eigen::Index(i)));
     p.pinned = p.fraction <= kPinnedFraction;
     const std::string range = "[" + statement_number(p.low) + ", " + statement_number(p.high) +
-                              "] (" + statement_number(100.0 * p.fraction) + " % of its range)";
+                              "] (" + std::to_string(std::lround(100.0 * p.fraction)) +
+                              " % of its range)";
     p.statement = p.pinned ? f.name + " in " + range
                            : f.name + " is not pinned by the data: anything in " + range +
                                  " is predicted within tolerance";

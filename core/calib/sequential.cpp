@@ -106,11 +106,13 @@ Eigen::VectorXd predicted_at(const CalibrationProblem& problem, const Eigen::Vec
   return y;
 }
 
-/// A round within tolerance, if any (the first).
-const VerifiedRound* within_round(const SequentialState& state) {
-  for (const auto& r : state.rounds)
-    if (r.simulated && score_point(state.targets, *r.simulated).within) return &r;
-  return nullptr;
+/// The index of the first round within tolerance, -1 when none is.
+int within_round(const SequentialState& state) {
+  for (std::size_t i = 0; i < state.rounds.size(); ++i) {
+    const auto& r = state.rounds[i];
+    if (r.simulated && score_point(state.targets, *r.simulated).within) return static_cast<int>(i);
+  }
+  return -1;
 }
 
 bool affordable(const SequentialState& state, const SequentialOptions& o, int points) {
@@ -155,7 +157,7 @@ SequentialDecision gp_step(const SequentialState& state, const SequentialOptions
   SequentialDecision d;
   const CalibrationProblem problem = gp_problem(state, options.calibration.seed);
   d.proposal = calibrate(problem, options.calibration);
-  if (within_round(state)) {
+  if ((d.accepted_round = within_round(state)) >= 0) {
     d.within = true;
     d.conclusion = "within uncertainty after " + spent(state);
     return d;
@@ -331,7 +333,7 @@ SequentialDecision next_step(const SequentialState& state, const SequentialOptio
       calibrate(stage_problem(state, state.stages.size() - 1, options.model), options.calibration);
   PointScore best_score;
   const VerifiedRound* best = best_round(state, &best_score);
-  if (within_round(state)) {
+  if ((d.accepted_round = within_round(state)) >= 0) {
     d.within = true;
     d.conclusion = "within uncertainty after " + spent(state);
     return d;

@@ -98,6 +98,8 @@ struct SequentialDecision {
   std::vector<Eigen::VectorXd> batch, batch_predicted;
   std::vector<doe::Factor> next_box;  ///< kNewStage: the narrowed box
   bool within = false;
+  /// When within: the index in state.rounds of the verified round that is (the calibrated set).
+  int accepted_round = -1;
   /// "within uncertainty after N rounds (M simulations)", or which metric is not and by how
   /// much, or what runs next.
   std::string conclusion;

@@ -110,6 +110,7 @@ TEST(Sequential, HiddenTruthEndsWithinUncertaintyAfterMoreThanOneRound) {
                     : "not within");
     EXPECT_TRUE(o.last.within) << h << ": " << o.last.conclusion;
     EXPECT_EQ(o.last.conclusion.rfind("within uncertainty after ", 0), 0u) << o.last.conclusion;
+    EXPECT_EQ(o.last.accepted_round, static_cast<int>(o.state.rounds.size()) - 1);
     ASSERT_FALSE(o.state.rounds.empty());
     missed_first += score_point(o.state.targets, *o.state.rounds.front().simulated).within ? 0 : 1;
     // The last simulated point is within tolerance by the noise-free truth as well, give or
