@@ -325,45 +325,4 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const Calibration
   return out;
 }
 
-std::vector<doe::Factor> narrow_box(const std::vector<doe::Factor>& factors,
-                                    const Eigen::VectorXd& natural_optimum, double percent) {
-  if (!(percent > 0.0 && percent < 100.0)) {
-    throw InputError("percent",
-                     "range narrowing needs 0 < percent < 100, got " + statement_number(percent));
-  }
-  if (natural_optimum.size() != static_cast<Eigen::Index>(factors.size())) {
-    throw InputError("optimum", "one value per factor needed");
-  }
-  std::vector<doe::Factor> out = factors;
-  for (std::size_t i = 0; i < factors.size(); ++i) {
-    const double v = natural_optimum(Eigen::Index(i));
-    if (v == 0.0) {
-      throw InputError(
-          "factor " + factors[i].name,
-          "optimum is 0: a box of +-" + statement_number(percent) + " % around it is empty");
-    }
-    const double a = v * (1.0 - percent / 100.0), b = v * (1.0 + percent / 100.0);
-    out[i].low = std::min(a, b);
-    out[i].high = std::max(a, b);
-    out[i].validate();
-  }
-  return out;
-}
-
-std::vector<NarrowingRound> calibrate_iteratively(
-    std::vector<doe::Factor> box,
-    const std::function<std::vector<MetricTarget>(const std::vector<doe::Factor>&)>& fit_in_box,
-    int rounds, double percent, double shrink, const CalibrationOptions& options) {
-  if (rounds < 1) throw InputError("rounds", "need at least one round");
-  if (!(shrink > 0.0 && shrink <= 1.0)) throw InputError("shrink", "must lie in (0, 1]");
-  std::vector<NarrowingRound> out;
-  for (int r = 0; r < rounds; ++r) {
-    CalibrationProblem problem{box, fit_in_box(box)};
-    NarrowingRound round{box, calibrate(problem, options)};
-    box = narrow_box(box, round.result.natural, percent * std::pow(shrink, r));
-    out.push_back(std::move(round));
-  }
-  return out;
-}
-
 }  // namespace demcal::calib

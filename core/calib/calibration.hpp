@@ -1,7 +1,8 @@
 #pragma once
 // Calibration against measured metrics with fitted response models (seed 000 §2.5.2 "with
-// these equations an optimisation of input parameters shall be done"; §3.3 for the range
-// narrowing). The objective is the weighted mean squared relative error
+// these equations an optimisation of input parameters shall be done"; the range narrowing of
+// §3.3 is the sequential loop's second stage, sequential.hpp). The objective is the weighted mean
+// squared relative error
 //   J(x) = sum_m w_m ((yhat_m(x) - t_m) / |t_m|)^2 / sum_m w_m ,
 // where a metric given with an uncertainty s_m uses w_m = (t_m / s_m)^2, so that its term is
 // ((yhat_m - t_m) / s_m)^2. J is minimised over the factor box in coded units by Nelder-Mead
@@ -119,23 +120,5 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const Calibration
 
 /// Envelope of one model over the box; `options` seeds the search for models with squares.
 Envelope reachable_envelope(const doe::ModelFit& model, const CalibrationOptions& options);
-
-/// Seed 000 §3.3: a new box of +-percent around the optimum (natural units), per factor.
-std::vector<doe::Factor> narrow_box(const std::vector<doe::Factor>& factors,
-                                    const Eigen::VectorXd& natural_optimum, double percent);
-
-/// One round of iterative narrowing: the box it used and the calibration found in it.
-struct NarrowingRound {
-  std::vector<doe::Factor> box;
-  CalibrationResult result;
-};
-
-/// Fits new models in each box (the callback runs the designed simulations and fits them),
-/// calibrates, and narrows the box around the optimum, `rounds` times. A box of a fixed
-/// +-x % never gets smaller than x % of the optimum, so round r uses percent * shrink^r.
-std::vector<NarrowingRound> calibrate_iteratively(
-    std::vector<doe::Factor> box,
-    const std::function<std::vector<MetricTarget>(const std::vector<doe::Factor>&)>& fit_in_box,
-    int rounds, double percent, double shrink, const CalibrationOptions& options);
 
 }  // namespace demcal::calib

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 
 #include "core/calib/calibration.hpp"
 #include "core/common/error.hpp"
@@ -117,35 +116,6 @@ TEST(Calibration, InvalidProblemsNameTheField) {
   }
   CalibrationProblem wrong{{{"a", 0, 1}}, {{"m", model, 1.0, 1.0, std::nullopt}}};
   EXPECT_THROW(calibrate(wrong, {}), InputError);
-}
-
-TEST(Calibration, NarrowingBoxesAroundTheOptimum) {
-  const std::vector<doe::Factor> box = narrow_box(kBox, Eigen::Vector3d(0.5, 1e8, 0.1), 33.0);
-  EXPECT_NEAR(box[0].low, 0.335, 1e-12);
-  EXPECT_NEAR(box[0].high, 0.665, 1e-12);
-  EXPECT_NEAR(box[1].high, 1.33e8, 1e-3);
-  EXPECT_THROW(narrow_box(kBox, Eigen::Vector3d(0.0, 1e8, 0.1), 33.0), InputError);
-
-  // A response that is not polynomial: each narrowed box fits the 2FI model better and the
-  // calibrated parameters close in on the truth (seed 000 §3.3).
-  const Eigen::Vector2d truth(0.45, 0.12);
-  const auto f1 = [](const Eigen::VectorXd& n) { return std::exp(2.0 * n(0)) + n(1); };
-  const auto f2 = [](const Eigen::VectorXd& n) { return std::sqrt(n(1)) * (1.0 + n(0)); };
-  const std::vector<doe::Factor> start{{"x", 0.1, 1.0}, {"y", 0.02, 0.4}};
-  const auto fit = [&](const std::vector<doe::Factor>& b) {
-    return std::vector<MetricTarget>{
-        {"m1", fit_on_box(f1, b, doe::ModelKind::kTwoFactor), f1(truth), 1.0, std::nullopt},
-        {"m2", fit_on_box(f2, b, doe::ModelKind::kTwoFactor), f2(truth), 1.0, std::nullopt}};
-  };
-  const auto rounds = calibrate_iteratively(start, fit, 4, 30.0, 0.5, {});
-  ASSERT_EQ(rounds.size(), 4u);
-  std::vector<double> errors;
-  for (const auto& r : rounds)
-    errors.push_back((r.result.natural - truth).cwiseQuotient(truth).norm());
-  for (double e : errors) std::printf("narrowing round: relative parameter error %.5f\n", e);
-  EXPECT_GT(errors.front(), 0.02);
-  EXPECT_LT(errors.back(), 0.2 * errors.front());
-  EXPECT_LT(errors.back(), 0.005);
 }
 
 }  // namespace
