@@ -222,6 +222,7 @@ void run_analyze(const AnalyzeOptions& opt) {
     for (const auto* e : by_size) {
       j["effects"].push_back({{"chain", e->term.name()},
                               {"effect", e->effect},
+                              {"in_model", e->in_model},
                               {"active_me", e->active},
                               {"active_sme", e->active_simultaneous}});
     }
@@ -265,6 +266,8 @@ void run_analyze(const AnalyzeOptions& opt) {
                                   : nlohmann::json(nullptr)}});
     }
     const auto& c = res.curvature;
+    j["noise"] = {
+        {"sd", res.noise.sd}, {"df", res.noise.degrees_of_freedom}, {"source", res.noise.source}};
     j["curvature"] = {{"available", c.available},
                       {"factorial_mean", c.factorial_mean},
                       {"centre_mean", c.centre_mean},
@@ -318,8 +321,9 @@ void run_analyze(const AnalyzeOptions& opt) {
   std::cout << "\n\n";
   if (res.lenth) {
     const auto& l = *res.lenth;
-    std::cout << "effects (difference of level means = 2 x coded coefficient), m = " << l.contrasts
-              << " contrasts\nLenth (1989): PSE = " << fmt(l.pse) << ", ME = " << fmt(l.me)
+    std::cout << "effects (difference of level means = 2 x coded coefficient); Lenth on the m = "
+              << l.contrasts << " terms of the model, (r) = residual contrast outside it"
+              << "\nLenth (1989): PSE = " << fmt(l.pse) << ", ME = " << fmt(l.me)
               << " (t = " << fmt(l.t_me, 4) << "), SME = " << fmt(l.sme)
               << " (t = " << fmt(l.t_sme, 4)
               << "); Student t quantiles with m/3 = " << fmt(l.degrees_of_freedom, 4)
@@ -329,7 +333,7 @@ void run_analyze(const AnalyzeOptions& opt) {
     for (const auto* e : by_size) {
       std::cout << std::setw(14) << fmt(e->effect) << "  "
                 << (e->active_simultaneous ? "SME " : (e->active ? "ME  " : "    ")) << "  "
-                << e->term.name() << "\n";
+                << e->term.name() << (e->in_model ? "" : " (r)") << "\n";
     }
     std::cout << "\n";
   }
@@ -367,7 +371,11 @@ void run_analyze(const AnalyzeOptions& opt) {
     std::cout << "\n";
   }
   const auto& c = res.curvature;
-  std::cout << "\ncurvature: ";
+  std::cout << "\nnoise: ";
+  if (res.noise.available())
+    std::cout << "sd " << fmt(res.noise.sd) << " with " << fmt(res.noise.degrees_of_freedom, 3)
+              << " df, ";
+  std::cout << res.noise.source << "\ncurvature: ";
   if (c.available) {
     std::cout << "factorial mean - centre mean = " << fmt(c.difference) << ", t = " << fmt(c.t, 4)
               << ", p = " << fmt(c.p_value, 3) << " against " << c.error_source << ": "

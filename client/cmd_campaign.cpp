@@ -3,6 +3,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "client/commands.hpp"
 #include "client/service_client.hpp"
@@ -23,6 +24,7 @@ void add_campaign_commands(CLI::App& app) {
     proto::ChannelOptions channel;
     std::int64_t id = 0;
     bool jobs = false;
+    std::string format = "table";
   };
   auto o = std::make_shared<Options>();
 
@@ -40,15 +42,26 @@ void add_campaign_commands(CLI::App& app) {
   add_connection_options(*status, o->channel);
   status->add_option("id", o->id, "campaign id")->required();
   status->add_flag("--jobs", o->jobs, "list every job with its state, attempt and metrics");
+  status
+      ->add_option("--format", o->format,
+                   "table or json (one document: the campaign, its calibration rounds, jobs)")
+      ->check(CLI::IsMember({"table", "json"}));
   status->callback([o] {
     auto stub = campaign_stub(o->channel);
     v1::GetRequest req;
     req.set_id(o->id);
     v1::Campaign c;
     check(stub->Get(proto::make_context(o->channel, 30).get(), req, &c), "status");
-    print_campaign_row(c);
     v1::ResultsReply r;
     check(stub->GetResults(proto::make_context(o->channel, 30).get(), req, &r), "results");
+    if (o->format == "json") {
+      nlohmann::json doc = nlohmann::json::parse(message_json(c));
+      if (o->jobs) doc["jobs"] = nlohmann::json::parse(message_json(r))["jobs"];
+      std::cout << doc.dump(2) << "\n";
+      return;
+    }
+    print_campaign_row(c);
+    print_rounds(std::cout, c.calibration_rounds());
     const auto flagged = std::count_if(r.jobs().begin(), r.jobs().end(),
                                        [](const v1::JobResult& j) { return j.flags_size() > 0; });
     if (flagged > 0)

@@ -16,6 +16,7 @@ void add_analysis_commands(CLI::App& app) {
     std::int64_t id = 0;
     std::string format = "table";
     std::string model = "2fi";
+    std::string calibrate_model;  ///< empty: the spec's calibration.model
     double alpha = 0.05;
     bool verify = false, wait = false;
     std::string out;
@@ -47,9 +48,12 @@ void add_analysis_commands(CLI::App& app) {
       "calibrate", "Propose a parameter set from the fitted models and the measurements");
   add_connection_options(*calibrate, o->channel);
   calibrate->add_option("id", o->id, "campaign id")->required();
-  calibrate->add_flag("--verify", o->verify, "simulate the proposed set (verification jobs)");
-  calibrate->add_flag("--wait", o->wait, "with --verify: wait for the verification jobs");
-  calibrate->add_option("--model", o->model, "main or 2fi")->check(CLI::IsMember({"main", "2fi"}));
+  calibrate->add_flag("--verify", o->verify,
+                      "advance the sequential calibration: queue the next round or stage");
+  calibrate->add_flag("--wait", o->wait,
+                      "with --verify: run the loop to its end (within tolerance or budget)");
+  calibrate->add_option("--model", o->calibrate_model, "main or 2fi (default: the spec's)")
+      ->check(CLI::IsMember({"main", "2fi"}));
   calibrate->add_option("--format", o->format, "table or json")
       ->check(CLI::IsMember({"table", "json"}));
   calibrate->callback([o] {
@@ -57,12 +61,11 @@ void add_analysis_commands(CLI::App& app) {
     v1::CalibrateRequest req;
     req.set_id(o->id);
     req.set_verify(o->verify);
-    req.set_model(o->model);
+    req.set_model(o->calibrate_model);
     v1::CalibrateReply reply;
-    check(stub->Calibrate(proto::make_context(o->channel, 300).get(), req, &reply), "calibrate");
-    if (o->verify && o->wait && reply.verification_state() == "running") {
-      watch_campaign(*stub, o->channel, o->id, std::cerr);
-      reply.Clear();
+    if (o->verify && o->wait) {
+      reply = drive_calibration(*stub, o->channel, req, std::cerr);
+    } else {
       check(stub->Calibrate(proto::make_context(o->channel, 300).get(), req, &reply), "calibrate");
     }
     print_calibration(std::cout, reply, o->format);

@@ -1,9 +1,11 @@
 // `demcal run SPEC [--workdir DIR] [--workers N] [--threads N] [--no-verify]`: the embedded default
 // (client/embedded.hpp). The campaign runs to the end over real gRPC; the effect tables and the
-// proposed calibration (verified by simulation) are printed. Running it again with the same work
-// directory resumes the campaign of the same name instead of starting over.
+// sequential calibration (verified by simulation round by round, docs/doe.md) are printed.
+// Running it again with the same work directory resumes the campaign of the same name instead
+// of starting over.
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "client/commands.hpp"
 #include "client/embedded.hpp"
@@ -20,43 +22,51 @@ struct RunOptions {
   std::string format = "table";
 };
 
+/// With `--format json` the one JSON document is all that goes to standard output: the
+/// design summary, progress and notes go to standard error.
 void run_embedded(const RunOptions& opt) {
+  const bool json = opt.format == "json";
+  std::ostream& text = json ? std::cerr : std::cout;
   const SpecFile file = read_campaign_spec(opt.spec);
   const auto workdir = work_directory(opt.spec, opt.workdir);
   EmbeddedService service(workdir, opt.local, opt.verbose);
   auto* stub = &service.stub();
   const auto& channel = service.channel();
-  std::cout << "work directory: " << workdir.string() << " (SQLite: " << service.db() << ")\n";
-  const std::int64_t id = service.submit_or_resume(file, std::cout);
-  std::cout << std::flush;
+  text << "work directory: " << workdir.string() << " (SQLite: " << service.db() << ")\n";
+  const std::int64_t id = service.submit_or_resume(file, text);
+  text << std::flush;
   const v1::Progress p = watch_campaign(*stub, channel, id, std::cerr);
-  std::cout << "\n" << progress_line(p) << "\n";
+  text << "\n" << progress_line(p) << "\n";
 
   v1::EffectsRequest ereq;
   ereq.set_id(id);
   v1::EffectsReply effects;
   check(stub->GetEffects(proto::make_context(channel, 300).get(), ereq, &effects), "effects");
-  print_effects(std::cout, effects, opt.format);
+  v1::GetRequest dreq;
+  dreq.set_id(id);
+  v1::DesignReply design;
+  check(stub->GetDesign(proto::make_context(channel, 60).get(), dreq, &design), "design");
+  nlohmann::json doc = {{"campaign", id},
+                        {"work_directory", workdir.string()},
+                        {"design", nlohmann::json::parse(message_json(design.summary()))},
+                        {"effects", nlohmann::json::parse(message_json(effects))},
+                        {"calibration", nullptr}};
+  if (!json) print_effects(std::cout, effects, opt.format);
 
   if (file.spec.measurements_size() == 0) {
-    std::cout << "\nno measurements in the spec: nothing to calibrate against\n";
-    return;
+    text << "\nno measurements in the spec: nothing to calibrate against\n";
+  } else {
+    v1::CalibrateRequest creq;
+    creq.set_id(id);
+    creq.set_verify(opt.verify);
+    const v1::CalibrateReply cal = drive_calibration(*stub, channel, creq, std::cerr);
+    doc["calibration"] = nlohmann::json::parse(message_json(cal));
+    if (!json) {
+      std::cout << "\n";
+      print_calibration(std::cout, cal, "table");
+    }
   }
-  v1::CalibrateRequest creq;
-  creq.set_id(id);
-  creq.set_verify(opt.verify);
-  v1::CalibrateReply cal;
-  check(stub->Calibrate(proto::make_context(channel, 300).get(), creq, &cal), "calibrate");
-  if (cal.verification_state() == "running") {
-    std::cout << "\nverifying the proposed set by simulation (" << cal.verification_jobs_size()
-              << " jobs)\n"
-              << std::flush;
-    watch_campaign(*stub, channel, id, std::cerr);
-    cal.Clear();
-    check(stub->Calibrate(proto::make_context(channel, 300).get(), creq, &cal), "calibrate");
-  }
-  std::cout << "\n";
-  print_calibration(std::cout, cal, opt.format == "json" ? "json" : "table");
+  if (json) std::cout << doc.dump(2) << "\n";
 }
 
 }  // namespace
@@ -71,7 +81,8 @@ void add_run_command(CLI::App& app) {
   add_local_worker_options(*cmd, o->local);
   cmd->add_flag("!--no-verify", o->verify, "do not simulate the proposed set");
   cmd->add_flag("-v,--verbose", o->verbose, "coordinator and worker logs");
-  cmd->add_option("--format", o->format, "table, csv or json (effects)")
+  cmd->add_option("--format", o->format,
+                  "table, csv (effects) or json (one document: design, effects, calibration)")
       ->check(CLI::IsMember({"table", "csv", "json"}));
   cmd->callback([o] { run_embedded(*o); });
 }

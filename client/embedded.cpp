@@ -1,5 +1,6 @@
 #include "client/embedded.hpp"
 
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <iostream>
@@ -36,6 +37,14 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
 EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local,
                                  bool verbose) {
   std::filesystem::create_directories(workdir);
+  // Logs of the embedded coordinator and workers go to standard error: standard output is the
+  // command's result (one JSON document with --format json).
+  static const auto logger = [] {
+    auto l = spdlog::stderr_color_mt("demcal-embedded");
+    spdlog::set_default_logger(l);
+    return l;
+  }();
+  (void)logger;
   spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
   server::CoordinatorOptions co;
   co.listen = "127.0.0.1:0";

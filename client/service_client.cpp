@@ -33,7 +33,9 @@ std::string duration(double s) {
   return o.str();
 }
 
-std::string to_json(const google::protobuf::Message& m) {
+}  // namespace
+
+std::string message_json(const google::protobuf::Message& m) {
   std::string out;
   google::protobuf::util::JsonPrintOptions o;
   o.add_whitespace = true;
@@ -42,6 +44,8 @@ std::string to_json(const google::protobuf::Message& m) {
   (void)google::protobuf::util::MessageToJsonString(m, &out, o);
   return out;
 }
+
+namespace {
 
 std::string csv_quote(const std::string& s) {
   if (s.find_first_of(",\"") == std::string::npos) return s;
@@ -171,7 +175,7 @@ v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const proto::Channe
 
 void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::string& format) {
   if (format == "json") {
-    out << to_json(e) << "\n";
+    out << message_json(e) << "\n";
     return;
   }
   if (format == "csv") {
@@ -192,8 +196,9 @@ void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::stri
       for (const auto& n : m.notes()) out << "  " << n << "\n";
       continue;
     }
-    out << "  Lenth: PSE " << fmt(m.pse()) << ", ME " << fmt(m.me()) << ", SME " << fmt(m.sme())
-        << " (t with " << fmt(m.lenth_df(), 3) << " df);  ** > SME, * > ME\n";
+    out << "  Lenth on the " << m.lenth_terms() << " model terms: PSE " << fmt(m.pse()) << ", ME "
+        << fmt(m.me()) << ", SME " << fmt(m.sme()) << " (t with " << fmt(m.lenth_df(), 3)
+        << " df);  ** > SME, * > ME, (r) residual contrast outside the model\n";
     out << "  " << std::setw(13) << "effect"
         << "  sig  alias chain\n";
     for (const auto& x : m.effects())
@@ -203,16 +208,47 @@ void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::stri
                               : "   ")
           << "  " << x.chain() << "\n";
     out << "  mean " << fmt(m.intercept()) << ", R^2 " << fmt(m.r_squared(), 4);
+    out << "\n  noise: ";
+    if (m.noise_df() > 0)
+      out << "sd " << fmt(m.noise_sd()) << " with " << fmt(m.noise_df(), 3) << " df, "
+          << m.noise_source();
+    else
+      out << m.noise_source();
+    out << "\n  curvature: ";
     if (m.curvature_available())
-      out << ", curvature p = " << fmt(m.curvature_p(), 3)
+      out << "factorial - centre mean " << fmt(m.curvature_difference())
+          << ", t = " << fmt(m.curvature_t(), 3) << " (" << fmt(m.curvature_df(), 3)
+          << " df), p = " << fmt(m.curvature_p(), 3)
           << (m.curvature_significant() ? " (significant)" : " (not significant)");
+    else
+      out << "not tested (needs centre points and a noise estimate)";
     out << "\n";
+  }
+}
+
+void print_rounds(std::ostream& out,
+                  const google::protobuf::RepeatedPtrField<v1::CalibrationRound>& rounds) {
+  if (rounds.empty()) return;
+  out << "\n  calibration rounds:\n";
+  for (const auto& r : rounds) {
+    out << "    round " << r.round() << " (stage " << r.stage() << ", batch " << r.batch()
+        << "): " << r.state();
+    if (r.state() == "done")
+      out << ", " << (r.within() ? "within" : "not within") << " tolerance; worst "
+          << r.worst_metric() << " at " << fmt(r.worst_deviation(), 3) << " x tolerance";
+    out << "\n      at";
+    for (const double v : r.proposed_values()) out << " " << fmt(v, 5);
+    out << "\n";
+    for (int m = 0; m < r.metrics_size(); ++m)
+      out << "      " << std::left << std::setw(34) << r.metrics(m) << std::right << " predicted "
+          << std::setw(11) << fmt(r.predicted(m)) << "  simulated "
+          << (m < r.simulated_size() ? fmt(r.simulated(m)) : "-") << "\n";
   }
 }
 
 void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std::string& format) {
   if (format == "json") {
-    out << to_json(c) << "\n";
+    out << message_json(c) << "\n";
     return;
   }
   out << "proposed parameter set (objective " << fmt(c.objective(), 4) << "):\n";
@@ -221,19 +257,36 @@ void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std
         << fmt(c.proposed_values(i), 6) << "\n";
   out << "\n  " << std::left << std::setw(36) << "metric" << std::right << std::setw(12)
       << "measured" << std::setw(12) << "predicted" << std::setw(12) << "simulated" << std::setw(10)
-      << "dev %"
-      << "  reach [min, max]\n";
+      << "dev %" << std::setw(11) << "tolerance"
+      << "  within  reach [min, max]\n";
   for (const auto& m : c.metrics()) {
     out << "  " << std::left << std::setw(36) << m.metric() << std::right << std::setw(12)
         << fmt(m.target()) << std::setw(12) << fmt(m.predicted()) << std::setw(12)
         << (m.simulated_available() ? fmt(m.simulated()) : "-") << std::setw(10)
-        << fmt(100 * m.relative_error(), 3) << "  [" << fmt(m.envelope_min()) << ", "
-        << fmt(m.envelope_max()) << "]\n";
+        << fmt(100 * m.relative_error(), 3) << std::setw(11) << fmt(m.tolerance(), 3) << "  "
+        << std::setw(6) << (m.simulated_available() ? (m.within() ? "yes" : "no") : "-") << "  ["
+        << fmt(m.envelope_min()) << ", " << fmt(m.envelope_max()) << "]\n";
     if (!m.statement().empty()) out << "      " << m.statement() << "\n";
   }
-  out << "  verification: " << c.verification_state();
-  if (c.verification_jobs_size()) out << " (" << c.verification_jobs_size() << " jobs)";
-  out << "\n";
+  out << "  tolerance = sqrt(uncertainty^2 + noise sd^2) (docs/doe.md); surrogate " << c.surrogate()
+      << "\n";
+  if (c.intervals_size()) out << "\n  parameters predicted within tolerance:\n";
+  for (const auto& i : c.intervals()) out << "    " << i.statement() << "\n";
+  print_rounds(out, c.rounds());
+  out << "  verification: " << c.verification_state() << ", " << c.simulations()
+      << " simulation(s) added by the calibration\n  " << c.conclusion() << "\n";
+}
+
+v1::CalibrateReply drive_calibration(v1::CampaignService::Stub& stub,
+                                     const proto::ChannelOptions& channel,
+                                     const v1::CalibrateRequest& request, std::ostream& progress) {
+  for (;;) {
+    v1::CalibrateReply reply;
+    check(stub.Calibrate(proto::make_context(channel, 300).get(), request, &reply), "calibrate");
+    if (!request.verify() || reply.verification_state() != "running") return reply;
+    progress << "calibration: " << reply.conclusion() << "\n";
+    watch_campaign(stub, channel, request.id(), progress);
+  }
 }
 
 }  // namespace demcal::cli

@@ -28,6 +28,16 @@ v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const proto::Channe
 /// table | csv | json
 void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::string& format);
 void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std::string& format);
+/// The rounds of a sequential calibration as a table.
+void print_rounds(std::ostream& out,
+                  const google::protobuf::RepeatedPtrField<v1::CalibrationRound>& rounds);
+/// Calls Calibrate until the calibration no longer runs (with `request.verify`: the whole
+/// sequential loop), watching the campaign's jobs on `progress` in between.
+v1::CalibrateReply drive_calibration(v1::CampaignService::Stub& stub,
+                                     const proto::ChannelOptions& channel,
+                                     const v1::CalibrateRequest& request, std::ostream& progress);
+/// A message as JSON with every field printed (the one document `--format json` writes).
+std::string message_json(const google::protobuf::Message& m);
 std::string state_name(v1::CampaignState s);
 
 }  // namespace demcal::cli

@@ -20,11 +20,12 @@ std::map<std::string, double> metrics_from_json(const std::string& json) {
   return out;
 }
 
-Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobRow>& jobs) {
+Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobRow>& jobs,
+                                const std::string& kind) {
   Eigen::MatrixXd y = Eigen::MatrixXd::Constant(
       plan.design.runs(), static_cast<Eigen::Index>(plan.responses.size()), std::nan(""));
   for (const auto& job : jobs) {
-    if (job.kind != "design" || job.state != "done" || !job.metrics_json) continue;
+    if (job.kind != kind || job.state != "done" || !job.metrics_json) continue;
     if (job.std_order < 1 || job.std_order > plan.design.runs()) continue;
     for (const auto& [metric, value] : metrics_from_json(*job.metrics_json)) {
       const std::string name = job.test + "." + metric;
@@ -53,58 +54,6 @@ doe::ResponseAnalysis analyse(const CampaignPlan& plan, const Eigen::VectorXd& y
   o.alpha = alpha;
   for (const auto& f : plan.factors) o.factors.push_back(f.factor);
   return doe::analyse_response(plan.design.coded, y, o);
-}
-
-CalibrationOutcome calibrate_plan(const CampaignPlan& plan, const Eigen::MatrixXd& responses,
-                                  doe::ModelKind model, int starts, std::uint64_t seed) {
-  if (plan.targets.empty())
-    throw InputError("spec.measurements", "the campaign has no measurements to calibrate against");
-  calib::CalibrationProblem problem;
-  for (const auto& f : plan.factors) problem.factors.push_back(f.factor);
-  CalibrationOutcome out;
-  for (const auto& t : plan.targets) {
-    if (t.holdout) continue;
-    Eigen::Index col = -1;
-    for (std::size_t c = 0; c < plan.responses.size(); ++c)
-      if (plan.responses[c] == t.response) col = Eigen::Index(c);
-    if (col < 0) throw InputError("spec.measurements", "no response " + t.response);
-    const Eigen::VectorXd y = responses.col(col);
-    int finite = 0;
-    for (Eigen::Index r = 0; r < y.size(); ++r) finite += std::isfinite(y(r)) ? 1 : 0;
-    if (finite < 2)
-      throw InputError(t.response, "only " + std::to_string(finite) +
-                                       " design runs have a result; the campaign must run first");
-    calib::MetricTarget m;
-    m.name = t.response;
-    m.model = doe::fit_model(plan.design.coded, y, model);
-    m.target = t.value;
-    m.weight = t.weight;
-    m.uncertainty = t.uncertainty;
-    problem.metrics.push_back(std::move(m));
-    out.metrics.push_back(t.response);
-  }
-  calib::CalibrationOptions o;
-  o.starts = starts;
-  o.seed = seed;
-  out.result = calib::calibrate(problem, o);
-  return out;
-}
-
-std::map<std::string, double> mean_responses(const std::vector<JobRow>& jobs,
-                                             const std::string& kind) {
-  std::map<std::string, std::pair<double, int>> sums;
-  for (const auto& job : jobs) {
-    if (job.kind != kind || job.state != "done" || !job.metrics_json) continue;
-    for (const auto& [metric, value] : metrics_from_json(*job.metrics_json)) {
-      if (!std::isfinite(value)) continue;
-      auto& s = sums[job.test + "." + metric];
-      s.first += value;
-      s.second += 1;
-    }
-  }
-  std::map<std::string, double> out;
-  for (const auto& [k, s] : sums) out[k] = s.first / s.second;
-  return out;
 }
 
 }  // namespace demcal::server

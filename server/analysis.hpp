@@ -20,21 +20,12 @@ std::map<std::string, double> metrics_from_json(const std::string& json);
 /// Per response ("test.metric"), the design runs (std order) whose value is flagged: a phase it
 /// is computed from did not reach its target.
 std::map<std::string, std::vector<int>> flagged_runs(const std::vector<JobRow>& jobs);
-Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobRow>& jobs);
+/// `kind` selects the jobs: the campaign's design, or a calibration stage's ("stage:<n>"),
+/// whose rows are the same design laid over the stage's box.
+Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobRow>& jobs,
+                                const std::string& kind = "design");
 
 doe::ResponseAnalysis analyse(const CampaignPlan& plan, const Eigen::VectorXd& y,
                               doe::ModelKind model, double alpha);
-
-struct CalibrationOutcome {
-  calib::CalibrationResult result;
-  std::vector<std::string> metrics;  ///< responses calibrated, in problem order
-};
-/// Throws InputError when there is no target or a target's response has too few results.
-CalibrationOutcome calibrate_plan(const CampaignPlan& plan, const Eigen::MatrixXd& responses,
-                                  doe::ModelKind model, int starts, std::uint64_t seed);
-
-/// Mean of each response over the done jobs of `kind` (verification runs).
-std::map<std::string, double> mean_responses(const std::vector<JobRow>& jobs,
-                                             const std::string& kind);
 
 }  // namespace demcal::server

@@ -13,6 +13,7 @@
 #include "core/doe/minimum_aberration.hpp"
 #include "core/lab/catalog.hpp"
 #include "proto/material_convert.hpp"
+#include "server/calibration.hpp"
 
 namespace demcal::server {
 namespace {
@@ -51,8 +52,17 @@ void check_settable(lab::MaterialModel model, const std::string& path, double va
   }
 }
 
-std::uint64_t job_seed(const v1::LabTest& t, int replicate) {
-  return (t.seed() ? t.seed() : 1) + static_cast<std::uint64_t>(replicate - 1);
+std::uint64_t base_seed(const v1::LabTest& t) {
+  return t.seed() ? t.seed() : 1;
+}
+
+/// The simulation seed of design row `row` (0-based, standard order): its own by default, so
+/// that repeated points (centre points, replicates) measure the run-to-run noise.
+std::uint64_t design_seed(const v1::LabTest& t, const v1::Design& design, const doe::Design& d,
+                          int row) {
+  if (design.simulation_seeds() == v1::Design::PINNED)
+    return base_seed(t) + static_cast<std::uint64_t>(d.replicate[std::size_t(row)] - 1);
+  return base_seed(t) + static_cast<std::uint64_t>(row);
 }
 
 }  // namespace
@@ -201,16 +211,28 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
                        "metric '" + m.metric() + "' is reported by several tests: name the test");
     if (!std::isfinite(m.value()) || m.value() == 0.0)
       throw InputError(where + ".value", "must be finite and non-zero (errors are relative)");
-    if (m.uncertainty() < 0) throw InputError(where + ".uncertainty", "must be >= 0");
-    if (m.weight() < 0) throw InputError(where + ".weight", "must be >= 0");
+    if (!(std::isfinite(m.uncertainty()) && m.uncertainty() >= 0))
+      throw InputError(where + ".uncertainty", "must be finite and >= 0");
+    if (!(std::isfinite(m.weight()) && m.weight() >= 0))
+      throw InputError(where + ".weight", "must be finite and >= 0");
     Target t{matches.front(), m.value(),  m.weight() > 0 ? m.weight() : 1.0,
              std::nullopt,    m.source(), m.holdout()};
     if (m.uncertainty() > 0) t.uncertainty = m.uncertainty();
     plan.targets.push_back(t);
   }
 
-  // One job per design row and test.
-  for (int r = 0; r < plan.design.runs(); ++r) {
+  // Checked at submission so that a bad calibration block is refused before anything runs.
+  (void)calibration_options(spec.calibration(), "spec.calibration");
+  jobs = design_jobs(spec, plan, plan.factors, "design", 0);
+  return plan;
+}
+
+std::vector<NewJob> design_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
+                                const std::vector<PlannedFactor>& box, const std::string& kind,
+                                int stage_offset) {
+  std::vector<NewJob> jobs;
+  const auto& design = plan.design;
+  for (int r = 0; r < design.runs(); ++r) {
     for (const auto& t : spec.tests()) {
       v1::JobSpec job;
       job.set_campaign_id(0);
@@ -218,21 +240,22 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
       *job.mutable_settings() = t.settings();
       *job.mutable_material() = spec.material();
       *job.mutable_parameters() = spec.fixed();
-      for (std::size_t f = 0; f < plan.factors.size(); ++f)
-        (*job.mutable_parameters())[plan.factors[f].path] =
-            plan.factors[f].factor.to_natural(plan.design.coded(r, Eigen::Index(f)));
-      job.set_seed(job_seed(t, plan.design.replicate[std::size_t(r)]));
+      for (std::size_t f = 0; f < box.size(); ++f)
+        (*job.mutable_parameters())[box[f].path] =
+            box[f].factor.to_natural(design.coded(r, Eigen::Index(f)));
+      const bool pinned = spec.design().simulation_seeds() == v1::Design::PINNED;
+      job.set_seed(design_seed(t, spec.design(), design, r) +
+                   (pinned ? 0 : static_cast<std::uint64_t>(stage_offset)));
       job.set_threads(t.threads());
-      jobs.push_back(
-          {r + 1, plan.design.run_order[std::size_t(r)], t.test(), "design", to_json(job)});
+      jobs.push_back({r + 1, design.run_order[std::size_t(r)], t.test(), kind, to_json(job)});
     }
   }
-  return plan;
+  return jobs;
 }
 
 std::vector<NewJob> jobs_at(const v1::CampaignSpec& spec, const v1::Material& material,
                             const std::map<std::string, double>& parameters, int std_order,
-                            const std::string& kind) {
+                            const std::string& kind, std::uint64_t seed_offset) {
   std::vector<NewJob> jobs;
   int order = 0;
   for (const auto& t : spec.tests()) {
@@ -242,19 +265,11 @@ std::vector<NewJob> jobs_at(const v1::CampaignSpec& spec, const v1::Material& ma
     *job.mutable_material() = material;
     *job.mutable_parameters() = spec.fixed();
     for (const auto& [path, value] : parameters) (*job.mutable_parameters())[path] = value;
-    job.set_seed(job_seed(t, 1));
+    job.set_seed(base_seed(t) + seed_offset);
     job.set_threads(t.threads());
     jobs.push_back({std_order, ++order, t.test(), kind, to_json(job)});
   }
   return jobs;
-}
-
-std::vector<NewJob> verification_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
-                                      const Eigen::VectorXd& natural) {
-  std::map<std::string, double> parameters;
-  for (std::size_t f = 0; f < plan.factors.size(); ++f)
-    parameters[plan.factors[f].path] = natural(Eigen::Index(f));
-  return jobs_at(spec, spec.material(), parameters, 0, "verify");
 }
 
 std::vector<std::string> factor_legend(const CampaignPlan& plan) {
@@ -376,13 +391,18 @@ v1::MetricEffects effects_message(const std::string& response, const doe::Respon
     o->set_effect(e->effect);
     o->set_active_me(e->active);
     o->set_active_sme(e->active_simultaneous);
+    o->set_in_model(e->in_model);
   }
   if (a.lenth) {
     m.set_pse(a.lenth->pse);
     m.set_me(a.lenth->me);
     m.set_sme(a.lenth->sme);
     m.set_lenth_df(a.lenth->degrees_of_freedom);
+    m.set_lenth_terms(a.lenth->contrasts);
   }
+  m.set_noise_sd(a.noise.sd);
+  m.set_noise_df(a.noise.degrees_of_freedom);
+  m.set_noise_source(a.noise.source);
   m.set_intercept(a.fit.intercept);
   for (std::size_t i = 0; i < a.fit.terms.size(); ++i) {
     auto* c = m.add_coefficients();
@@ -395,12 +415,18 @@ v1::MetricEffects effects_message(const std::string& response, const doe::Respon
   m.set_curvature_available(a.curvature.available);
   m.set_curvature_p(a.curvature.p_value);
   m.set_curvature_significant(a.curvature.significant);
+  m.set_curvature_difference(a.curvature.difference);
+  m.set_curvature_t(a.curvature.t);
+  m.set_curvature_df(a.curvature.degrees_of_freedom);
+  m.set_curvature_error(a.curvature.error_source);
   for (const auto& n : a.notes) m.add_notes(n);
   return m;
 }
 
 std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
-                            const std::vector<JobRow>& jobs, const std::string& format) {
+                            const std::vector<JobRow>& jobs,
+                            const std::vector<v1::CalibrationRound>& rounds,
+                            const std::string& format) {
   const Eigen::MatrixXd y = response_matrix(plan, jobs);
   const auto& d = plan.design;
   if (format == "csv") {
@@ -443,6 +469,8 @@ std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
     }
     j["jobs"].push_back(o);
   }
+  j["calibration_rounds"] = nlohmann::json::array();
+  for (const auto& r : rounds) j["calibration_rounds"].push_back(nlohmann::json::parse(to_json(r)));
   return j.dump(2);
 }
 

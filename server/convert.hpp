@@ -19,14 +19,18 @@ namespace demcal::server {
 CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs);
 
 /// Jobs that simulate each test of the spec with `material` at one parameter set (the spec's
-/// fixed parameters, then `parameters`), as design row `std_order` of job kind `kind`.
+/// fixed parameters, then `parameters`), as design row `std_order` of job kind `kind`, with
+/// the test's seed + `seed_offset`.
 std::vector<NewJob> jobs_at(const v1::CampaignSpec& spec, const v1::Material& material,
                             const std::map<std::string, double>& parameters, int std_order,
-                            const std::string& kind);
+                            const std::string& kind, std::uint64_t seed_offset = 0);
 
-/// Jobs that simulate each test at one parameter set (verification of a calibration).
-std::vector<NewJob> verification_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
-                                      const Eigen::VectorXd& natural);
+/// One job per design row and test, the plan's design laid over `box` (the campaign's factors
+/// or a calibration stage's narrowed box), of job kind `kind`. Seeds: see Design.Seeds in the
+/// proto; a later stage adds `stage_offset` to keep its runs' seeds apart from the first.
+std::vector<NewJob> design_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
+                                const std::vector<PlannedFactor>& box, const std::string& kind,
+                                int stage_offset);
 
 v1::DesignSummary design_summary(const CampaignPlan& plan, int jobs);
 v1::DesignReply design_reply(const CampaignPlan& plan, int jobs);
@@ -43,7 +47,10 @@ void from_json(const std::string& json, google::protobuf::Message& message);
 
 /// The whole campaign (spec, design, runs, results) as JSON, or as a CSV of the design in
 /// natural units plus one column per response (readable by `demcal analyze`).
+/// The JSON form also holds the calibration rounds.
 std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
-                            const std::vector<JobRow>& jobs, const std::string& format);
+                            const std::vector<JobRow>& jobs,
+                            const std::vector<v1::CalibrationRound>& rounds,
+                            const std::string& format);
 
 }  // namespace demcal::server

@@ -10,6 +10,7 @@
 #include "core/common/error.hpp"
 #include "server/analysis.hpp"
 #include "server/auth.hpp"
+#include "server/calibration.hpp"
 #include "server/convert.hpp"
 #include "server/diagnosis.hpp"
 
@@ -70,7 +71,12 @@ grpc::Status CampaignServiceImpl::Get(grpc::ServerContext* ctx, const v1::GetReq
   DEMCAL_AUTHORIZE(ctx);
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
-  *reply = campaign_message(*row, store_.counts(row->id), now_seconds(), true);
+  try {
+    *reply = campaign_message(*row, store_.counts(row->id), now_seconds(), true);
+    for (auto& r : calibration_rounds(store_, *row)) *reply->add_calibration_rounds() = r;
+  } catch (const std::exception& e) {
+    return internal(e);
+  }
   return grpc::Status::OK;
 }
 
@@ -96,7 +102,9 @@ grpc::Status CampaignServiceImpl::Cancel(grpc::ServerContext* ctx, const v1::Can
 grpc::Status CampaignServiceImpl::Watch(grpc::ServerContext* ctx, const v1::WatchRequest* req,
                                         grpc::ServerWriter<v1::Progress>* writer) {
   DEMCAL_AUTHORIZE(ctx);
-  const double interval = req->interval_seconds() > 0 ? req->interval_seconds() : 0.5;
+  const double interval = req->interval_seconds() != 0.0 ? req->interval_seconds() : 0.5;
+  if (!(interval > 0.0 && interval <= 60.0))
+    return {grpc::StatusCode::INVALID_ARGUMENT, "interval_seconds: must lie in (0, 60]"};
   std::string last;
   double last_sent = 0.0;
   while (!ctx->IsCancelled() && !stopping_) {
@@ -152,7 +160,8 @@ grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
     const Eigen::MatrixXd y = response_matrix(plan, jobs);
     const auto flagged = flagged_runs(jobs);
     const auto kind = model_kind(req->model(), "model");
-    const double alpha = req->alpha() > 0 ? req->alpha() : 0.05;
+    const double alpha = req->alpha() != 0.0 ? req->alpha() : 0.05;
+    if (!(alpha > 0.0 && alpha < 0.5)) throw InputError("alpha", "must lie in (0, 0.5)");
     for (const auto& l : factor_legend(plan)) reply->add_factor_letters(l);
     for (std::size_t c = 0; c < plan.responses.size(); ++c) {
       const Eigen::VectorXd col = y.col(Eigen::Index(c));
@@ -196,57 +205,15 @@ grpc::Status CampaignServiceImpl::Calibrate(grpc::ServerContext* ctx,
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   try {
-    const CampaignPlan plan = plan_from_json(row->design_json);
-    const auto jobs = store_.jobs(row->id);
-    const auto kind = model_kind(req->model(), "model");
-    CalibrationOutcome out;
-    try {
-      out = calibrate_plan(plan, response_matrix(plan, jobs), kind,
-                           req->starts() > 0 ? req->starts() : 16, req->seed() ? req->seed() : 1);
-    } catch (const InputError& e) {
-      return {grpc::StatusCode::FAILED_PRECONDITION, e.what()};
-    }
-    const auto& r = out.result;
-    for (std::size_t f = 0; f < plan.factors.size(); ++f) {
-      (*reply->mutable_proposed())[plan.factors[f].path] = r.natural(Eigen::Index(f));
-      reply->add_factor_paths(plan.factors[f].path);
-      reply->add_proposed_values(r.natural(Eigen::Index(f)));
-    }
-    reply->set_objective(r.objective);
-    // One verification round per campaign: the proposal is deterministic for a seed.
-    std::vector<std::int64_t> verify_ids;
-    for (const auto& j : jobs)
-      if (j.kind == "verify") verify_ids.push_back(j.id);
-    if (req->verify() && verify_ids.empty()) {
-      v1::CampaignSpec spec;
-      from_json(row->spec_json, spec);
-      verify_ids = store_.add_jobs(row->id, verification_jobs(spec, plan, r.natural));
-      spdlog::info("campaign {}: {} verification jobs queued", row->id, verify_ids.size());
-    }
-    for (const auto id : verify_ids) reply->add_verification_jobs(id);
-    const auto vc = store_.counts(row->id, "verify");
-    reply->set_verification_state(vc.total() == 0             ? "none"
-                                  : vc.queued + vc.leased > 0 ? "running"
-                                                              : "done");
-    const auto simulated = mean_responses(store_.jobs(row->id), "verify");
-    for (const auto& m : r.metrics) {
-      auto* o = reply->add_metrics();
-      o->set_metric(m.name);
-      o->set_target(m.target);
-      o->set_predicted(m.predicted);
-      o->set_relative_error(m.relative_error);
-      o->set_envelope_min(m.envelope.min);
-      o->set_envelope_max(m.envelope.max);
-      o->set_reachable(m.reachable);
-      o->set_statement(m.statement);
-      if (const auto it = simulated.find(m.name); it != simulated.end()) {
-        o->set_simulated_available(true);
-        o->set_simulated(it->second);
-      }
-    }
+    // One calibration step at a time: two concurrent calls must not queue the same round twice.
+    std::lock_guard lock(calibrate_mutex_);
+    *reply = calibrate_campaign(store_, *row, *req);
     return grpc::Status::OK;
   } catch (const InputError& e) {
-    return invalid(e);
+    // A bad request field is invalid; a campaign not ready to calibrate is a precondition.
+    const std::string where = e.where();
+    if (where == "model" || where == "starts") return invalid(e);
+    return {grpc::StatusCode::FAILED_PRECONDITION, e.what()};
   } catch (const std::exception& e) {
     return internal(e);
   }
@@ -278,8 +245,12 @@ grpc::Status CampaignServiceImpl::Export(grpc::ServerContext* ctx, const v1::Exp
   if (format != "json" && format != "csv")
     return {grpc::StatusCode::INVALID_ARGUMENT, "format: expected csv or json"};
   reply->set_format(format);
-  reply->set_content(
-      export_campaign(*row, plan_from_json(row->design_json), store_.jobs(row->id), format));
+  try {
+    reply->set_content(export_campaign(*row, plan_from_json(row->design_json), store_.jobs(row->id),
+                                       calibration_rounds(store_, *row), format));
+  } catch (const std::exception& e) {
+    return internal(e);
+  }
   return grpc::Status::OK;
 }
 

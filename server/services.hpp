@@ -46,6 +46,7 @@ class CampaignServiceImpl final : public v1::CampaignService::Service {
   ServiceConfig config_;
   const std::atomic<bool>& stopping_;
   std::mutex diagnose_mutex_;
+  std::mutex calibrate_mutex_;
 };
 
 class WorkerServiceImpl final : public v1::WorkerService::Service {

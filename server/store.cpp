@@ -75,6 +75,45 @@ const std::vector<const char*>& migrations() {
       ALTER TABLE results ADD COLUMN flags_json TEXT NOT NULL DEFAULT '{}';
       ALTER TABLE results ADD COLUMN cost_json TEXT NOT NULL DEFAULT '{}';
       )sql",
+      // 4: the sequential calibration: its rounds, its stage boxes, and the jobs of its stage
+      // designs (kind 'stage:<n>'), which need the jobs table rebuilt as in migration 2.
+      R"sql(
+      CREATE TABLE jobs_v4 (
+        id INTEGER PRIMARY KEY AUTOINCREMENT,
+        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
+        std_order INTEGER NOT NULL,
+        run_order INTEGER NOT NULL,
+        test TEXT NOT NULL,
+        kind TEXT NOT NULL CHECK (kind IN ('design', 'verify') OR kind LIKE 'diagnose:%'
+                                  OR kind LIKE 'stage:%'),
+        payload TEXT NOT NULL,
+        state TEXT NOT NULL
+          CHECK (state IN ('queued', 'leased', 'done', 'failed', 'cancelled')),
+        attempt INTEGER NOT NULL DEFAULT 0,
+        counted INTEGER NOT NULL DEFAULT 0,
+        lease_deadline REAL NOT NULL DEFAULT 0,
+        worker TEXT NOT NULL DEFAULT '',
+        error TEXT NOT NULL DEFAULT '',
+        finished REAL NOT NULL DEFAULT 0);
+      INSERT INTO jobs_v4 SELECT * FROM jobs;
+      DROP TABLE jobs;
+      ALTER TABLE jobs_v4 RENAME TO jobs;
+      CREATE INDEX jobs_queue ON jobs (state, campaign_id, kind, run_order);
+      CREATE INDEX jobs_campaign ON jobs (campaign_id);
+      CREATE TABLE calibration_rounds (
+        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
+        round INTEGER NOT NULL,
+        stage INTEGER NOT NULL,
+        proposal_json TEXT NOT NULL,
+        created REAL NOT NULL,
+        PRIMARY KEY (campaign_id, round));
+      CREATE TABLE calibration_stages (
+        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
+        stage INTEGER NOT NULL,
+        box_json TEXT NOT NULL,
+        created REAL NOT NULL,
+        PRIMARY KEY (campaign_id, stage));
+      )sql",
   };
   return m;
 }
@@ -328,10 +367,8 @@ bool Store::cancel(std::int64_t campaign_id, double now) {
   return true;
 }
 
-std::vector<std::int64_t> Store::add_jobs(std::int64_t campaign_id,
-                                          const std::vector<NewJob>& jobs) {
-  std::lock_guard lock(mutex_);
-  Transaction tx(*this);
+std::vector<std::int64_t> Store::insert_jobs(std::int64_t campaign_id,
+                                             const std::vector<NewJob>& jobs) {
   std::vector<std::int64_t> ids;
   for (const auto& job : jobs) {
     Statement s(db_,
@@ -344,8 +381,68 @@ std::vector<std::int64_t> Store::add_jobs(std::int64_t campaign_id,
   Statement c(
       db_, "UPDATE campaigns SET state = 'running', finished = 0 WHERE id = ? AND state = 'done'");
   c.bind(1, campaign_id).step();
+  return ids;
+}
+
+std::vector<std::int64_t> Store::add_jobs(std::int64_t campaign_id,
+                                          const std::vector<NewJob>& jobs) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  auto ids = insert_jobs(campaign_id, jobs);
   tx.commit();
   return ids;
+}
+
+std::vector<std::int64_t> Store::add_calibration_round(std::int64_t campaign_id,
+                                                       const CalibrationRoundRow& round,
+                                                       const std::vector<NewJob>& jobs) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  Statement s(db_,
+              "INSERT INTO calibration_rounds (campaign_id, round, stage, proposal_json, created) "
+              "VALUES (?, ?, ?, ?, ?)");
+  s.bind(1, campaign_id).bind(2, round.round).bind(3, round.stage);
+  s.bind(4, round.proposal_json).bind(5, round.created).step();
+  auto ids = insert_jobs(campaign_id, jobs);
+  tx.commit();
+  return ids;
+}
+
+std::vector<std::int64_t> Store::add_calibration_stage(std::int64_t campaign_id,
+                                                       const CalibrationStageRow& stage,
+                                                       const std::vector<NewJob>& jobs) {
+  std::lock_guard lock(mutex_);
+  Transaction tx(*this);
+  Statement s(db_,
+              "INSERT INTO calibration_stages (campaign_id, stage, box_json, created) "
+              "VALUES (?, ?, ?, ?)");
+  s.bind(1, campaign_id).bind(2, stage.stage).bind(3, stage.box_json).bind(4, stage.created);
+  s.step();
+  auto ids = insert_jobs(campaign_id, jobs);
+  tx.commit();
+  return ids;
+}
+
+std::vector<CalibrationRoundRow> Store::calibration_rounds(std::int64_t campaign_id) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_,
+              "SELECT round, stage, proposal_json, created FROM calibration_rounds "
+              "WHERE campaign_id = ? ORDER BY round");
+  s.bind(1, campaign_id);
+  std::vector<CalibrationRoundRow> out;
+  while (s.step()) out.push_back({s.i32(0), s.i32(1), s.text(2), s.f64(3)});
+  return out;
+}
+
+std::vector<CalibrationStageRow> Store::calibration_stages(std::int64_t campaign_id) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_,
+              "SELECT stage, box_json, created FROM calibration_stages "
+              "WHERE campaign_id = ? ORDER BY stage");
+  s.bind(1, campaign_id);
+  std::vector<CalibrationStageRow> out;
+  while (s.step()) out.push_back({s.i32(0), s.text(1), s.f64(2)});
+  return out;
 }
 
 std::optional<JobRow> Store::lease(const std::string& worker, double now) {

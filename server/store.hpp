@@ -35,7 +35,7 @@ struct NewJob {
   int std_order = 0;  ///< 1-based design row; 0 for a verification job
   int run_order = 0;
   std::string test;
-  std::string kind = "design";  ///< design | verify
+  std::string kind = "design";  ///< design | verify | stage:<n> | diagnose:<group>
   std::string payload;          ///< JobSpec as JSON (without id and attempt)
 };
 
@@ -51,6 +51,22 @@ struct JobRow {
   double finished = 0.0;
   std::string flags_json = "{}";  ///< metric -> why it cannot be trusted
   std::string cost_json = "{}";   ///< the run's cost block (demcal.v1.RunCost as JSON)
+};
+
+/// One round of the sequential calibration: its proposal as JSON (server/calibration.cpp).
+struct CalibrationRoundRow {
+  int round = 0;  ///< 1-based; its verification jobs have kind 'verify' and std_order = round
+  int stage = 1;
+  std::string proposal_json;
+  double created = 0.0;
+};
+
+/// A second (or later) stage of the calibration: its box as JSON; its design jobs have kind
+/// 'stage:<stage>'.
+struct CalibrationStageRow {
+  int stage = 2;
+  std::string box_json;
+  double created = 0.0;
 };
 
 struct Counts {
@@ -88,6 +104,16 @@ class Store {
   bool cancel(std::int64_t campaign_id, double now);
   /// Adds jobs to an existing campaign (verification runs); the campaign runs again.
   std::vector<std::int64_t> add_jobs(std::int64_t campaign_id, const std::vector<NewJob>& jobs);
+  /// Stores a calibration round and queues its jobs in one transaction.
+  std::vector<std::int64_t> add_calibration_round(std::int64_t campaign_id,
+                                                  const CalibrationRoundRow& round,
+                                                  const std::vector<NewJob>& jobs);
+  /// Stores a calibration stage and queues its design jobs in one transaction.
+  std::vector<std::int64_t> add_calibration_stage(std::int64_t campaign_id,
+                                                  const CalibrationStageRow& stage,
+                                                  const std::vector<NewJob>& jobs);
+  std::vector<CalibrationRoundRow> calibration_rounds(std::int64_t campaign_id);
+  std::vector<CalibrationStageRow> calibration_stages(std::int64_t campaign_id);
 
   /// The next queued job (oldest campaign first, then run order), leased to `worker`.
   std::optional<JobRow> lease(const std::string& worker, double now);
@@ -111,6 +137,8 @@ class Store {
   void exec(const char* sql);
   void migrate();
   void finish_campaigns(double now);
+  /// Inserts queued jobs and reopens a finished campaign; inside a transaction.
+  std::vector<std::int64_t> insert_jobs(std::int64_t campaign_id, const std::vector<NewJob>& jobs);
   bool requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason, bool retryable,
                        double now);
 

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/common/error.hpp"
+#include "core/common/rng.hpp"
 #include "core/doe/design.hpp"
 
 namespace demcal::calib {
@@ -77,8 +78,9 @@ Eigen::VectorXd nelder_mead(const Objective& f, const Eigen::VectorXd& start, in
   return clamp_box(simplex[std::size_t(best)]);
 }
 
-/// Minimises f over the box from the centre and a seeded Latin hypercube of starts.
-Eigen::VectorXd minimise(const Objective& f, int k, const CalibrationOptions& options) {
+}  // namespace
+
+Eigen::VectorXd minimise_in_box(const Objective& f, int k, const CalibrationOptions& options) {
   std::vector<Eigen::VectorXd> starts{Eigen::VectorXd::Zero(k)};
   if (options.starts > 1) {
     const doe::Design lhs = doe::latin_hypercube(k, std::max(2, options.starts - 1), options.seed);
@@ -96,16 +98,11 @@ Eigen::VectorXd minimise(const Objective& f, int k, const CalibrationOptions& op
   return best;
 }
 
+namespace {
+
 bool has_squares(const doe::ModelFit& model) {
   return std::any_of(model.terms.begin(), model.terms.end(),
                      [](const doe::ModelTerm& t) { return t.squared; });
-}
-
-std::string number(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
 }
 
 void validate(const CalibrationProblem& problem) {
@@ -114,9 +111,9 @@ void validate(const CalibrationProblem& problem) {
   for (const auto& f : problem.factors) f.validate();
   for (const auto& m : problem.metrics) {
     const std::string where = "metrics." + m.name;
-    if (m.model.factor_count != static_cast<int>(problem.factors.size())) {
-      throw InputError(where, "model has " + std::to_string(m.model.factor_count) +
-                                  " factors, the problem " +
+    const int dims = m.gp ? m.gp->dimension() : m.model.factor_count;
+    if (dims != static_cast<int>(problem.factors.size())) {
+      throw InputError(where, "model has " + std::to_string(dims) + " factors, the problem " +
                                   std::to_string(problem.factors.size()));
     }
     if (!std::isfinite(m.target)) throw InputError(where + ".target", "must be finite");
@@ -124,6 +121,8 @@ void validate(const CalibrationProblem& problem) {
       throw InputError(where + ".uncertainty", "must be positive");
     }
     if (!m.uncertainty && !(m.weight >= 0.0)) throw InputError(where + ".weight", "must be >= 0");
+    if (!(std::isfinite(m.noise_sd) && m.noise_sd >= 0.0))
+      throw InputError(where + ".noise_sd", "must be finite and >= 0");
     if (m.target == 0.0 && !m.uncertainty) {
       throw InputError(where + ".target",
                        "is 0: a relative error is undefined; give an "
@@ -132,7 +131,127 @@ void validate(const CalibrationProblem& problem) {
   }
 }
 
+/// Whether the box reaches the target: an envelope that misses it by no more than the
+/// tolerance still reaches it, since noise and measurement error cover the gap.
+void state_reach(MetricOutcome& o) {
+  const std::string range =
+      "[" + statement_number(o.envelope.min) + ", " + statement_number(o.envelope.max) + "]";
+  const std::string within = o.tolerance > 0.0 ? " (tolerance +-" + statement_number(o.tolerance) +
+                                                     ": uncertainty and noise)"
+                                               : "";
+  const std::string head = "target " + statement_number(o.target) + " of " + o.name;
+  if (o.target > o.envelope.max + o.tolerance) {
+    o.reachable = false;
+    o.statement = head + " lies above the largest value reachable in the box, " +
+                  statement_number(o.envelope.max) + within +
+                  ": unreachable with these factor ranges";
+  } else if (o.target < o.envelope.min - o.tolerance) {
+    o.reachable = false;
+    o.statement = head + " lies below the smallest value reachable in the box, " +
+                  statement_number(o.envelope.min) + within +
+                  ": unreachable with these factor ranges";
+  } else {
+    o.statement = head + " is within reach " + range + within;
+  }
+}
+
+Envelope searched_envelope(const Objective& f, int k, const CalibrationOptions& options) {
+  Envelope env;
+  env.argmin = minimise_in_box(f, k, options);
+  env.argmax = minimise_in_box([&](const Eigen::VectorXd& x) { return -f(x); }, k, options);
+  env.min = f(env.argmin);
+  env.max = f(env.argmax);
+  return env;
+}
+
+/// Whether the surrogates predict every metric within its tolerance (widened by their own
+/// predictive sd) at a coded point.
+bool predicted_within(const CalibrationProblem& problem, const Eigen::VectorXd& x) {
+  for (const auto& m : problem.metrics) {
+    const double band = std::sqrt(std::pow(tolerance(m), 2) + predictive_variance(m, x));
+    if (!(std::abs(predict(m, x) - m.target) <= band)) return false;
+  }
+  return true;
+}
+
+std::vector<ParameterInterval> parameter_intervals(const CalibrationProblem& problem,
+                                                   const Eigen::VectorXd& optimum,
+                                                   std::uint64_t seed) {
+  constexpr int kSamples = 4000;
+  const auto k = static_cast<Eigen::Index>(problem.factors.size());
+  std::vector<ParameterInterval> out(problem.factors.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i].name = problem.factors[i].name;
+  for (const auto& m : problem.metrics) {
+    if (!(tolerance(m) > 0.0)) {
+      for (auto& p : out) p.statement = "no interval: " + m.name + " has no uncertainty or noise";
+      return out;
+    }
+  }
+  Eigen::VectorXd lo = Eigen::VectorXd::Constant(k, 2.0), hi = Eigen::VectorXd::Constant(k, -2.0);
+  Rng rng(seed);
+  for (int s = 0; s <= kSamples; ++s) {
+    Eigen::VectorXd x = optimum;
+    if (s > 0)
+      for (Eigen::Index i = 0; i < k; ++i) x(i) = 2.0 * rng.uniform() - 1.0;
+    if (!predicted_within(problem, x)) continue;
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    auto& p = out[i];
+    const auto& f = problem.factors[i];
+    if (lo(Eigen::Index(i)) > hi(Eigen::Index(i))) {
+      p.statement = "no interval: no point of the box is predicted within tolerance";
+      continue;
+    }
+    p.available = true;
+    p.low = f.to_natural(lo(Eigen::Index(i)));
+    p.high = f.to_natural(hi(Eigen::Index(i)));
+    p.fraction = 0.5 * (hi(Eigen::Index(i)) - lo(Eigen::Index(i)));
+    p.pinned = p.fraction <= kPinnedFraction;
+    const std::string range = "[" + statement_number(p.low) + ", " + statement_number(p.high) +
+                              "] (" + std::to_string(std::lround(100.0 * p.fraction)) +
+                              " % of its range)";
+    p.statement = p.pinned ? f.name + " in " + range
+                           : f.name + " is not pinned by the data: anything in " + range +
+                                 " is predicted within tolerance";
+  }
+  return out;
+}
+
 }  // namespace
+
+std::string statement_number(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+double predict(const MetricTarget& m, const Eigen::VectorXd& x) {
+  return m.gp ? m.gp->mean(x) : m.model.predict(x);
+}
+
+double predictive_variance(const MetricTarget& m, const Eigen::VectorXd& x) {
+  return m.gp ? m.gp->variance(x) : 0.0;
+}
+
+double tolerance(const MetricTarget& m) {
+  const double u = m.uncertainty ? *m.uncertainty : 0.0;
+  return std::hypot(u, m.noise_sd);
+}
+
+double objective_of(const std::vector<MetricTarget>& metrics, const Eigen::VectorXd& values) {
+  double j = 0.0, total_weight = 0.0;
+  for (std::size_t i = 0; i < metrics.size(); ++i) {
+    const auto& m = metrics[i];
+    const double scale = m.uncertainty ? *m.uncertainty : std::abs(m.target);
+    const double r = (values(Eigen::Index(i)) - m.target) / scale;
+    j += (m.uncertainty ? 1.0 : m.weight) * r * r;
+    total_weight += effective_weight(m);
+  }
+  return j / total_weight;
+}
 
 double effective_weight(const MetricTarget& m) {
   return m.uncertainty ? std::pow(m.target / *m.uncertainty, 2) : m.weight;
@@ -161,11 +280,7 @@ Envelope reachable_envelope(const doe::ModelFit& model, const CalibrationOptions
     }
     return env;
   }
-  env.argmin = minimise([&](const Eigen::VectorXd& x) { return model.predict(x); }, k, options);
-  env.argmax = minimise([&](const Eigen::VectorXd& x) { return -model.predict(x); }, k, options);
-  env.min = model.predict(env.argmin);
-  env.max = model.predict(env.argmax);
-  return env;
+  return searched_envelope([&](const Eigen::VectorXd& x) { return model.predict(x); }, k, options);
 }
 
 CalibrationResult calibrate(const CalibrationProblem& problem, const CalibrationOptions& options) {
@@ -176,13 +291,10 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const Calibration
   for (const auto& m : problem.metrics) total_weight += effective_weight(m);
   if (!(total_weight > 0.0)) throw InputError("metrics", "all weights are zero");
   const Objective objective = [&](const Eigen::VectorXd& x) {
-    double j = 0.0;
-    for (const auto& m : problem.metrics) {
-      const double scale = m.uncertainty ? *m.uncertainty : std::abs(m.target);
-      const double r = (m.model.predict(x) - m.target) / scale;
-      j += (m.uncertainty ? 1.0 : m.weight) * r * r;
-    }
-    return j / total_weight;
+    Eigen::VectorXd values(Eigen::Index(problem.metrics.size()));
+    for (std::size_t m = 0; m < problem.metrics.size(); ++m)
+      values(Eigen::Index(m)) = predict(problem.metrics[m], x);
+    return objective_of(problem.metrics, values);
   };
   // Ridge toward the centre (reported objective without it): of the many sets that fit equally
   // well when there are more factors than metrics, the one nearest the design centre.
@@ -190,7 +302,7 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const Calibration
     return objective(x) + options.centre_weight * x.squaredNorm() / k;
   };
   CalibrationResult out;
-  out.coded = minimise(options.centre_weight > 0.0 ? regularised : objective, k, options);
+  out.coded = minimise_in_box(options.centre_weight > 0.0 ? regularised : objective, k, options);
   out.objective = objective(out.coded);
   out.natural.resize(k);
   for (int i = 0; i < k; ++i)
@@ -199,65 +311,17 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const Calibration
     MetricOutcome o;
     o.name = m.name;
     o.target = m.target;
-    o.predicted = m.model.predict(out.coded);
+    o.predicted = predict(m, out.coded);
     o.relative_error =
         m.target != 0.0 ? (o.predicted - m.target) / std::abs(m.target) : std::nan("");
-    o.envelope = reachable_envelope(m.model, options);
-    const std::string range = "[" + number(o.envelope.min) + ", " + number(o.envelope.max) + "]";
-    if (m.target > o.envelope.max) {
-      o.reachable = false;
-      o.statement = "target " + number(m.target) + " of " + m.name +
-                    " lies above the largest value reachable in the box, " +
-                    number(o.envelope.max) + ": unreachable with these factor ranges";
-    } else if (m.target < o.envelope.min) {
-      o.reachable = false;
-      o.statement = "target " + number(m.target) + " of " + m.name +
-                    " lies below the smallest value reachable in the box, " +
-                    number(o.envelope.min) + ": unreachable with these factor ranges";
-    } else {
-      o.statement = "target " + number(m.target) + " of " + m.name + " is within reach " + range;
-    }
+    o.envelope = m.gp ? searched_envelope([&](const Eigen::VectorXd& x) { return predict(m, x); },
+                                          k, options)
+                      : reachable_envelope(m.model, options);
+    o.tolerance = tolerance(m);
+    state_reach(o);
     out.metrics.push_back(o);
   }
-  return out;
-}
-
-std::vector<doe::Factor> narrow_box(const std::vector<doe::Factor>& factors,
-                                    const Eigen::VectorXd& natural_optimum, double percent) {
-  if (!(percent > 0.0 && percent < 100.0)) {
-    throw InputError("percent", "range narrowing needs 0 < percent < 100, got " + number(percent));
-  }
-  if (natural_optimum.size() != static_cast<Eigen::Index>(factors.size())) {
-    throw InputError("optimum", "one value per factor needed");
-  }
-  std::vector<doe::Factor> out = factors;
-  for (std::size_t i = 0; i < factors.size(); ++i) {
-    const double v = natural_optimum(Eigen::Index(i));
-    if (v == 0.0) {
-      throw InputError("factor " + factors[i].name,
-                       "optimum is 0: a box of +-" + number(percent) + " % around it is empty");
-    }
-    const double a = v * (1.0 - percent / 100.0), b = v * (1.0 + percent / 100.0);
-    out[i].low = std::min(a, b);
-    out[i].high = std::max(a, b);
-    out[i].validate();
-  }
-  return out;
-}
-
-std::vector<NarrowingRound> calibrate_iteratively(
-    std::vector<doe::Factor> box,
-    const std::function<std::vector<MetricTarget>(const std::vector<doe::Factor>&)>& fit_in_box,
-    int rounds, double percent, double shrink, const CalibrationOptions& options) {
-  if (rounds < 1) throw InputError("rounds", "need at least one round");
-  if (!(shrink > 0.0 && shrink <= 1.0)) throw InputError("shrink", "must lie in (0, 1]");
-  std::vector<NarrowingRound> out;
-  for (int r = 0; r < rounds; ++r) {
-    CalibrationProblem problem{box, fit_in_box(box)};
-    NarrowingRound round{box, calibrate(problem, options)};
-    box = narrow_box(box, round.result.natural, percent * std::pow(shrink, r));
-    out.push_back(std::move(round));
-  }
+  out.intervals = parameter_intervals(problem, out.coded, options.seed);
   return out;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Calibration against measured metrics with fitted response models (seed 000 §2.5.2 "with
-// these equations an optimisation of input parameters shall be done"; §3.3 for the range
-// narrowing). The objective is the weighted mean squared relative error
+// these equations an optimisation of input parameters shall be done"; the range narrowing of
+// §3.3 is the sequential loop's second stage, sequential.hpp). The objective is the weighted mean
+// squared relative error
 //   J(x) = sum_m w_m ((yhat_m(x) - t_m) / |t_m|)^2 / sum_m w_m ,
 // where a metric given with an uncertainty s_m uses w_m = (t_m / s_m)^2, so that its term is
 // ((yhat_m - t_m) / s_m)^2. J is minimised over the factor box in coded units by Nelder-Mead
@@ -10,10 +11,12 @@
 #include <Eigen/Dense>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/calib/gaussian_process.hpp"
 #include "core/doe/factor.hpp"
 #include "core/doe/model_fit.hpp"
 
@@ -25,7 +28,20 @@ struct MetricTarget {
   double target = 0.0;
   double weight = 1.0;
   std::optional<double> uncertainty;
+  double noise_sd = 0.0;  ///< run-to-run noise of the simulated metric; 0 = none known
+  /// When set, the surrogate in place of `model`: a Gaussian process over the same coded box.
+  std::shared_ptr<const GaussianProcess> gp;
 };
+
+/// The surrogate's prediction at a coded point (the GP's mean, else the polynomial).
+double predict(const MetricTarget& metric, const Eigen::VectorXd& coded);
+/// Its variance there: the GP's, 0 for a polynomial.
+double predictive_variance(const MetricTarget& metric, const Eigen::VectorXd& coded);
+
+/// How far a simulated value may lie from the target and still match it: the measurement's
+/// uncertainty and the simulation's noise combined as independent errors,
+/// sqrt(uncertainty^2 + noise_sd^2); 0 when neither is known.
+double tolerance(const MetricTarget& metric);
 
 struct CalibrationProblem {
   std::vector<doe::Factor> factors;
@@ -55,44 +71,54 @@ struct MetricOutcome {
   double target = 0.0;
   double predicted = 0.0;
   double relative_error = 0.0;  ///< (predicted - target) / |target|
+  double tolerance = 0.0;       ///< see tolerance(MetricTarget)
   Envelope envelope;
   bool reachable = true;
-  std::string statement;  ///< plain words: within reach, or above/below what the box reaches
+  /// Plain words: within reach, or above/below what the box reaches by more than the tolerance.
+  std::string statement;
 };
+
+/// Which values of a factor the surrogates predict to match every target: over a seeded sample
+/// of the box, the points where each metric's |prediction - target| <= sqrt(tolerance^2 +
+/// predictive variance), and their smallest and largest value of the factor.
+struct ParameterInterval {
+  std::string name;
+  bool available = false;        ///< false: some metric has no tolerance, or no point matches
+  double low = 0.0, high = 0.0;  ///< natural units
+  double fraction = 1.0;         ///< of the factor's coded range
+  bool pinned = false;           ///< fraction <= kPinnedFraction
+  std::string statement;         ///< plain words, a warning when not pinned
+};
+/// A factor whose matching values span more than this fraction of its range is not pinned.
+constexpr double kPinnedFraction = 0.5;
 
 struct CalibrationResult {
   Eigen::VectorXd coded;
   Eigen::VectorXd natural;
   double objective = 0.0;
   std::vector<MetricOutcome> metrics;
+  std::vector<ParameterInterval> intervals;  ///< one per factor
 };
+
+/// A number as the calibration's statements print it (6 significant digits).
+std::string statement_number(double v);
+
+/// The objective J for given values of the metrics (one per metric, in problem order).
+double objective_of(const std::vector<MetricTarget>& metrics, const Eigen::VectorXd& values);
 
 /// A metric's weight in the objective: (target / uncertainty)^2 when an uncertainty is given,
 /// else its weight; its term is that weight times the squared relative error.
 double effective_weight(const MetricTarget& metric);
+
+/// Minimises f over the coded box [-1, 1]^k by Nelder-Mead on the box-projected point, from the
+/// centre and from a seeded maximin Latin hypercube of options.starts - 1 more points.
+Eigen::VectorXd minimise_in_box(const std::function<double(const Eigen::VectorXd&)>& f, int k,
+                                const CalibrationOptions& options);
 
 /// Checks the problem (names the offending metric or factor) and solves it.
 CalibrationResult calibrate(const CalibrationProblem& problem, const CalibrationOptions& options);
 
 /// Envelope of one model over the box; `options` seeds the search for models with squares.
 Envelope reachable_envelope(const doe::ModelFit& model, const CalibrationOptions& options);
-
-/// Seed 000 §3.3: a new box of +-percent around the optimum (natural units), per factor.
-std::vector<doe::Factor> narrow_box(const std::vector<doe::Factor>& factors,
-                                    const Eigen::VectorXd& natural_optimum, double percent);
-
-/// One round of iterative narrowing: the box it used and the calibration found in it.
-struct NarrowingRound {
-  std::vector<doe::Factor> box;
-  CalibrationResult result;
-};
-
-/// Fits new models in each box (the callback runs the designed simulations and fits them),
-/// calibrates, and narrows the box around the optimum, `rounds` times. A box of a fixed
-/// +-x % never gets smaller than x % of the optimum, so round r uses percent * shrink^r.
-std::vector<NarrowingRound> calibrate_iteratively(
-    std::vector<doe::Factor> box,
-    const std::function<std::vector<MetricTarget>(const std::vector<doe::Factor>&)>& fit_in_box,
-    int rounds, double percent, double shrink, const CalibrationOptions& options);
 
 }  // namespace demcal::calib

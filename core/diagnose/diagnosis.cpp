@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/calib/calibration.hpp"
+#include "core/calib/sequential.hpp"
 #include "core/common/error.hpp"
 #include "core/doe/alias_structure.hpp"
 #include "core/doe/analysis.hpp"
@@ -210,33 +211,14 @@ std::vector<calib::MetricTarget> fit_targets(const Problem& p, const Eigen::Matr
   return out;
 }
 
-/// The same terms refitted by weighted least squares on more rows (the design's, then the
-/// verification runs from row `first_verified` on, weighted kVerifiedWeight): the alias
-/// structure stays the design's; the verified runs, near the optimum, pull the fit to be right
-/// where it is used (a trust-region flavour of surrogate correction).
-constexpr double kVerifiedWeight = 10.0;
+/// The same terms refitted on more rows (the design's, then the verification runs from row
+/// `first_verified` on, weighted calib::kVerifiedWeight): the alias structure stays the
+/// design's; the verified runs, near the optimum, pull the fit to be right where it is used.
 void refit(doe::ModelFit& fit, const Eigen::MatrixXd& coded, const Eigen::VectorXd& y,
            Eigen::Index first_verified) {
-  std::vector<Eigen::Index> rows;
-  for (Eigen::Index r = 0; r < y.size(); ++r)
-    if (std::isfinite(y(r))) rows.push_back(r);
-  const auto n = static_cast<Eigen::Index>(rows.size());
-  const auto terms = static_cast<Eigen::Index>(fit.terms.size());
-  Eigen::MatrixXd x(n, terms + 1);
-  Eigen::VectorXd b(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    x(i, 0) = 1.0;
-    for (Eigen::Index t = 0; t < terms; ++t)
-      x(i, t + 1) = fit.term_value(std::size_t(t), coded.row(rows[std::size_t(i)]).transpose());
-    b(i) = y(rows[std::size_t(i)]);
-    if (rows[std::size_t(i)] >= first_verified) {
-      x.row(i) *= std::sqrt(kVerifiedWeight);
-      b(i) *= std::sqrt(kVerifiedWeight);
-    }
-  }
-  const Eigen::VectorXd beta = x.completeOrthogonalDecomposition().solve(b);
-  fit.intercept = beta(0);
-  fit.coefficients = beta.tail(terms);
+  Eigen::VectorXd weights = Eigen::VectorXd::Ones(y.size());
+  weights.tail(y.size() - first_verified).setConstant(calib::kVerifiedWeight);
+  fit = doe::refit(fit, coded, y, weights);
 }
 
 Fitted calibrate_targets(const Problem& p, const std::vector<Factor>& factors,

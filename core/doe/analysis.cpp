@@ -92,6 +92,115 @@ PredictionErrorRow prediction_error(const ModelFit& fit, const Eigen::VectorXd& 
   return row;
 }
 
+/// Order of the highest two-level term of a model: 1 for main (and squares), 2 otherwise.
+int two_level_order(ModelKind kind) {
+  return kind == ModelKind::kMain || kind == ModelKind::kSquares ? 1 : 2;
+}
+
+/// Effects of the two-level runs: the saturated set of contrasts, named by their chains. Lenth's
+/// method uses the model's terms only; the other contrasts (higher-order classes, and 2FI chains
+/// under a main-effects model) are listed as residual, as FrF2/DoE.base leave them to the
+/// residual of lm(y ~ model) and judge only its coefficients.
+void estimate_effects(const Eigen::MatrixXd& coded, const Eigen::VectorXd& y,
+                      const std::vector<int>& two_level_rows, const AnalysisOptions& options,
+                      ResponseAnalysis& out) {
+  FitOptions sat;
+  sat.saturate = true;
+  sat.rows = two_level_rows;
+  const ModelFit contrasts = fit_model(coded, y, ModelKind::kTwoFactor, sat);
+  const int order = two_level_order(options.model);
+  std::vector<double> model_effects;
+  for (std::size_t t = 0; t < contrasts.terms.size(); ++t) {
+    EffectEstimate e{contrasts.terms[t], 2.0 * contrasts.coefficients(Eigen::Index(t))};
+    e.in_model = contrasts.terms[t].order() <= order;
+    if (e.in_model) model_effects.push_back(e.effect);
+    out.effects.push_back(e);
+  }
+  const std::size_t residual = out.effects.size() - model_effects.size();
+  if (model_effects.size() >= 3) {
+    out.lenth = lenth(model_effects, options.alpha);
+    for (auto& e : out.effects) {
+      if (!e.in_model) continue;
+      e.active = std::abs(e.effect) > out.lenth->me;
+      e.active_simultaneous = std::abs(e.effect) > out.lenth->sme;
+    }
+    out.notes.push_back(
+        "Lenth (1989) on the " + std::to_string(model_effects.size()) + " terms of the '" +
+        to_string(options.model) + "' model" +
+        (residual ? " (" + std::to_string(residual) + " contrast(s) outside it listed as residual)"
+                  : "") +
+        "; ME and SME use Student t quantiles with m/3 = " + format(out.lenth->degrees_of_freedom) +
+        " degrees of freedom, computed by demcal (incomplete beta), not "
+        "read from a table");
+    if (!out.balance.balanced()) {
+      out.notes.push_back(
+          "with runs missing the contrasts are correlated; Lenth's method "
+          "assumes independent contrasts of equal variance");
+    }
+  } else {
+    out.notes.push_back("fewer than 3 model terms among the contrasts: no Lenth test");
+  }
+  std::vector<std::pair<double, std::string>> sorted;
+  for (const auto& e : out.effects)
+    if (e.in_model) sorted.emplace_back(std::abs(e.effect), e.term.name());
+  std::sort(sorted.begin(), sorted.end());
+  const double m = static_cast<double>(sorted.size());
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    out.half_normal.push_back({sorted[i].second, sorted[i].first,
+                               normal_quantile(0.5 + 0.5 * (static_cast<double>(i) + 0.5) / m)});
+  }
+  if (!options.factors.empty()) {
+    std::vector<ModelTerm> low_order;
+    for (const auto& e : out.effects) {
+      if (!e.term.squared && e.term.order() <= 2) low_order.push_back(e.term);
+    }
+    out.seed = seed_equation(coded, y, low_order, options.factors);
+  }
+}
+
+/// Pure error when runs are repeated and differ; else the sigma behind Lenth's PSE: an effect is a
+/// difference of two means of nf/2 runs, so its sd is 2 sigma / sqrt(nf).
+NoiseEstimate noise_estimate(double ss_pe, double df_pe, const std::optional<LenthResult>& lenth,
+                             int factorial_runs) {
+  NoiseEstimate n;
+  // Repeated runs that agree exactly (a pinned seed) say nothing about the noise.
+  if (df_pe > 0.0 && ss_pe > 0.0) {
+    n.sd = std::sqrt(ss_pe / df_pe);
+    n.degrees_of_freedom = df_pe;
+    n.source = "pure error (" + format(df_pe) + " df)";
+  } else if (lenth && lenth->pse > 0.0 && factorial_runs > 0) {
+    n.sd = lenth->pse * std::sqrt(static_cast<double>(factorial_runs)) / 2.0;
+    n.degrees_of_freedom = lenth->degrees_of_freedom;
+    n.source = "Lenth PSE (" + format(n.degrees_of_freedom) + " df; " +
+               (df_pe > 0.0 ? "repeated runs identical: pinned seeds?)" : "no repeated runs)");
+  } else {
+    n.source = "none (no repeated runs and no Lenth PSE)";
+  }
+  return n;
+}
+
+/// Factorial mean against centre mean (Montgomery 2017, sec. 6.8), with the noise as error.
+CurvatureTest curvature_test(const Eigen::VectorXd& y, const std::vector<int>& two_level_rows,
+                             const std::vector<int>& centre_rows, const NoiseEstimate& noise,
+                             double alpha) {
+  CurvatureTest cur;
+  cur.factorial_runs = static_cast<int>(two_level_rows.size());
+  cur.centre_runs = static_cast<int>(centre_rows.size());
+  for (const int r : two_level_rows) cur.factorial_mean += y(r) / cur.factorial_runs;
+  for (const int r : centre_rows) cur.centre_mean += y(r) / cur.centre_runs;
+  cur.difference = cur.factorial_mean - cur.centre_mean;
+  const double nf = cur.factorial_runs, nc = cur.centre_runs;
+  cur.sum_of_squares = nf * nc * cur.difference * cur.difference / (nf + nc);
+  cur.error_source = noise.source;
+  if (!noise.available() || !(noise.sd > 0.0)) return cur;
+  cur.degrees_of_freedom = noise.degrees_of_freedom;
+  cur.available = true;
+  cur.t = cur.difference / (noise.sd * std::sqrt(1.0 / nf + 1.0 / nc));
+  cur.p_value = 2.0 * (1.0 - student_t_cdf(std::abs(cur.t), cur.degrees_of_freedom));
+  cur.significant = cur.p_value < alpha;
+  return cur;
+}
+
 }  // namespace
 
 ResponseAnalysis analyse_response(const Eigen::MatrixXd& coded, const Eigen::VectorXd& y,
@@ -156,84 +265,17 @@ ResponseAnalysis analyse_response(const Eigen::MatrixXd& coded, const Eigen::Vec
     }
   }
 
-  // Effects of the two-level runs: the saturated set of contrasts, named by their chains.
   if (two_level_rows.size() >= 4) {
-    FitOptions sat;
-    sat.saturate = true;
-    sat.rows = two_level_rows;
-    const ModelFit contrasts = fit_model(coded, y, ModelKind::kTwoFactor, sat);
-    std::vector<double> values;
-    for (std::size_t t = 0; t < contrasts.terms.size(); ++t) {
-      values.push_back(2.0 * contrasts.coefficients(Eigen::Index(t)));
-      out.effects.push_back({contrasts.terms[t], values.back(), false, false});
-    }
-    if (values.size() >= 3) {
-      out.lenth = lenth(values, options.alpha);
-      for (auto& e : out.effects) {
-        e.active = std::abs(e.effect) > out.lenth->me;
-        e.active_simultaneous = std::abs(e.effect) > out.lenth->sme;
-      }
-      out.notes.push_back("Lenth (1989) ME and SME use Student t quantiles with m/3 = " +
-                          format(out.lenth->degrees_of_freedom) +
-                          " degrees of freedom, computed by demcal (incomplete beta), not "
-                          "read from a table");
-      if (!bal.balanced()) {
-        out.notes.push_back(
-            "with runs missing the contrasts are correlated; Lenth's method "
-            "assumes independent contrasts of equal variance");
-      }
-      std::vector<std::pair<double, std::string>> sorted;
-      for (const auto& e : out.effects) sorted.emplace_back(std::abs(e.effect), e.term.name());
-      std::sort(sorted.begin(), sorted.end());
-      const double m = static_cast<double>(sorted.size());
-      for (std::size_t i = 0; i < sorted.size(); ++i) {
-        out.half_normal.push_back(
-            {sorted[i].second, sorted[i].first,
-             normal_quantile(0.5 + 0.5 * (static_cast<double>(i) + 0.5) / m)});
-      }
-    }
-    if (!options.factors.empty()) {
-      std::vector<ModelTerm> low_order;
-      for (const auto& e : out.effects) {
-        if (!e.term.squared && e.term.order() <= 2) low_order.push_back(e.term);
-      }
-      out.seed = seed_equation(coded, y, low_order, options.factors);
-    }
+    estimate_effects(coded, y, two_level_rows, options, out);
   } else {
     out.notes.push_back("fewer than 4 two-level runs: no effects or Lenth test");
   }
 
-  // Curvature: factorial mean against centre mean (Montgomery 2017, sec. 6.8).
   const auto [ss_pe, df_pe] = pure_error(coded, y, out.fit.rows_used);
   out.pure_error_df = df_pe;
-  CurvatureTest& cur = out.curvature;
+  out.noise = noise_estimate(ss_pe, df_pe, out.lenth, static_cast<int>(two_level_rows.size()));
   if (!centre_rows.empty() && two_level_rows.size() >= 2) {
-    cur.factorial_runs = static_cast<int>(two_level_rows.size());
-    cur.centre_runs = static_cast<int>(centre_rows.size());
-    for (const int r : two_level_rows) cur.factorial_mean += y(r) / cur.factorial_runs;
-    for (const int r : centre_rows) cur.centre_mean += y(r) / cur.centre_runs;
-    cur.difference = cur.factorial_mean - cur.centre_mean;
-    const double nf = cur.factorial_runs, nc = cur.centre_runs;
-    cur.sum_of_squares = nf * nc * cur.difference * cur.difference / (nf + nc);
-    double s2 = 0.0;
-    if (df_pe > 0.0) {
-      s2 = ss_pe / df_pe;
-      cur.degrees_of_freedom = df_pe;
-      cur.error_source = "pure error (" + format(df_pe) + " df)";
-    } else if (out.lenth && out.lenth->pse > 0.0) {
-      // An effect is a difference of two means of nf/2 runs: sd = 2 sigma / sqrt(nf).
-      const double sigma = out.lenth->pse * std::sqrt(nf) / 2.0;
-      s2 = sigma * sigma;
-      cur.degrees_of_freedom = out.lenth->degrees_of_freedom;
-      cur.error_source =
-          "Lenth PSE (" + format(cur.degrees_of_freedom) + " df; no replicated runs)";
-    }
-    if (s2 > 0.0) {
-      cur.available = true;
-      cur.t = cur.difference / std::sqrt(s2 * (1.0 / nf + 1.0 / nc));
-      cur.p_value = 2.0 * (1.0 - student_t_cdf(std::abs(cur.t), cur.degrees_of_freedom));
-      cur.significant = cur.p_value < options.alpha;
-    }
+    out.curvature = curvature_test(y, two_level_rows, centre_rows, out.noise, options.alpha);
   }
 
   // ANOVA with sequential sums of squares (equal to the partial ones on an orthogonal design).

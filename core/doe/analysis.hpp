@@ -32,9 +32,20 @@ struct BalanceReport {
 
 struct EffectEstimate {
   ModelTerm term;
-  double effect = 0.0;               ///< difference of level means = 2 x coded coefficient
+  double effect = 0.0;  ///< difference of level means = 2 x coded coefficient
+  /// A term of the analysed model (main: main effects; 2fi, quadratic: mains and 2FI chains).
+  /// Contrasts outside the model are residual: listed, not in Lenth's PSE, never flagged.
+  bool in_model = true;
   bool active = false;               ///< |effect| > ME
   bool active_simultaneous = false;  ///< |effect| > SME
+};
+
+/// The run-to-run noise of a response: a standard deviation with its degrees of freedom.
+struct NoiseEstimate {
+  double sd = 0.0;
+  double degrees_of_freedom = 0.0;  ///< 0: no estimate
+  std::string source;               ///< "pure error (n df)", "Lenth PSE (m/3 df)" or "none"
+  bool available() const { return degrees_of_freedom > 0.0; }
 };
 
 struct HalfNormalPoint {
@@ -72,6 +83,8 @@ struct ResponseAnalysis {
   double alpha = 0.05;
   BalanceReport balance;
   std::vector<EffectEstimate> effects;  ///< empty without two-level runs
+  /// Lenth's method on the effects of the model's terms only (m = their number), as FrF2's
+  /// DanielPlot and DoE.base's halfnormal do on the coefficients of the fitted lm.
   std::optional<LenthResult> lenth;
   std::vector<HalfNormalPoint> half_normal;
   std::optional<SeedEquation> seed;  ///< when natural ranges are known and runs are two-level
@@ -79,6 +92,8 @@ struct ResponseAnalysis {
   CurvatureTest curvature;
   std::vector<AnovaRow> anova;  ///< empty when there are no error degrees of freedom
   double pure_error_df = 0.0;
+  /// From pure error when runs are repeated (centre points, replicates), else from Lenth's PSE.
+  NoiseEstimate noise;
   std::vector<PredictionErrorRow> prediction_errors;
   std::vector<std::string> notes;
 };

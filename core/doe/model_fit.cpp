@@ -86,6 +86,19 @@ int distinct_rows(const Eigen::MatrixXd& x) {
   return static_cast<int>(std::unique(rows.begin(), rows.end()) - rows.begin());
 }
 
+/// Coefficients (intercept first) and what follows from them on the fitted rows.
+void set_solution(ModelFit& fit, const Eigen::MatrixXd& design, const Eigen::VectorXd& beta,
+                  const Eigen::VectorXd& y) {
+  fit.intercept = beta(0);
+  fit.coefficients = beta.tail(beta.size() - 1);
+  fit.fitted = design * beta;
+  fit.residuals = y - fit.fitted;
+  fit.sse = fit.residuals.squaredNorm();
+  fit.sst = (y.array() - y.mean()).matrix().squaredNorm();
+  fit.residual_df = static_cast<int>(design.rows() - design.cols());
+  fit.r_squared = fit.sst > 0.0 ? 1.0 - fit.sse / fit.sst : 1.0;
+}
+
 std::string candidate_name(const Candidate& c) {
   return word_name(c.word) + (c.squared ? "^2" : "");
 }
@@ -201,14 +214,7 @@ ModelFit fit_model(const Eigen::MatrixXd& coded, const Eigen::VectorXd& response
   design.rightCols(p - 1) = columns;
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(design);
   const Eigen::VectorXd beta = qr.solve(y);
-  fit.intercept = beta(0);
-  fit.coefficients = beta.tail(p - 1);
-  fit.fitted = design * beta;
-  fit.residuals = y - fit.fitted;
-  fit.sse = fit.residuals.squaredNorm();
-  fit.sst = (y.array() - y.mean()).matrix().squaredNorm();
-  fit.residual_df = static_cast<int>(n - p);
-  fit.r_squared = fit.sst > 0.0 ? 1.0 - fit.sse / fit.sst : 1.0;
+  set_solution(fit, design, beta, y);
   fit.adj_r_squared = fit.residual_df > 0 && fit.sst > 0.0
                           ? 1.0 - (fit.sse / fit.residual_df) / (fit.sst / double(n - 1))
                           : std::nan("");
@@ -234,6 +240,42 @@ ModelFit fit_model(const Eigen::MatrixXd& coded, const Eigen::VectorXd& response
         Eigen::MatrixXd::Identity(p, p));
     fit.standard_errors = (r_inv.rowwise().squaredNorm().tail(p - 1) * s2).array().sqrt().matrix();
   }
+  return fit;
+}
+
+ModelFit refit(const ModelFit& structure, const Eigen::MatrixXd& coded,
+               const Eigen::VectorXd& response, const Eigen::VectorXd& weights) {
+  if (coded.rows() != response.size() || coded.cols() != structure.factor_count ||
+      (weights.size() != 0 && weights.size() != response.size())) {
+    throw InputError("response", "refit needs one value (and weight) per row and " +
+                                     std::to_string(structure.factor_count) + " columns");
+  }
+  ModelFit fit = structure;
+  fit.rows_used.clear();
+  for (Eigen::Index r = 0; r < coded.rows(); ++r) {
+    if (std::isfinite(response(r))) fit.rows_used.push_back(static_cast<int>(r));
+  }
+  const auto n = static_cast<Eigen::Index>(fit.rows_used.size());
+  const auto p = static_cast<Eigen::Index>(structure.terms.size()) + 1;
+  if (n < 1) throw InputError("response", "no finite response to refit on");
+  Eigen::MatrixXd design(n, p);
+  Eigen::VectorXd y(n), sqrt_w(n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const int row = fit.rows_used[std::size_t(r)];
+    const Eigen::VectorXd x = coded.row(row).transpose();
+    design(r, 0) = 1.0;
+    for (Eigen::Index t = 1; t < p; ++t) design(r, t) = structure.term_value(std::size_t(t - 1), x);
+    y(r) = response(row);
+    sqrt_w(r) = weights.size() ? std::sqrt(weights(row)) : 1.0;
+  }
+  const Eigen::VectorXd beta = (sqrt_w.asDiagonal() * design)
+                                   .completeOrthogonalDecomposition()
+                                   .solve(sqrt_w.asDiagonal() * y);
+  set_solution(fit, design, beta, y);
+  // Leverage, leave-one-out and standard errors describe the design fit only.
+  fit.standard_errors.resize(0);
+  fit.leverage.resize(0);
+  fit.loo_residuals.clear();
   return fit;
 }
 

@@ -71,4 +71,13 @@ struct FitOptions {
 ModelFit fit_model(const Eigen::MatrixXd& coded, const Eigen::VectorXd& response, ModelKind kind,
                    const FitOptions& options = {});
 
+/// Refits the terms of `structure` (chosen on its design) on other rows, e.g. the design plus
+/// verification runs: the regressors are the chain means predict() uses, so points off the
+/// design inform the same model instead of splitting its alias chains. Row r weighs
+/// `weights(r)` in the least squares (empty = all 1); the minimum-norm solution is taken when
+/// the rows do not determine every coefficient. Sets the intercept, coefficients, rows_used,
+/// fitted values, residuals, sse, sst, residual_df and R^2; NaN marks a missing response.
+ModelFit refit(const ModelFit& structure, const Eigen::MatrixXd& coded,
+               const Eigen::VectorXd& response, const Eigen::VectorXd& weights = {});
+
 }  // namespace demcal::doe

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 
 #include "core/calib/calibration.hpp"
 #include "core/common/error.hpp"
@@ -119,33 +118,42 @@ TEST(Calibration, InvalidProblemsNameTheField) {
   EXPECT_THROW(calibrate(wrong, {}), InputError);
 }
 
-TEST(Calibration, NarrowingBoxesAroundTheOptimum) {
-  const std::vector<doe::Factor> box = narrow_box(kBox, Eigen::Vector3d(0.5, 1e8, 0.1), 33.0);
-  EXPECT_NEAR(box[0].low, 0.335, 1e-12);
-  EXPECT_NEAR(box[0].high, 0.665, 1e-12);
-  EXPECT_NEAR(box[1].high, 1.33e8, 1e-3);
-  EXPECT_THROW(narrow_box(kBox, Eigen::Vector3d(0.0, 1e8, 0.1), 33.0), InputError);
+}  // namespace
+}  // namespace demcal::calib
 
-  // A response that is not polynomial: each narrowed box fits the 2FI model better and the
-  // calibrated parameters close in on the truth (seed 000 §3.3).
-  const Eigen::Vector2d truth(0.45, 0.12);
-  const auto f1 = [](const Eigen::VectorXd& n) { return std::exp(2.0 * n(0)) + n(1); };
-  const auto f2 = [](const Eigen::VectorXd& n) { return std::sqrt(n(1)) * (1.0 + n(0)); };
-  const std::vector<doe::Factor> start{{"x", 0.1, 1.0}, {"y", 0.02, 0.4}};
-  const auto fit = [&](const std::vector<doe::Factor>& b) {
-    return std::vector<MetricTarget>{
-        {"m1", fit_on_box(f1, b, doe::ModelKind::kTwoFactor), f1(truth), 1.0, std::nullopt},
-        {"m2", fit_on_box(f2, b, doe::ModelKind::kTwoFactor), f2(truth), 1.0, std::nullopt}};
-  };
-  const auto rounds = calibrate_iteratively(start, fit, 4, 30.0, 0.5, {});
-  ASSERT_EQ(rounds.size(), 4u);
-  std::vector<double> errors;
-  for (const auto& r : rounds)
-    errors.push_back((r.result.natural - truth).cwiseQuotient(truth).norm());
-  for (double e : errors) std::printf("narrowing round: relative parameter error %.5f\n", e);
-  EXPECT_GT(errors.front(), 0.02);
-  EXPECT_LT(errors.back(), 0.2 * errors.front());
-  EXPECT_LT(errors.back(), 0.005);
+namespace demcal::calib {
+namespace {
+
+TEST(Calibration, IntervalsPinWhatTheDataDecidesAndWarnAboutTheRest) {
+  // One metric that depends on A only: A is pinned to a narrow interval around its solution,
+  // B is not pinned and the statement says so.
+  const std::vector<doe::Factor> box{{"A", 0.0, 1.0, doe::Scale::kLinear},
+                                     {"B", 0.0, 1.0, doe::Scale::kLinear}};
+  const doe::Design d = doe::full_factorial(2);
+  Eigen::VectorXd y(d.runs());
+  for (int r = 0; r < d.runs(); ++r) y(r) = 10.0 + 4.0 * d.coded(r, 0);
+  CalibrationProblem p{box, {}};
+  MetricTarget m;
+  m.name = "m";
+  m.model = doe::fit_model(d.coded, y, doe::ModelKind::kMain);
+  m.target = 11.0;  // A coded 0.25, natural 0.625
+  m.uncertainty = 0.2;
+  p.metrics.push_back(m);
+  const CalibrationResult r = calibrate(p, {});
+  ASSERT_EQ(r.intervals.size(), 2u);
+  const auto& a = r.intervals[0];
+  ASSERT_TRUE(a.available) << a.statement;
+  EXPECT_TRUE(a.pinned);
+  EXPECT_NEAR(a.low, 0.625 - 0.025, 0.005);  // |4 x - 1| <= 0.2 in coded units
+  EXPECT_NEAR(a.high, 0.625 + 0.025, 0.005);
+  const auto& b = r.intervals[1];
+  EXPECT_FALSE(b.pinned);
+  EXPECT_NE(b.statement.find("B is not pinned by the data"), std::string::npos) << b.statement;
+  // Without an uncertainty or noise there is no tolerance to judge by, and it says so.
+  p.metrics[0].uncertainty.reset();
+  const CalibrationResult none = calibrate(p, {});
+  EXPECT_FALSE(none.intervals[0].available);
+  EXPECT_NE(none.intervals[0].statement.find("no uncertainty or noise"), std::string::npos);
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "core/common/error.hpp"
 #include "core/common/rng.hpp"
@@ -40,6 +42,67 @@ TEST(Lenth, PseOfAKnownSet) {
   effects.push_back(100.0);
   const LenthResult r = lenth(effects, 0.05);
   EXPECT_DOUBLE_EQ(r.pse, 1.5 * 8.0);
+}
+
+/// Reads a CSV of numbers with a header line; one vector per row.
+std::vector<std::vector<double>> read_numbers(const std::string& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in) << path;
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::stringstream s(line);
+    std::vector<double> row;
+    for (std::string cell; std::getline(s, cell, ',');) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST(Lenth, EqualsFrF2OnTheOracleDesignForTheMainAndTheTwoFactorModel) {
+  // tests/data/lenth-oracle: the FrF2 8-3.1 design, a fixed response, and Lenth's numbers as
+  // FrF2/DoE.base compute them on the non-NA coefficients of lm(y ~ model) (lenth_oracle.py).
+  // The 2FI model has 8 mains + 13 clear 2FIs + 7 chains = 28 terms; the 3 contrasts aliased
+  // only with 3FIs are residual. The main-effects model has 8 terms and 23 residual contrasts.
+  const std::string dir = std::string(DEMCAL_SOURCE_DIR) + "/tests/data/";
+  const auto design = read_numbers(dir + "doe-oracle/frf2_32run_8fac_design_standard_order.csv");
+  const auto response = read_numbers(dir + "lenth-oracle/response.csv");
+  ASSERT_EQ(design.size(), 32u);
+  ASSERT_EQ(response.size(), 32u);
+  Eigen::MatrixXd coded(32, 8);
+  Eigen::VectorXd y(32);
+  for (int r = 0; r < 32; ++r) {
+    for (int c = 0; c < 8; ++c) coded(r, c) = design[std::size_t(r)][std::size_t(c)];
+    y(r) = response[std::size_t(r)][0];
+  }
+  struct Expected {
+    ModelKind model;
+    int m;
+    double pse, me, sme;
+  };
+  // expected.txt, written by lenth_oracle.py.
+  for (const Expected& x :
+       {Expected{ModelKind::kMain, 8, 0.00372773371875, 0.0127479907823, 0.0294154949595},
+        Expected{ModelKind::kTwoFactor, 28, 0.0477776804062, 0.107495069172, 0.205443745674}}) {
+    AnalysisOptions opt;
+    opt.model = x.model;
+    const ResponseAnalysis res = analyse_response(coded, y, opt);
+    ASSERT_TRUE(res.lenth) << to_string(x.model);
+    EXPECT_EQ(res.lenth->contrasts, x.m);
+    EXPECT_NEAR(res.lenth->pse, x.pse, 1e-10);
+    EXPECT_NEAR(res.lenth->me, x.me, 1e-8);
+    EXPECT_NEAR(res.lenth->sme, x.sme, 1e-8);
+    EXPECT_EQ(res.effects.size(), 31u);
+    int residual = 0;
+    for (const auto& e : res.effects) {
+      if (e.in_model) continue;
+      ++residual;
+      EXPECT_FALSE(e.active || e.active_simultaneous) << e.term.name();
+    }
+    EXPECT_EQ(residual, 31 - x.m);
+    EXPECT_EQ(res.half_normal.size(), std::size_t(x.m));
+  }
 }
 
 TEST(SeedEquation, EffectsAndNaturalConstantsOfAKnownResponse) {
@@ -166,6 +229,35 @@ TEST(Analysis, CurvatureAnovaAndPureErrorOnAReplicatedDesign) {
   }
   EXPECT_TRUE(has_curvature);
   EXPECT_TRUE(has_pure);
+}
+
+TEST(Analysis, NoiseFromCentrePointsAndTheCurvatureTestAgainstIt) {
+  // A 2^3 with 4 centre points, each run with its own noise: the noise is the centre points'
+  // standard deviation with 3 df, and a bowl-shaped response shows significant curvature.
+  Design d = full_factorial(3);
+  add_centre_points(d, 4);
+  const double centre_noise[] = {0.1, -0.05, 0.02, -0.07};
+  Eigen::VectorXd y(d.runs());
+  for (int r = 0; r < d.runs(); ++r) {
+    const Eigen::RowVectorXd x = d.coded.row(r);
+    y(r) = 5.0 + x(0) + 2.0 * x(1) * x(1) + (r >= 8 ? centre_noise[r - 8] : 0.01 * (r % 3));
+  }
+  const ResponseAnalysis res = analyse_response(d.coded, y, {});
+  double mean = 0.0, ss = 0.0;
+  for (const double e : centre_noise) mean += e / 4.0;
+  for (const double e : centre_noise) ss += (e - mean) * (e - mean);
+  ASSERT_TRUE(res.noise.available());
+  EXPECT_DOUBLE_EQ(res.noise.degrees_of_freedom, 3.0);
+  EXPECT_NEAR(res.noise.sd, std::sqrt(ss / 3.0), 1e-12);
+  EXPECT_NE(res.noise.source.find("pure error"), std::string::npos);
+  ASSERT_TRUE(res.curvature.available);
+  EXPECT_NEAR(res.curvature.difference, 2.0, 0.1);
+  EXPECT_DOUBLE_EQ(res.curvature.degrees_of_freedom, 3.0);
+  EXPECT_TRUE(res.curvature.significant);
+  // Identical centre points (one seed for all) leave no pure error: the Lenth fallback is used.
+  for (int r = 8; r < d.runs(); ++r) y(r) = 7.0;
+  const ResponseAnalysis same = analyse_response(d.coded, y, {});
+  EXPECT_NE(same.noise.source.find("Lenth"), std::string::npos) << same.noise.source;
 }
 
 TEST(Analysis, PredictionErrorTableDropsWithInteractions) {

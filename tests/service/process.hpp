@@ -18,12 +18,16 @@ namespace demcal::test {
 
 class Process {
  public:
-  Process(std::vector<std::string> argv, const std::string& log) : log_(log) {
+  /// Standard output and error go to `log`, or error to `error_log` when one is given (to read
+  /// a command's standard output alone).
+  Process(std::vector<std::string> argv, const std::string& log, const std::string& error_log = "")
+      : log_(log) {
     pid_ = fork();
     if (pid_ == 0) {
       const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
       dup2(fd, 1);
-      dup2(fd, 2);
+      dup2(error_log.empty() ? fd : open(error_log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644),
+           2);
       std::vector<char*> args;
       for (auto& a : argv) args.push_back(a.data());
       args.push_back(nullptr);

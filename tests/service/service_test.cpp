@@ -25,8 +25,10 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kToken = "test-token-123";
 
-/// A packing campaign of 2^2 runs (+ centre points) at `particles` particles.
-std::string tiny_spec(int particles, int centre = 0, const std::string& extra_factor = "") {
+/// A packing campaign of 2^2 runs (+ centre points) at `particles` particles; by default its
+/// calibration verifies one round only.
+std::string tiny_spec(int particles, int centre = 0, const std::string& extra_factor = "",
+                      const std::string& calibration = "calibration: {rounds: 1, stages: 1}\n") {
   return R"(
 name: tiny
 material:
@@ -46,7 +48,7 @@ factors:
          R"(design: {type: full_factorial, centre_points: )" + std::to_string(centre) + R"(}
 measurements:
   - {metric: solid_fraction, value: 0.6, uncertainty: 0.02}
-)";
+)" + calibration;
 }
 
 class Service : public ::testing::Test {
@@ -203,12 +205,27 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
          return s;
        }(),
        "spec.tests[0].settings.particles"},
+      {tiny_spec(30, 0, "", "calibration: {narrow: 1.5}\n"), "spec.calibration.narrow"},
+      {tiny_spec(30, 0, "", "calibration: {model: quadratic}\n"), "spec.calibration.model"},
+      {tiny_spec(30, 0, "", "calibration: {surrogate: kriging}\n"), "spec.calibration.surrogate"},
+      {tiny_spec(30, 0, "", "calibration: {batch: -1}\n"), "spec.calibration.batch"},
   };
   for (const auto& c : cases) {
     const auto s = submit(c.yaml);
     EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << c.field;
     EXPECT_NE(s.error_message().find(c.field), std::string::npos)
         << c.field << " not in: " << s.error_message();
+  }
+  // A NaN the YAML reader would refuse, sent straight over gRPC, is refused by the coordinator.
+  {
+    v1::SubmitRequest req;
+    *req.mutable_spec() = cli::parse_campaign_spec(tiny_spec(30), "spec.yaml").spec;
+    req.mutable_spec()->mutable_measurements(0)->set_uncertainty(std::nan(""));
+    v1::SubmitReply reply;
+    const auto s = campaigns_->Submit(ctx().get(), req, &reply);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(s.error_message().find("spec.measurements[0].uncertainty"), std::string::npos)
+        << s.error_message();
   }
   // Mistakes the JSON parser catches name the field and the YAML line before anything is sent.
   std::string typo = tiny_spec(30);
@@ -399,7 +416,10 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
   EXPECT_NE(out.find("== packing.solid_fraction (5 of 5 runs) =="), std::string::npos) << out;
   EXPECT_NE(out.find("alias chain"), std::string::npos);
   EXPECT_NE(out.find("proposed parameter set"), std::string::npos);
-  EXPECT_NE(out.find("verification: done (1 jobs)"), std::string::npos) << out;
+  EXPECT_NE(out.find("verification: done, 1 simulation(s) added by the calibration"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("round 1 (stage 1, batch 1): done"), std::string::npos) << out;
   // Both local workers ran jobs side by side (--workers 2), by the jobs table of the file.
   std::map<std::string, int> jobs_by_worker;
   each_row(path("work/campaign.db"), "SELECT worker, COUNT(*) FROM jobs GROUP BY worker",
@@ -420,6 +440,16 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
     ++with_cost;
   });
   EXPECT_EQ(with_cost, 6);
+  // Run again with --format json: the campaign resumes, and standard output is one JSON
+  // document (design, effects, calibration); progress went to standard error.
+  Process again({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--format", "json"},
+                path("again.json"), path("again.err"));
+  ASSERT_EQ(again.wait_exit(120), 0) << again.log();
+  const auto doc = nlohmann::json::parse(again.log());
+  EXPECT_EQ(doc.at("design").at("runs"), 5);
+  EXPECT_EQ(doc.at("effects").at("metrics").size(), 2u);
+  EXPECT_EQ(doc.at("calibration").at("rounds").size(), 1u);
+  EXPECT_EQ(doc.at("calibration").at("simulations"), 1);
   // A bad spec is refused before anything runs, naming the file, line and field.
   std::string bad = tiny_spec(60);
   bad.replace(bad.find("density: 2500"), 13, "densty: 2500");
@@ -428,6 +458,115 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
                   path("bad.log"));
   EXPECT_EQ(refused.wait_exit(30), 2);
   EXPECT_NE(refused.log().find("bad.yaml:8: material.densty"), std::string::npos) << refused.log();
+}
+
+/// Runs the CLI against the test's coordinator; returns its standard output parsed as JSON.
+nlohmann::json cli_json(const std::string& dir, const std::string& name,
+                        const std::vector<std::string>& args, const proto::ChannelOptions& ch) {
+  std::vector<std::string> argv{DEMCAL_CLI_BIN};
+  argv.insert(argv.end(), args.begin(), args.end());
+  for (const std::string a : {"--coordinator", ch.address.c_str(), "--token", kToken.c_str()})
+    argv.push_back(a);
+  const std::string out = dir + "/" + name + ".json", err = dir + "/" + name + ".err";
+  Process p(argv, out, err);
+  EXPECT_EQ(p.wait_exit(150), 0) << name << ": " << p.log();
+  try {
+    return nlohmann::json::parse(p.log());
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << name << " did not print one JSON document: " << e.what() << "\n" << p.log();
+    return {};
+  }
+}
+
+TEST_F(Service, CentrePointsDifferCurvatureIsTestedAndTheCalibrationRoundsAreShownAsJson) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(
+      submit(tiny_spec(200, 2, "", "calibration: {rounds: 2, stages: 2, max_jobs: 16}\n"), &id)
+          .ok());
+  start_worker("w");
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 90)) << workers_[0]->log();
+  // The two centre points (design rows 5 and 6) ran with their own seeds and differ.
+  std::map<int, double> centre;
+  std::set<std::uint64_t> seeds;
+  const auto design_results = results(id);
+  for (const auto& j : design_results.jobs()) {
+    if (j.kind() != "design" || j.std_order() < 5) continue;
+    centre[j.std_order()] = j.metrics().at("solid_fraction");
+  }
+  each_row(path("c.db"), "SELECT payload FROM jobs WHERE kind = 'design' AND std_order >= 5",
+           [&](sqlite3_stmt* st) {
+             const auto job =
+                 nlohmann::json::parse(reinterpret_cast<const char*>(sqlite3_column_text(st, 0)));
+             seeds.insert(std::stoull(job.at("seed").get<std::string>()));
+           });
+  ASSERT_EQ(centre.size(), 2u);
+  EXPECT_NE(centre[5], centre[6]);
+  EXPECT_EQ(seeds.size(), 2u);
+
+  const std::string ids = std::to_string(id);
+  const auto effects = cli_json(dir_, "effects", {"effects", ids, "--format", "json"}, channel_);
+  bool found = false;
+  for (const auto& m : effects.at("metrics")) {
+    if (m.at("metric") != "packing.solid_fraction") continue;
+    found = true;
+    EXPECT_TRUE(m.at("curvature_available")) << m.dump();
+    EXPECT_EQ(m.at("noise_df"), 1.0);
+    EXPECT_GT(m.at("noise_sd").get<double>(), 0.0);
+    EXPECT_NE(m.at("noise_source").get<std::string>().find("pure error"), std::string::npos);
+    EXPECT_NE(m.at("curvature_error").get<std::string>().find("pure error"), std::string::npos);
+  }
+  EXPECT_TRUE(found);
+
+  const auto cal = cli_json(dir_, "calibrate",
+                            {"calibrate", ids, "--verify", "--wait", "--format", "json"}, channel_);
+  const auto& rounds = cal.at("rounds");
+  ASSERT_GE(rounds.size(), 1u) << cal.dump();
+  EXPECT_LE(cal.at("simulations").get<int>(), 16);
+  const std::string conclusion = cal.at("conclusion");
+  EXPECT_TRUE(conclusion.rfind("within uncertainty after ", 0) == 0 ||
+              conclusion.rfind("not within uncertainty after ", 0) == 0)
+      << conclusion;
+  EXPECT_EQ(cal.at("verification_state"), "done");
+  if (conclusion.rfind("within", 0) == 0) {
+    // The calibrated set is the verified round that matched, not a newer proposal.
+    EXPECT_EQ(cal.at("proposed_values"), rounds.back().at("proposed_values")) << cal.dump();
+  }
+  EXPECT_GT(cal.at("metrics").at(0).at("tolerance").get<double>(), 0.02);
+
+  const auto status =
+      cli_json(dir_, "status", {"status", ids, "--jobs", "--format", "json"}, channel_);
+  EXPECT_EQ(status.at("calibration_rounds").size(), rounds.size());
+  EXPECT_GE(status.at("jobs").size(), 6u + rounds.size());
+  const auto exported = cli_json(dir_, "export", {"export", ids, "--format", "json"}, channel_);
+  EXPECT_EQ(exported.at("calibration_rounds").size(), rounds.size());
+  const auto diagnosis =
+      cli_json(dir_, "diagnose", {"diagnose", ids, "--no-wait", "--format", "json"}, channel_);
+  EXPECT_TRUE(diagnosis.is_object() && !diagnosis.empty()) << diagnosis.dump();
+}
+
+TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(200, 2, "",
+                               "calibration: {surrogate: gp, batch: 2, rounds: 2, max_jobs: 4}\n"),
+                     &id)
+                  .ok());
+  start_worker("w");
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 90)) << workers_[0]->log();
+  const auto cal = cli_json(
+      dir_, "calibrate",
+      {"calibrate", std::to_string(id), "--verify", "--wait", "--format", "json"}, channel_);
+  EXPECT_EQ(cal.at("surrogate"), "gp");
+  const auto& rounds = cal.at("rounds");
+  ASSERT_FALSE(rounds.empty()) << cal.dump();
+  EXPECT_EQ(rounds.size() % 2, 0u) << "whole batches of two";
+  EXPECT_EQ(rounds.at(0).at("batch"), 1);
+  EXPECT_EQ(rounds.at(1).at("batch"), 1);
+  EXPECT_LE(cal.at("simulations").get<int>(), 4);
+  ASSERT_EQ(cal.at("intervals").size(), 2u);
+  for (const auto& i : cal.at("intervals"))
+    EXPECT_FALSE(i.at("statement").get<std::string>().empty()) << i.dump();
 }
 
 }  // namespace

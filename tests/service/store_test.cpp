@@ -230,7 +230,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 3);
+    EXPECT_EQ(Store::latest_schema_version(), 4);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
@@ -264,8 +264,22 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());  // reopening does not migrate again
-    EXPECT_EQ(s.schema_version(), 3);
+    EXPECT_EQ(s.schema_version(), 4);
     EXPECT_EQ(s.jobs(1).size(), 2u);
+    // Version 4 admits the calibration's stage designs and stores rounds and stages with them.
+    const auto round_jobs = s.add_calibration_round(1, {1, 1, R"({"natural":[0.3]})", 300.0},
+                                                    {{1, 1, "packing", "verify", "{}"}});
+    EXPECT_EQ(round_jobs.size(), 1u);
+    s.add_calibration_stage(1, {2, R"({"box":[]})", 310.0}, {{1, 1, "packing", "stage:2", "{}"}});
+    EXPECT_EQ(s.counts(1, "stage:2").queued, 1);
+    ASSERT_EQ(s.calibration_rounds(1).size(), 1u);
+    EXPECT_EQ(s.calibration_rounds(1)[0].proposal_json, R"({"natural":[0.3]})");
+    ASSERT_EQ(s.calibration_stages(1).size(), 1u);
+    EXPECT_EQ(s.calibration_stages(1)[0].stage, 2);
+    // A round stored twice is refused and leaves no job behind.
+    EXPECT_ANY_THROW(
+        s.add_calibration_round(1, {1, 1, "{}", 320.0}, {{1, 1, "packing", "verify", "{}"}}));
+    EXPECT_EQ(s.jobs(1).size(), 4u);
   }
   std::filesystem::remove(path);
   std::filesystem::remove(path.string() + "-wal");

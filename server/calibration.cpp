@@ -1,0 +1,400 @@
+#include "server/calibration.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string_view>
+
+#include "core/common/error.hpp"
+#include "server/analysis.hpp"
+#include "server/convert.hpp"
+#include "server/plan.hpp"
+#include "server/services.hpp"
+
+namespace demcal::server {
+namespace {
+
+constexpr std::string_view kStagePrefix = "stage:";
+/// Verification seeds start here, apart from every design and stage row's seed.
+constexpr std::uint64_t kVerifySeedOffset = 1'000'000;
+
+/// Everything the calibration of one campaign knows, read from the store.
+struct Loaded {
+  v1::CampaignSpec spec;
+  CampaignPlan plan;
+  std::vector<JobRow> jobs;
+  std::vector<CalibrationRoundRow> round_rows;
+  std::vector<std::string> responses;  ///< the calibrated responses, in target order
+  std::vector<double> noise_df;
+  calib::SequentialState state;
+  calib::SequentialOptions options;
+  bool pending = false;  ///< calibration jobs queued or leased
+};
+
+/// The polynomial models the calibration fits: main or 2fi (two-level designs).
+doe::ModelKind polynomial_model(const std::string& text, const std::string& where) {
+  const doe::ModelKind m = doe::parse_model_kind(text, where);
+  if (m != doe::ModelKind::kMain && m != doe::ModelKind::kTwoFactor)
+    throw InputError(where, "the calibration fits main or 2fi models");
+  return m;
+}
+
+bool is_calibration_job(const JobRow& j) {
+  return (j.kind == "verify" && j.std_order > 0) || j.kind.starts_with(kStagePrefix);
+}
+
+bool is_open(const JobRow& j) {
+  return j.state == "queued" || j.state == "leased";
+}
+
+int column_of(const CampaignPlan& plan, const std::string& response) {
+  for (std::size_t c = 0; c < plan.responses.size(); ++c)
+    if (plan.responses[c] == response) return static_cast<int>(c);
+  throw InputError("spec.measurements", "no response " + response);
+}
+
+/// The simulated values of a round once every job of it has ended (NaN for a failed metric).
+std::optional<Eigen::VectorXd> round_values(const Loaded& l, const std::vector<int>& columns,
+                                            int round) {
+  Eigen::VectorXd v = Eigen::VectorXd::Constant(Eigen::Index(columns.size()), std::nan(""));
+  int seen = 0;
+  for (const auto& j : l.jobs) {
+    if (j.kind != "verify" || j.std_order != round) continue;
+    ++seen;
+    if (is_open(j)) return std::nullopt;
+    if (j.state != "done" || !j.metrics_json) continue;
+    for (const auto& [metric, value] : metrics_from_json(*j.metrics_json))
+      for (std::size_t m = 0; m < columns.size(); ++m)
+        if (l.plan.responses[std::size_t(columns[m])] == j.test + "." + metric)
+          v(Eigen::Index(m)) = value;
+  }
+  if (seen == 0) return std::nullopt;
+  return v;
+}
+
+std::string box_to_json(const std::vector<doe::Factor>& box) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& f : box) j.push_back({{"low", f.low}, {"high", f.high}});
+  return j.dump();
+}
+
+std::vector<doe::Factor> box_from_json(const CampaignPlan& plan, const std::string& text) {
+  const auto j = nlohmann::json::parse(text);
+  std::vector<doe::Factor> box;
+  for (std::size_t i = 0; i < plan.factors.size(); ++i) {
+    doe::Factor f = plan.factors[i].factor;
+    f.low = j.at(i).at("low").get<double>();
+    f.high = j.at(i).at("high").get<double>();
+    box.push_back(f);
+  }
+  return box;
+}
+
+Eigen::VectorXd vector_of(const nlohmann::json& j) {
+  Eigen::VectorXd v(Eigen::Index(j.size()));
+  for (std::size_t i = 0; i < j.size(); ++i)
+    v(Eigen::Index(i)) = j[i].is_number() ? j[i].get<double>() : std::nan("");
+  return v;
+}
+
+calib::StageRuns stage_runs(const Loaded& l, const std::vector<int>& columns,
+                            std::vector<doe::Factor> box, const std::string& kind) {
+  const Eigen::MatrixXd y = response_matrix(l.plan, l.jobs, kind);
+  calib::StageRuns st{std::move(box), l.plan.design.coded,
+                      Eigen::MatrixXd(y.rows(), Eigen::Index(columns.size()))};
+  for (std::size_t m = 0; m < columns.size(); ++m)
+    st.responses.col(Eigen::Index(m)) = y.col(columns[m]);
+  return st;
+}
+
+/// The calibrated targets with the run-to-run noise of their metrics, from the campaign's
+/// design (pure error of its repeated points, else Lenth's PSE).
+void add_targets(Loaded& l) {
+  const Eigen::MatrixXd& y = l.state.stages.front().responses;
+  std::size_t m = 0;
+  for (const auto& t : l.plan.targets) {
+    if (t.holdout) continue;
+    const Eigen::VectorXd col = y.col(Eigen::Index(m));
+    const int finite = static_cast<int>(col.array().isFinite().count());
+    if (finite < 2)
+      throw InputError(t.response, "only " + std::to_string(finite) +
+                                       " design runs have a result; the campaign must run first");
+    const doe::ResponseAnalysis a = analyse(l.plan, col, l.options.model, 0.05);
+    l.state.targets.push_back({t.response, t.value, t.weight, t.uncertainty, a.noise.sd});
+    l.noise_df.push_back(a.noise.degrees_of_freedom);
+    l.responses.push_back(t.response);
+    ++m;
+  }
+}
+
+Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& req) {
+  Loaded l;
+  from_json(row.spec_json, l.spec);
+  l.plan = plan_from_json(row.design_json);
+  l.jobs = store.jobs(row.id);
+  l.round_rows = store.calibration_rounds(row.id);
+  l.options = calibration_options(l.spec.calibration(), "spec.calibration");
+  if (!req.model().empty()) l.options.model = polynomial_model(req.model(), "model");
+  if (req.starts() < 0 || req.starts() > 1000) throw InputError("starts", "must lie in [0, 1000]");
+  l.options.calibration.starts = req.starts() > 0 ? req.starts() : 16;
+  l.options.calibration.seed = req.seed() ? req.seed() : 1;
+  if (l.plan.targets.empty())
+    throw InputError("spec.measurements", "the campaign has no measurements to calibrate against");
+  std::vector<int> columns;
+  for (const auto& t : l.plan.targets)
+    if (!t.holdout) columns.push_back(column_of(l.plan, t.response));
+  if (columns.empty())
+    throw InputError("spec.measurements", "every measurement is held out: nothing to calibrate");
+  auto& s = l.state;
+  s.factors.clear();
+  for (const auto& f : l.plan.factors) s.factors.push_back(f.factor);
+  s.jobs_per_point = std::max(1, l.spec.tests_size());
+  s.stages.push_back(stage_runs(l, columns, s.factors, "design"));
+  add_targets(l);
+  for (const auto& st : store.calibration_stages(row.id))
+    s.stages.push_back(stage_runs(l, columns, box_from_json(l.plan, st.box_json),
+                                  std::string(kStagePrefix) + std::to_string(st.stage)));
+  for (const auto& r : l.round_rows) {
+    const auto j = nlohmann::json::parse(r.proposal_json);
+    s.rounds.push_back({r.stage, vector_of(j.at("natural")), vector_of(j.at("predicted")),
+                        round_values(l, columns, r.round), j.value("batch", r.round)});
+  }
+  std::set<std::string> workers;
+  for (const auto& j : l.jobs) {
+    if (!j.worker.empty()) workers.insert(j.worker);
+    if (!is_calibration_job(j)) continue;
+    ++s.jobs_used;
+    l.pending = l.pending || is_open(j);
+  }
+  // One GP batch keeps every worker busy: as many points as workers have run this campaign.
+  if (l.spec.calibration().batch() == 0)
+    l.options.batch = std::clamp(static_cast<int>(workers.size()), 1, 64);
+  return l;
+}
+
+std::string proposal_json(const Eigen::VectorXd& natural, const Eigen::VectorXd& predicted,
+                          const std::vector<std::string>& metrics, int batch) {
+  nlohmann::json j;
+  for (Eigen::Index i = 0; i < natural.size(); ++i) j["natural"].push_back(natural(i));
+  for (Eigen::Index i = 0; i < predicted.size(); ++i) j["predicted"].push_back(predicted(i));
+  j["metrics"] = metrics;
+  j["batch"] = batch;
+  return j.dump();
+}
+
+v1::CalibrationRound round_message(const Loaded& l, std::size_t i) {
+  const auto& r = l.state.rounds[i];
+  v1::CalibrationRound m;
+  m.set_round(l.round_rows[i].round);
+  m.set_stage(r.stage);
+  m.set_batch(r.batch);
+  for (Eigen::Index f = 0; f < r.natural.size(); ++f) m.add_proposed_values(r.natural(f));
+  for (std::size_t t = 0; t < l.responses.size(); ++t) {
+    m.add_metrics(l.responses[t]);
+    m.add_predicted(r.predicted(Eigen::Index(t)));
+  }
+  m.set_state(r.simulated ? "done" : "running");
+  if (r.simulated) {
+    for (Eigen::Index t = 0; t < r.simulated->size(); ++t) m.add_simulated((*r.simulated)(t));
+    const calib::PointScore score = calib::score_point(l.state.targets, *r.simulated);
+    m.set_within(score.within);
+    m.set_worst_deviation(score.worst);
+    m.set_worst_metric(l.responses[std::size_t(score.worst_metric)]);
+  }
+  return m;
+}
+
+/// Per metric: target, prediction, reach, tolerance, and the latest simulated value.
+void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
+                 const calib::CalibrationResult* proposal) {
+  const calib::VerifiedRound* latest = nullptr;
+  for (const auto& r : l.state.rounds)
+    if (r.simulated) latest = &r;
+  for (std::size_t m = 0; m < l.state.targets.size(); ++m) {
+    const auto& t = l.state.targets[m];
+    auto* o = reply.add_metrics();
+    o->set_metric(t.name);
+    o->set_target(t.target);
+    o->set_uncertainty(t.uncertainty.value_or(0.0));
+    o->set_noise_sd(t.noise_sd);
+    o->set_noise_df(l.noise_df[m]);
+    const double tol = std::hypot(t.uncertainty.value_or(0.0), t.noise_sd);
+    o->set_tolerance(tol);
+    if (proposal) {
+      const auto& p = proposal->metrics[m];
+      o->set_predicted(p.predicted);
+      o->set_relative_error(p.relative_error);
+      o->set_envelope_min(p.envelope.min);
+      o->set_envelope_max(p.envelope.max);
+      o->set_reachable(p.reachable);
+      o->set_statement(p.statement);
+    } else if (!l.state.rounds.empty()) {
+      o->set_predicted(l.state.rounds.back().predicted(Eigen::Index(m)));
+    }
+    if (latest && std::isfinite((*latest->simulated)(Eigen::Index(m)))) {
+      const double sim = (*latest->simulated)(Eigen::Index(m));
+      o->set_simulated_available(true);
+      o->set_simulated(sim);
+      o->set_within(tol > 0.0 && std::abs(sim - t.target) <= tol);
+    }
+  }
+}
+
+void add_intervals(v1::CalibrateReply& reply, const Loaded& l,
+                   const calib::CalibrationResult& proposal) {
+  for (std::size_t f = 0; f < proposal.intervals.size(); ++f) {
+    const auto& p = proposal.intervals[f];
+    auto* o = reply.add_intervals();
+    o->set_factor(l.plan.factors[f].path);
+    o->set_available(p.available);
+    o->set_low(p.low);
+    o->set_high(p.high);
+    o->set_fraction(p.fraction);
+    o->set_pinned(p.pinned);
+    o->set_statement(p.statement);
+  }
+}
+
+void set_proposed(v1::CalibrateReply& reply, const Loaded& l, const Eigen::VectorXd& natural) {
+  for (std::size_t f = 0; f < l.plan.factors.size(); ++f) {
+    (*reply.mutable_proposed())[l.plan.factors[f].path] = natural(Eigen::Index(f));
+    reply.add_factor_paths(l.plan.factors[f].path);
+    reply.add_proposed_values(natural(Eigen::Index(f)));
+  }
+}
+
+/// Queues one round per point of the decision's batch, all with the next batch number.
+std::vector<std::int64_t> queue_rounds(Store& store, const CampaignRow& row, const Loaded& l,
+                                       const calib::SequentialDecision& d) {
+  const int batch = l.state.rounds.empty() ? 1 : l.state.rounds.back().batch + 1;
+  const bool pinned = l.spec.design().simulation_seeds() == v1::Design::PINNED;
+  std::vector<std::int64_t> ids;
+  int round = static_cast<int>(l.round_rows.size());
+  for (std::size_t b = 0; b < d.batch.size(); ++b) {
+    ++round;
+    std::map<std::string, double> parameters;
+    for (std::size_t f = 0; f < l.plan.factors.size(); ++f)
+      parameters[l.plan.factors[f].path] = d.batch[b](Eigen::Index(f));
+    const auto jobs = jobs_at(l.spec, l.spec.material(), parameters, round, "verify",
+                              pinned ? 0 : kVerifySeedOffset + std::uint64_t(round));
+    const auto queued = store.add_calibration_round(
+        row.id,
+        {round, d.stage, proposal_json(d.batch[b], d.batch_predicted[b], l.responses, batch),
+         now_seconds()},
+        jobs);
+    ids.insert(ids.end(), queued.begin(), queued.end());
+  }
+  spdlog::info("campaign {}: calibration batch {} ({} round(s), stage {}) queued", row.id, batch,
+               d.batch.size(), d.stage);
+  return ids;
+}
+
+std::vector<std::int64_t> queue_stage(Store& store, const CampaignRow& row, const Loaded& l,
+                                      const calib::SequentialDecision& d) {
+  const int stage = d.stage + 1;
+  std::vector<PlannedFactor> box = l.plan.factors;
+  for (std::size_t f = 0; f < box.size(); ++f) box[f].factor = d.next_box[f];
+  const auto jobs =
+      design_jobs(l.spec, l.plan, box, std::string(kStagePrefix) + std::to_string(stage),
+                  (stage - 1) * l.plan.design.runs());
+  spdlog::info("campaign {}: calibration stage {} queued ({} jobs)", row.id, stage, jobs.size());
+  return store.add_calibration_stage(row.id, {stage, box_to_json(d.next_box), now_seconds()}, jobs);
+}
+
+std::string running_conclusion(const Loaded& l) {
+  int open = 0;
+  for (const auto& j : l.jobs) open += is_calibration_job(j) && is_open(j) ? 1 : 0;
+  return "calibration running: " + std::to_string(open) + " job(s) left, " +
+         std::to_string(l.state.rounds.size()) + " round(s) so far";
+}
+
+}  // namespace
+
+calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
+                                             const std::string& where) {
+  calib::SequentialOptions o;
+  if (spec.rounds()) o.rounds = spec.rounds();
+  if (spec.stages()) o.stages = spec.stages();
+  if (spec.narrow() != 0.0) o.narrow = spec.narrow();
+  o.max_jobs = spec.max_jobs();
+  if (spec.surrogate() == "gp")
+    o.surrogate = calib::Surrogate::kGaussianProcess;
+  else if (!spec.surrogate().empty() && spec.surrogate() != "polynomial")
+    throw InputError(where + ".surrogate",
+                     "unknown surrogate '" + spec.surrogate() + "' (polynomial or gp)");
+  if (spec.batch() < 0) throw InputError(where + ".batch", "must be >= 0");
+  if (spec.batch() > 0) o.batch = spec.batch();
+  if (!spec.model().empty()) o.model = polynomial_model(spec.model(), where + ".model");
+  o.validate(where);
+  return o;
+}
+
+std::vector<v1::CalibrationRound> calibration_rounds(Store& store, const CampaignRow& row) {
+  if (store.calibration_rounds(row.id).empty()) return {};
+  const Loaded l = load(store, row, {});
+  std::vector<v1::CalibrationRound> out;
+  for (std::size_t i = 0; i < l.state.rounds.size(); ++i) out.push_back(round_message(l, i));
+  return out;
+}
+
+v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
+                                      const v1::CalibrateRequest& request) {
+  const Loaded l = load(store, row, request);
+  v1::CalibrateReply reply;
+  reply.set_surrogate(l.options.surrogate == calib::Surrogate::kGaussianProcess ? "gp"
+                                                                                : "polynomial");
+  for (std::size_t i = 0; i < l.state.rounds.size(); ++i) *reply.add_rounds() = round_message(l, i);
+  if (l.pending) {
+    reply.set_verification_state("running");
+    reply.set_stage(static_cast<int>(l.state.stages.size()));
+    reply.set_simulations(l.state.jobs_used);
+    reply.set_conclusion(running_conclusion(l));
+    if (!l.state.rounds.empty()) set_proposed(reply, l, l.state.rounds.back().natural);
+    add_metrics(reply, l, nullptr);
+    return reply;
+  }
+  const calib::SequentialDecision d = calib::next_step(l.state, l.options);
+  reply.set_stage(d.stage);
+  reply.set_objective(d.proposal.objective);
+  add_metrics(reply, l, &d.proposal);
+  if (d.within) {
+    // The calibrated set is the verified one, with what was predicted there.
+    const auto& accepted = l.state.rounds[std::size_t(d.accepted_round)];
+    set_proposed(reply, l, accepted.natural);
+    for (int m = 0; m < reply.metrics_size(); ++m) {
+      auto* o = reply.mutable_metrics(m);
+      o->set_predicted(accepted.predicted(m));
+      o->set_relative_error((o->predicted() - o->target()) / std::abs(o->target()));
+    }
+  } else {
+    set_proposed(reply, l, d.proposal.natural);
+  }
+  add_intervals(reply, l, d.proposal);
+  std::vector<std::int64_t> queued;
+  if (request.verify() && d.step == calib::NextStep::kVerify)
+    queued = queue_rounds(store, row, l, d);
+  if (request.verify() && d.step == calib::NextStep::kNewStage)
+    queued = queue_stage(store, row, l, d);
+  for (const auto id : queued) reply.add_verification_jobs(id);
+  const int simulations = l.state.jobs_used + static_cast<int>(queued.size());
+  reply.set_simulations(simulations);
+  if (!queued.empty()) {
+    reply.set_verification_state("running");
+    reply.set_conclusion(d.conclusion);
+  } else {
+    reply.set_verification_state(l.state.rounds.empty() ? "none" : "done");
+    if (request.verify() || d.step == calib::NextStep::kDone)
+      reply.set_conclusion(d.conclusion);
+    else if (l.state.rounds.empty())
+      reply.set_conclusion("proposal not verified yet (calibrate --verify)");
+    else
+      reply.set_conclusion("not within uncertainty yet; calibrate --verify continues: " +
+                           d.conclusion);
+  }
+  return reply;
+}
+
+}  // namespace demcal::server

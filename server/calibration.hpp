@@ -1,0 +1,28 @@
+#pragma once
+// The coordinator's side of the sequential calibration (core/calib/sequential.hpp): it builds
+// the state from the store (design results, stage designs, verification rounds), asks for the
+// next step, and queues its jobs. Verification jobs have kind 'verify' and std_order = round;
+// a stage design's jobs have kind 'stage:<n>' and the design rows' std_order.
+#include <string>
+#include <vector>
+
+#include "core/calib/sequential.hpp"
+#include "demcal/v1/campaign.pb.h"
+#include "server/store.hpp"
+
+namespace demcal::server {
+
+/// The spec's calibration options with their defaults; InputError names `where`.<field>.
+calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
+                                             const std::string& where);
+
+/// One Calibrate call: the current proposal, every round so far, and the conclusion. With
+/// `verify` it advances the loop (queues a round or a stage design) when nothing is running.
+/// InputError when there is nothing to calibrate yet (no measurements, design unfinished).
+v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
+                                      const v1::CalibrateRequest& request);
+
+/// The stored rounds with their simulated values so far (status and export).
+std::vector<v1::CalibrationRound> calibration_rounds(Store& store, const CampaignRow& row);
+
+}  // namespace demcal::server
