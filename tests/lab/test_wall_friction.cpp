@@ -1,5 +1,6 @@
 // wall_friction (seed 000 §2.7.5, §3.3.4): the angle rises with the particle-wall friction
-// coefficient, and a two-point calibration reproduces a target angle.
+// coefficient and stays below its Coulomb limit, and a two-point calibration reproduces a target
+// angle.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -37,13 +38,26 @@ TEST(WallFriction, TorqueToShearStressAndRegression) {
 }
 
 TEST(WallFriction, RisesWithWallFriction) {
-  // Up to mu_wall 0.2: above it this small bed no longer slips at the piston alone (at 0.3 three
-  // beds gave 7.8-12.2 deg, below atan(0.3) = 16.7 deg), a limit docs/lab-tests.md states.
+  // Up to mu_wall 0.2 (at 0.3: StaysBelowTheCoulombLimitOfTheWall).
   const double a = angle(0.05), b = angle(0.1), c = angle(0.2);
   EXPECT_GT(a, 0.0);
   EXPECT_GT(b, a);
   EXPECT_GT(c, b);
   EXPECT_LT(c, 45.0);
+}
+
+TEST(WallFriction, StaysBelowTheCoulombLimitOfTheWall) {
+  // A bed whose interparticle friction (0.5) exceeds the wall's slips at the wall, where no contact
+  // carries more than mu_wall times its normal force: the angle is at most atan(mu_wall) (Coulomb),
+  // below it as far as spheres at the wall roll instead of sliding (no rolling resistance here).
+  // Measured two-bed means: 14.3 deg at mu_wall 0.3 (atan = 16.7 deg); with rolling resistance
+  // (EPSD mu_r 1) single beds gave 16.6 and 19.5 deg: the torque-to-stress conversion assumes a
+  // uniform stress under the coupon, so a bed loading its rim reads above the limit
+  // (docs/lab-tests.md).
+  const double limit = std::atan(0.3) * 180.0 / M_PI;
+  const double a = angle(0.3);
+  EXPECT_LT(a, limit + 0.5);
+  EXPECT_GT(a, 0.75 * limit);
 }
 
 TEST(WallFriction, TwoPointCalibrationHitsTarget) {
