@@ -1,5 +1,6 @@
 #include "proto/channel.hpp"
 
+#include <cctype>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -43,6 +44,16 @@ std::unique_ptr<grpc::ClientContext> make_context(const ChannelOptions& o,
   ctx->set_deadline(std::chrono::system_clock::now() +
                     std::chrono::milliseconds(static_cast<long>(deadline_seconds * 1000)));
   return ctx;
+}
+
+std::string read_token_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("--token-file " + path + ": cannot be read");
+  std::string token;
+  std::getline(in, token);
+  while (!token.empty() && std::isspace(static_cast<unsigned char>(token.back()))) token.pop_back();
+  if (token.empty()) throw std::runtime_error("--token-file " + path + ": the first line is empty");
+  return token;
 }
 
 }  // namespace demcal::proto

@@ -20,6 +20,11 @@ struct ChannelOptions {
 
 std::shared_ptr<grpc::Channel> make_channel(const ChannelOptions& options);
 
+/// The bearer token in the first line of `path` (trailing blanks dropped). Throws
+/// std::runtime_error naming the file when it cannot be read or its first line is empty: a
+/// token file that was asked for and is missing never means "no token" (fail closed).
+std::string read_token_file(const std::string& path);
+
 /// A context carrying the token and a deadline.
 std::unique_ptr<grpc::ClientContext> make_context(const ChannelOptions& options,
                                                   double deadline_seconds);

@@ -56,6 +56,26 @@ std::uint64_t base_seed(const v1::LabTest& t) {
   return t.seed() ? t.seed() : 1;
 }
 
+/// Limits on what one submission can ask the coordinator to build and store: centre points and
+/// replicates each within their range, and the campaign's jobs (design rows x replicates x
+/// tests) at most kMaxCampaignJobs, so a submission cannot stall the store's lock or its disk.
+constexpr int kMaxCentrePoints = 64, kMaxReplicates = 16, kMaxCampaignJobs = 8192;
+void check_repeats(const v1::Design& d, int runs, int tests) {
+  if (d.centre_points() < 0 || d.centre_points() > kMaxCentrePoints)
+    throw InputError("spec.design.centre_points",
+                     "must be in [0, " + std::to_string(kMaxCentrePoints) + "]");
+  if (d.replicates() < 0 || d.replicates() > kMaxReplicates)
+    throw InputError("spec.design.replicates",
+                     "must be in [0, " + std::to_string(kMaxReplicates) + "]");
+  const long jobs = static_cast<long>(runs + d.centre_points()) * std::max(1, d.replicates()) *
+                    std::max(1, tests);
+  if (jobs > kMaxCampaignJobs)
+    throw InputError("spec.design", std::to_string(jobs) +
+                                        " jobs (runs and centre points x "
+                                        "replicates x tests); at most " +
+                                        std::to_string(kMaxCampaignJobs) + " per campaign");
+}
+
 /// The simulation seed of design row `row` (0-based, standard order): its own by default, so
 /// that repeated points (centre points, replicates) measure the run-to-run noise.
 std::uint64_t design_seed(const v1::LabTest& t, const v1::Design& design, const doe::Design& d,
@@ -172,8 +192,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
     throw InputError("spec.design.runs", std::to_string(runs) + " runs cannot estimate " +
                                              std::to_string(k) + " main effects (need at least " +
                                              std::to_string(k + 1) + ")");
-  if (d.centre_points() < 0) throw InputError("spec.design.centre_points", "must be >= 0");
-  if (d.replicates() < 0) throw InputError("spec.design.replicates", "must be >= 0");
+  check_repeats(d, runs, spec.tests_size());
   try {
     if (!d.generators().empty()) {
       plan.design = doe::fractional_factorial(k, d.generators());

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "proto/channel.hpp"
 #include "server/coordinator.hpp"
 
 int main(int argc, char** argv) {
@@ -30,10 +31,12 @@ int main(int argc, char** argv) {
   app.add_flag("--insecure", o.insecure, "plain TCP: tokens and data in clear text");
   app.add_option("--port-file", port_file, "write the port listened on to this file");
   CLI11_PARSE(app, argc, argv);
-  if (!token_file.empty()) {
-    std::ifstream in(token_file);
-    std::getline(in, o.token);
-  }
+  if (!token_file.empty()) try {
+      o.token = demcal::proto::read_token_file(token_file);
+    } catch (const std::exception& e) {
+      spdlog::critical("{}", e.what());
+      return 2;
+    }
   // Signals are taken synchronously by this thread; every other thread inherits the mask.
   sigset_t set;
   sigemptyset(&set);

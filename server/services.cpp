@@ -92,7 +92,11 @@ grpc::Status CampaignServiceImpl::List(grpc::ServerContext* ctx, const v1::ListR
 grpc::Status CampaignServiceImpl::Cancel(grpc::ServerContext* ctx, const v1::CancelRequest* req,
                                          v1::Campaign* reply) {
   DEMCAL_AUTHORIZE(ctx);
-  if (!store_.cancel(req->id(), now_seconds())) return not_found(req->id());
+  if (!store_.cancel(req->id(), now_seconds())) {
+    if (!store_.campaign(req->id())) return not_found(req->id());
+    return {grpc::StatusCode::FAILED_PRECONDITION,
+            "campaign " + std::to_string(req->id()) + " is done: nothing to cancel"};
+  }
   spdlog::info("campaign {} cancelled", req->id());
   const auto row = store_.campaign(req->id());
   *reply = campaign_message(*row, store_.counts(row->id), now_seconds(), false);
@@ -292,10 +296,20 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* ctx, const v1::He
 
 namespace {
 
-/// Checks the flags and the cost block of a result: a flag names a reported metric, texts and
-/// the phase list are bounded, every number is finite and not negative. Empty when valid.
-std::string result_extras_error(const v1::CompleteRequest& req) {
-  constexpr std::size_t kMaxText = 2000, kMaxPhases = 10000;
+/// Checks a result before it is stored: every metric value finite and the metrics bounded in
+/// number and name length, the wall time finite and >= 0; a flag names a reported metric; texts
+/// and the phase list of the cost block bounded, its numbers finite and not negative. Empty when
+/// valid. (A NaN would be stored as null and break every later analysis of the campaign.)
+std::string result_error(const v1::CompleteRequest& req) {
+  constexpr std::size_t kMaxText = 2000, kMaxPhases = 10000, kMaxMetrics = 10000, kMaxName = 200;
+  if (static_cast<std::size_t>(req.metrics_size()) > kMaxMetrics) return "metrics: more than 10000";
+  for (const auto& [metric, value] : req.metrics()) {
+    if (metric.empty() || metric.size() > kMaxName)
+      return "metrics: a name is empty or longer than 200 characters";
+    if (!std::isfinite(value)) return "metrics." + metric + ": must be finite";
+  }
+  if (!std::isfinite(req.wall_seconds()) || req.wall_seconds() < 0.0)
+    return "wall_seconds: must be finite and >= 0";
   for (const auto& [metric, reason] : req.flags()) {
     if (!req.metrics().contains(metric))
       return "flags." + metric + ": flags a metric the result does not report";
@@ -323,7 +337,7 @@ std::string result_extras_error(const v1::CompleteRequest& req) {
 grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::CompleteRequest* req,
                                          v1::CompleteReply*) {
   DEMCAL_AUTHORIZE(ctx);
-  if (const std::string error = result_extras_error(*req); !error.empty())
+  if (const std::string error = result_error(*req); !error.empty())
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
   std::map<std::string, double> metrics(req->metrics().begin(), req->metrics().end());
   const nlohmann::json flags(

@@ -1,5 +1,8 @@
 #include "server/store.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <stdexcept>
 #include <tuple>
 
@@ -178,7 +181,19 @@ class Store::Transaction {
   bool done_ = false;
 };
 
+namespace {
+/// Creates a new database file readable by its owner only (0600): it holds every spec and result.
+/// SQLite gives the -wal and -shm files the main file's permissions. An existing file is left as
+/// it is; ":memory:" and "" (temporary databases) have no file.
+void create_private_file(const std::string& path) {
+  if (path.empty() || path == ":memory:") return;
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd >= 0) ::close(fd);
+}
+}  // namespace
+
 Store::Store(const std::string& path, StoreLimits limits) : limits_(limits) {
+  create_private_file(path);
   if (sqlite3_open_v2(path.c_str(), &db_,
                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
                       nullptr) != SQLITE_OK) {
@@ -356,7 +371,11 @@ std::optional<JobRow> Store::job(std::int64_t job_id) {
 bool Store::cancel(std::int64_t campaign_id, double now) {
   std::lock_guard lock(mutex_);
   Transaction tx(*this);
-  Statement c(db_, "UPDATE campaigns SET state = 'cancelled', finished = ? WHERE id = ?");
+  // A done campaign stays done: its results are complete, and a later verification or diagnosis
+  // reopens it (add_jobs) rather than finding it cancelled.
+  Statement c(db_,
+              "UPDATE campaigns SET state = 'cancelled', finished = ? WHERE id = ? AND state <> "
+              "'done'");
   c.bind(1, now).bind(2, campaign_id).step();
   if (sqlite3_changes(db_) == 0) return false;
   Statement j(db_,

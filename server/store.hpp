@@ -100,7 +100,7 @@ class Store {
   Counts counts(std::int64_t campaign_id, const std::string& kind = "");
   std::vector<JobRow> jobs(std::int64_t campaign_id);
   std::optional<JobRow> job(std::int64_t job_id);
-  /// Cancels every queued or leased job; false when the campaign does not exist.
+  /// Cancels every queued or leased job; false when the campaign does not exist or is done.
   bool cancel(std::int64_t campaign_id, double now);
   /// Adds jobs to an existing campaign (verification runs); the campaign runs again.
   std::vector<std::int64_t> add_jobs(std::int64_t campaign_id, const std::vector<NewJob>& jobs);

@@ -30,10 +30,12 @@ int main(int argc, char** argv) {
   app.add_option("--max-backoff", o.max_backoff, "longest reconnection back-off (s)")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  if (!token_file.empty()) {
-    std::ifstream in(token_file);
-    std::getline(in, o.channel.token);
-  }
+  if (!token_file.empty()) try {
+      o.channel.token = demcal::proto::read_token_file(token_file);
+    } catch (const std::exception& e) {
+      spdlog::critical("{}", e.what());
+      return 2;
+    }
   sigset_t set;
   sigemptyset(&set);
   sigaddset(&set, SIGINT);

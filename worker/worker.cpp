@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <future>
@@ -63,7 +64,8 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
   try {
     const lab::MaterialModel material = proto::job_material(job);
     lab::RunOptions ro;
-    ro.threads = job.threads() > 0 ? job.threads() : threads;
+    // The worker's --threads is what its machine gives it: a spec may ask for fewer, never more.
+    ro.threads = job.threads() > 0 ? std::min(job.threads(), threads) : threads;
     ro.seed = job.seed() ? job.seed() : 1;
     ro.progress = [&progress](double f) { progress = f; };
     const lab::LabOutput out =

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -175,6 +176,21 @@ TEST_F(Service, MissingOrWrongTokenIsUnauthenticated) {
   EXPECT_EQ(w.wait_exit(20), 2) << w.log();
 }
 
+TEST_F(Service, AMissingOrEmptyTokenFileStopsServerAndWorkerInsteadOfTurningAuthOff) {
+  std::ofstream(path("empty.token")) << "\n";
+  for (const std::string file : {path("missing.token"), path("empty.token")}) {
+    Process server({DEMCAL_SERVER_BIN, "--listen", "127.0.0.1:0", "--db", path("c.db"),
+                    "--token-file", file, "--port-file", path("port")},
+                   path("server.log"));
+    EXPECT_EQ(server.wait_exit(20), 2) << server.log();
+    EXPECT_NE(server.log().find(file), std::string::npos) << server.log();
+    EXPECT_FALSE(fs::exists(path("port"))) << "the server listened";
+    Process worker({DEMCAL_WORKER_BIN, "--coordinator", "127.0.0.1:1", "--token-file", file},
+                   path("worker.log"));
+    EXPECT_EQ(worker.wait_exit(20), 2) << worker.log();
+  }
+}
+
 TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
   start_server();
   struct Case {
@@ -205,6 +221,13 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
          return s;
        }(),
        "spec.tests[0].settings.particles"},
+      {tiny_spec(30, 100000), "spec.design.centre_points"},
+      {[] {
+         auto s = tiny_spec(30);
+         s.replace(s.find("centre_points: 0}"), 17, "centre_points: 0, replicates: 1000}");
+         return s;
+       }(),
+       "spec.design.replicates"},
       {tiny_spec(30, 0, "", "calibration: {narrow: 1.5}\n"), "spec.calibration.narrow"},
       {tiny_spec(30, 0, "", "calibration: {model: quadratic}\n"), "spec.calibration.model"},
       {tiny_spec(30, 0, "", "calibration: {surrogate: kriging}\n"), "spec.calibration.surrogate"},
@@ -285,6 +308,14 @@ TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
   good.set_attempt(2);
   good.set_worker("fast");
   (*good.mutable_metrics())["solid_fraction"] = 0.58;
+  // A non-finite metric or wall time is refused and the lease stays the worker's.
+  v1::CompleteRequest nan_metric = good, nan_time = good;
+  (*nan_metric.mutable_metrics())["solid_fraction"] = std::nan("");
+  nan_time.set_wall_seconds(std::numeric_limits<double>::infinity());
+  for (const auto* bad : {&nan_metric, &nan_time}) {
+    const auto st = workers_stub_->Complete(ctx().get(), *bad, &cr);
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << st.error_message();
+  }
   EXPECT_TRUE(workers_stub_->Complete(ctx().get(), good, &cr).ok());
   EXPECT_EQ(workers_stub_->Complete(ctx().get(), good, &cr).error_code(),
             grpc::StatusCode::FAILED_PRECONDITION);  // once only

@@ -27,6 +27,13 @@ TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     s.create_campaign("c", "{}", "{}", jobs(3), 0.0);
     ASSERT_TRUE(s.lease("w", 1.0));
+    // Specs and results are the owner's alone: the file and its write-ahead log are 0600.
+    namespace fs = std::filesystem;
+    const auto others = fs::perms::group_all | fs::perms::others_all;
+    for (const std::string file : {path.string(), path.string() + "-wal"}) {
+      ASSERT_TRUE(fs::exists(file)) << file;
+      EXPECT_EQ(fs::status(file).permissions() & others, fs::perms::none) << file;
+    }
   }
   {
     Store s(path.string());  // migrations are not re-run; the lease survived
@@ -139,6 +146,13 @@ TEST(Store, CancelStopsLeasingAndRefusesResults) {
   EXPECT_FALSE(s.complete(a->id, 1, "w", "{}", 1.0, 2.0));
   EXPECT_EQ(s.counts(id).cancelled, 3);
   EXPECT_EQ(s.campaign(id)->state, "cancelled");
+  // A done campaign is not cancelled: it stays done with its results.
+  const auto done = s.create_campaign("d", "{}", "{}", jobs(1), 3.0);
+  const auto b = s.lease("w", 3.0);
+  ASSERT_TRUE(s.complete(b->id, 1, "w", "{}", 1.0, 4.0));
+  EXPECT_FALSE(s.cancel(done, 5.0));
+  EXPECT_EQ(s.campaign(done)->state, "done");
+  EXPECT_EQ(s.counts(done).done, 1);
 }
 
 TEST(Store, VerificationJobsReopenADoneCampaign) {
