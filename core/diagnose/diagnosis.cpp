@@ -493,15 +493,26 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
   };
   const CandidateOutcome* named = pick(reachable);
   if (!named) named = pick(!reachable);
+  std::string why = reachable ? "every target is within the base box's reach, so the design and "
+                                "its model are examined first"
+                              : "some target is out of the base box's reach, so model extensions "
+                                "are examined first";
+  // The envelope that found a target out of reach is the base design's model, which an aliased
+  // interaction or curvature makes wrong: a remedy that explains, whose refitted box reaches every
+  // target and which verifies at least as well as the extension shows that the box did reach.
+  if (!reachable && named && !remedy(*named))
+    if (const CandidateOutcome* r = pick(true);
+        r && r->reaches_all && r->verified_rms <= named->verified_rms) {
+      named = r;
+      why =
+          "some target is out of the base design's reach, but a remedy of the design reaches "
+          "every target and verifies at least as well as any model extension";
+    }
   if (!all_verified) {
     rep.conclusion = "simulations still running";
   } else if (named) {
     rep.named_cause = named->id;
-    rep.conclusion = std::string(reachable ? "every target is within the base box's reach, so "
-                                             "the design and its model are examined first"
-                                           : "some target is out of the base box's reach, so "
-                                             "model extensions are examined first") +
-                     "; named cause: " + named->cause + " (" + named->evidence + ")";
+    rep.conclusion = why + "; named cause: " + named->cause + " (" + named->evidence + ")";
   } else {
     rep.conclusion = "no candidate cuts the verified error (" + percent(base_rms) + ") by " +
                      percent(p.options.margin) + " or more: none is named";
