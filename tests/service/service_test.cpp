@@ -178,7 +178,7 @@ TEST_F(Service, MissingOrWrongTokenIsUnauthenticated) {
 
 TEST_F(Service, AMissingOrEmptyTokenFileStopsServerAndWorkerInsteadOfTurningAuthOff) {
   std::ofstream(path("empty.token")) << "\n";
-  for (const std::string file : {path("missing.token"), path("empty.token")}) {
+  for (const std::string& file : {path("missing.token"), path("empty.token")}) {
     Process server({DEMCAL_SERVER_BIN, "--listen", "127.0.0.1:0", "--db", path("c.db"),
                     "--token-file", file, "--port-file", path("port")},
                    path("server.log"));

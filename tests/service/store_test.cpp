@@ -30,7 +30,7 @@ TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
     // Specs and results are the owner's alone: the file and its write-ahead log are 0600.
     namespace fs = std::filesystem;
     const auto others = fs::perms::group_all | fs::perms::others_all;
-    for (const std::string file : {path.string(), path.string() + "-wal"}) {
+    for (const std::string& file : {path.string(), path.string() + "-wal"}) {
       ASSERT_TRUE(fs::exists(file)) << file;
       EXPECT_EQ(fs::status(file).permissions() & others, fs::perms::none) << file;
     }
