@@ -88,7 +88,7 @@ TEST(Seed001Example, SmallVariantRunsADrumOfTheSeedsGranules) {
       lab::read_settings<lab::RotatingDrumSettings>(proto::to_settings(job->settings()), "s");
   const auto bed = lab::drum_bed(s, model.simulated_sizes(), "s");
   EXPECT_EQ(out.metrics.at("particles"), double(bed.particles));
-  EXPECT_NEAR(out.metrics.at("drum_diameter_ratio"), 15.4, 0.5);  // 100 mm / (31 x 213 um)
+  EXPECT_NEAR(out.metrics.at("drum_diameter_ratio"), 15.4, 0.5);  // 100 mm / (31 x 208 um)
   // A rolling bed with a sloped surface that fills the drum's lower part (43 % fill of a bulk
   // at solid fraction 0.6 shows as ~45-60 % black in the projected image).
   EXPECT_GT(out.metrics.at("dynamic_angle_of_repose"), 20.0);
