@@ -48,6 +48,17 @@ bool centrifuging(const sim::World& w, double radius) {
   return std::count(covered.begin(), covered.end(), true) >= 0.9 * kSectors;
 }
 
+/// The drum (an inner cylinder about z) and its two end plates, all pivoting about the axis so
+/// that they turn as one body; each carries the material's wall law.
+void add_drum_walls(sim::World& w, double radius, double depth) {
+  w.walls.push_back(walls::make_wall(
+      "drum", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius, 0.0, depth}, kWallDie));
+  w.walls.push_back(walls::make_wall("back", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
+  w.walls.push_back(
+      walls::make_wall("front", walls::Plane{{0, 0, depth}, {0, 0, -1}}, kWallPiston));
+  for (auto& wall : w.walls) wall.pivot = {0, 0, 0};
+}
+
 }  // namespace
 
 DrumImage project_drum(const std::vector<Vec3>& x, const std::vector<double>& radius,
@@ -125,12 +136,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   const DrumBed bed = drum_bed(s, sizes, "settings");
   const double radius = bed.radius, depth = bed.length;
   Rng rng(options.seed);
-  w.walls.push_back(walls::make_wall(
-      "drum", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius, 0.0, depth}, kWallDie));
-  w.walls.push_back(walls::make_wall("back", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
-  w.walls.push_back(
-      walls::make_wall("front", walls::Plane{{0, 0, depth}, {0, 0, -1}}, kWallPiston));
-  for (auto& wall : w.walls) wall.pivot = {0, 0, 0};
+  add_drum_walls(w, radius, depth);
 
   particles::InsertRequest req = material_insert_request(
       material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth}, bed.particles);
