@@ -31,6 +31,21 @@ std::string number(double v) {
   return o.str();
 }
 
+/// Room for a bed with a free surface and a flowing layer: D >= 6 d_max, W >= 1.25 d_max.
+void check_room(const RotatingDrumSettings& s, double d_max, const std::string& where) {
+  if (1e-3 * s.diameter < 6.0 * d_max)
+    throw InputError(where + ".diameter", "the drum (" + number(s.diameter) +
+                                              " mm) is narrower than 6 of the largest simulated "
+                                              "particles (" +
+                                              number(1e3 * d_max) +
+                                              " mm each): widen it or coarse-grain less");
+  if (1e-3 * s.length < 1.25 * d_max)
+    throw InputError(where + ".length", "the drum (" + number(s.length) +
+                                            " mm deep) is shallower than 1.25 of the largest "
+                                            "simulated particles (" +
+                                            number(1e3 * d_max) + " mm)");
+}
+
 }  // namespace
 
 std::string drum_rpm_label(double rpm) {
@@ -45,19 +60,7 @@ DrumBed drum_bed(const RotatingDrumSettings& s, const particles::SizeDistributio
   const auto [volume, diameter] = mean_volume_and_diameter(simulated);
   bed.mean_diameter = diameter;
   bed.diameter_ratio = 2.0 * bed.radius / diameter;
-  const double d_max = 2.0 * particles::max_radius(simulated);
-  // Room for a bed with a free surface and a flowing layer: D >= 6 d_max, W >= 1.25 d_max.
-  if (2.0 * bed.radius < 6.0 * d_max)
-    throw InputError(where + ".diameter", "the drum (" + number(s.diameter) +
-                                              " mm) is narrower than 6 of the largest simulated "
-                                              "particles (" +
-                                              number(1e3 * d_max) +
-                                              " mm each): widen it or coarse-grain less");
-  if (bed.length < 1.25 * d_max)
-    throw InputError(where + ".length", "the drum (" + number(s.length) +
-                                            " mm deep) is shallower than 1.25 of the largest "
-                                            "simulated particles (" +
-                                            number(1e3 * d_max) + " mm)");
+  check_room(s, 2.0 * particles::max_radius(simulated), where);
   const double bulk = s.fill * M_PI * bed.radius * bed.radius * bed.length;
   const double count = std::round(bulk * s.solid_fraction / volume);
   if (count > s.max_particles)

@@ -1,6 +1,7 @@
 #pragma once
-// rotating_drum (seed 001 §3.2.2-3.2.3): dynamic angle of repose at 4 rpm and the area method
-// (occupied cross-sectional area, eq. 20) at 4, 40, 80, 105 and 116 rpm.
+// rotating_drum (seed 001 §3.2.2-3.2.3): dynamic angle of repose at `rpm` (4 in the seed) and the
+// area method (occupied cross-sectional area, eq. 20) at 4, 40, 80, 105 and 116 rpm, in a drum
+// given in real units whose particle count follows from its size, its fill and the sizes.
 #include <array>
 
 #include "core/lab/lab_test.hpp"

@@ -78,6 +78,13 @@ TEST(LabRotatingDrum, SeedDrumAtLambda64HoldsTheSeedsGranuleCount) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.where(), "settings.diameter") << e.what();
   }
+  // ... and one shallower than 1.25 of them, naming the length.
+  try {
+    drum_bed(drum_settings({{"length", 1}}), m.simulated_sizes(), "settings");
+    ADD_FAILURE() << "1 mm deep drum accepted for 2 mm granules";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), "settings.length") << e.what();
+  }
 }
 
 /// The mean angle of two beds (lab seeds 1, 2): one short run of 332 granules scatters by a few
