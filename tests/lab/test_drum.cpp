@@ -74,7 +74,7 @@ TEST(LabRotatingDrum, SeedDrumAtLambda64HoldsTheSeedsGranuleCount) {
   // A drum narrower than 6 of its largest particles is refused, naming the diameter.
   try {
     drum_bed(drum_settings({{"diameter", 5}}), m.simulated_sizes(), "settings");
-    ADD_FAILURE() << "5 mm drum accepted for 1.5 mm granules";
+    ADD_FAILURE() << "5 mm drum accepted for 2 mm granules";
   } catch (const InputError& e) {
     EXPECT_EQ(e.where(), "settings.diameter") << e.what();
   }
