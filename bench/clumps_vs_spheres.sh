@@ -14,11 +14,18 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 [ -x "$demcal" ] || { echo "build demcal first (scripts/build)" >&2; exit 1; }
 
+# The drum is sized by its geometry: D x 0.44 D at 43 % fill holds N spheres of 1 mm radius when
+# N (4/3 pi) 1e-9 = 0.43 (pi D^2 / 4) 0.44 D 0.6.
+if [ "$test" = rotating_drum ]; then
+  settings=$(python3 -c "import math; d = ($bodies * 4e-9 / 3 / (0.43 / 4 * 0.44 * 0.6)) ** (1 / 3); print('{diameter: %.2f, length: %.2f}' % (1e3 * d, 0.44e3 * d))")
+else
+  settings="{particles: $bodies}"
+fi
 # spec SHAPE_LINE: the lab spec, with the given shape line in the material (or none).
 spec() {
   cat <<YAML
 test: $test
-settings: {particles: $bodies}
+settings: $settings
 seed: 1
 threads: $threads
 material:

@@ -3,6 +3,7 @@
 #include <google/protobuf/util/json_util.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -67,11 +68,17 @@ class Converter {
           std::size_t used = 0;
           const double v = std::stod(s, &used);
           if (used == s.size()) {
+            // JSON has no NaN or infinity (they would be written as null, i.e. the default):
+            // refuse them here, with their line.
+            if (!std::isfinite(v))
+              throw InputError(file_ + ":" + std::to_string(n.Mark().line + 1) + ": " + user_path,
+                               "'" + s + "' is not a finite number");
             if (s.find_first_of(".eE") == std::string::npos && std::abs(v) < 9e15)
               return static_cast<std::int64_t>(v);
             return v;
           }
-        } catch (const std::exception&) {
+        } catch (const std::invalid_argument&) {
+        } catch (const std::out_of_range&) {
         }
         return s;
       }
@@ -83,7 +90,7 @@ class Converter {
  private:
   static bool is_slot(const std::string& path) {
     static const std::regex re(
-        R"(material\.((particle_law|wall_law)\.(normal|cohesion|tangential|rolling)|shape))");
+        R"((material\.(particle_law|wall_law)|tests\[\d+\]\.wall_law)\.(normal|cohesion|tangential|rolling)|material\.shape)");
     return std::regex_match(path, re);
   }
   std::string file_;

@@ -85,7 +85,56 @@ std::uint64_t design_seed(const v1::LabTest& t, const v1::Design& design, const 
   return base_seed(t) + static_cast<std::uint64_t>(row);
 }
 
+/// The material a test instance runs with: `material` with the instance's own wall law, if any.
+v1::Material instance_material(const v1::Material& material, const v1::LabTest& t) {
+  v1::Material m = material;
+  if (t.has_wall_law()) *m.mutable_wall_law() = t.wall_law();
+  return m;
+}
+
+/// One job of a test instance: the lab test to run, its settings and material, the parameters
+/// (the spec's fixed ones, then `parameters`) and the simulation seed.
+v1::JobSpec instance_job(const v1::CampaignSpec& spec, const v1::LabTest& t,
+                         const v1::Material& material,
+                         const std::map<std::string, double>& parameters, std::uint64_t seed) {
+  v1::JobSpec job;
+  job.set_test(t.test());
+  *job.mutable_settings() = t.settings();
+  *job.mutable_material() = instance_material(material, t);
+  *job.mutable_parameters() = spec.fixed();
+  for (const auto& [path, value] : parameters) (*job.mutable_parameters())[path] = value;
+  job.set_seed(seed);
+  job.set_threads(t.threads());
+  return job;
+}
+
+/// Checks an instance name: responses are "<name>.<metric>", so no dots, and a name a shell and
+/// a CSV header carry as it is.
+void check_instance_name(const std::string& name, const std::string& where) {
+  const bool ok =
+      !name.empty() && name.size() <= 64 &&
+      name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") == std::string::npos;
+  if (!ok) throw InputError(where, "'" + name + "' is not an instance name (1-64 of a-z, 0-9, _)");
+}
+
+/// The model of a test instance: the campaign's with the instance's wall law; errors in that law
+/// name the instance's field.
+lab::MaterialModel instance_model(const v1::CampaignSpec& spec, const v1::LabTest& t,
+                                  const std::string& where) {
+  try {
+    return proto::to_material_model(instance_material(spec.material(), t), "spec.material");
+  } catch (const InputError& e) {
+    const std::string base = "spec.material.wall_law";
+    if (!t.has_wall_law() || e.where().rfind(base, 0) != 0) throw;
+    throw InputError(where + ".wall_law" + e.where().substr(base.size()), e.message());
+  }
+}
+
 }  // namespace
+
+std::string instance_name(const v1::LabTest& t) {
+  return t.name().empty() ? t.test() : t.name();
+}
 
 std::string to_json(const google::protobuf::Message& message) {
   std::string out;
@@ -110,6 +159,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
 
   if (spec.tests_size() == 0) throw InputError("spec.tests", "a campaign needs at least one test");
   std::set<std::string> seen_tests;
+  std::vector<std::pair<std::string, lab::MaterialModel>> instances;  // name, model
   for (int i = 0; i < spec.tests_size(); ++i) {
     const auto& t = spec.tests(i);
     const std::string where = "spec." + idx("tests", i);
@@ -119,12 +169,19 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
     } catch (const InputError& e) {
       throw InputError(where + ".test", e.message());
     }
-    if (!seen_tests.insert(t.test()).second)
-      throw InputError(where + ".test", "test '" + t.test() + "' appears twice");
-    lab::validate_settings(*info, proto::to_settings(t.settings()), where + ".settings");
+    const std::string name = instance_name(t);
+    if (!t.name().empty()) check_instance_name(t.name(), where + ".name");
+    if (!seen_tests.insert(name).second)
+      throw InputError(where + (t.name().empty() ? ".test" : ".name"),
+                       "test '" + name + "' appears twice (give each instance its own `name`)");
+    const lab::Settings settings = proto::to_settings(t.settings());
+    lab::validate_settings(*info, settings, where + ".settings");
     if (t.threads() < 0) throw InputError(where + ".threads", "must be >= 0");
-    plan.tests.push_back(t.test());
-    for (const auto& m : info->metrics) plan.responses.push_back(t.test() + "." + m.name);
+    lab::MaterialModel instance = instance_model(spec, t, where);
+    lab::check_size(t.test(), instance, settings, where + ".settings");
+    instances.emplace_back(name, std::move(instance));
+    plan.tests.push_back(name);
+    for (const auto& m : info->metrics) plan.responses.push_back(name + "." + m.name);
   }
 
   {
@@ -136,6 +193,12 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
                                     known_paths(lab::parameters(model)) + ")");
       check_settable(model, path, value, where);
       lab::set_parameter(model, path, value);
+      for (auto& [name, instance] : instances) {
+        if (!find_parameter(lab::parameters(instance), path))
+          throw InputError(where,
+                           "not a parameter of test '" + name + "' (its own wall_law lacks it)");
+        lab::set_parameter(instance, path, value);
+      }
     }
   }
 
@@ -170,6 +233,10 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
     if (log && !(f.low() > 0)) throw InputError(where + ".low", "must be > 0 on a log scale");
     check_settable(model, f.path(), f.low(), where + ".low");
     check_settable(model, f.path(), f.high(), where + ".high");
+    for (const auto& [name, instance] : instances)
+      if (!find_parameter(lab::parameters(instance), f.path()))
+        throw InputError(where + ".path", "'" + f.path() + "' is not a parameter of test '" + name +
+                                              "' (its own wall_law lacks it)");
     plan.factors.push_back(
         {f.path(), doe::Factor{f.name().empty() ? f.path() : f.name(), f.low(), f.high(),
                                log ? doe::Scale::kLog : doe::Scale::kLinear}});
@@ -252,21 +319,17 @@ std::vector<NewJob> design_jobs(const v1::CampaignSpec& spec, const CampaignPlan
   std::vector<NewJob> jobs;
   const auto& design = plan.design;
   for (int r = 0; r < design.runs(); ++r) {
+    std::map<std::string, double> parameters;
+    for (std::size_t f = 0; f < box.size(); ++f)
+      parameters[box[f].path] = box[f].factor.to_natural(design.coded(r, Eigen::Index(f)));
     for (const auto& t : spec.tests()) {
-      v1::JobSpec job;
-      job.set_campaign_id(0);
-      job.set_test(t.test());
-      *job.mutable_settings() = t.settings();
-      *job.mutable_material() = spec.material();
-      *job.mutable_parameters() = spec.fixed();
-      for (std::size_t f = 0; f < box.size(); ++f)
-        (*job.mutable_parameters())[box[f].path] =
-            box[f].factor.to_natural(design.coded(r, Eigen::Index(f)));
       const bool pinned = spec.design().simulation_seeds() == v1::Design::PINNED;
-      job.set_seed(design_seed(t, spec.design(), design, r) +
-                   (pinned ? 0 : static_cast<std::uint64_t>(stage_offset)));
-      job.set_threads(t.threads());
-      jobs.push_back({r + 1, design.run_order[std::size_t(r)], t.test(), kind, to_json(job)});
+      const std::uint64_t seed = design_seed(t, spec.design(), design, r) +
+                                 (pinned ? 0 : static_cast<std::uint64_t>(stage_offset));
+      v1::JobSpec job = instance_job(spec, t, spec.material(), parameters, seed);
+      job.set_campaign_id(0);
+      jobs.push_back(
+          {r + 1, design.run_order[std::size_t(r)], instance_name(t), kind, to_json(job)});
     }
   }
   return jobs;
@@ -277,17 +340,10 @@ std::vector<NewJob> jobs_at(const v1::CampaignSpec& spec, const v1::Material& ma
                             const std::string& kind, std::uint64_t seed_offset) {
   std::vector<NewJob> jobs;
   int order = 0;
-  for (const auto& t : spec.tests()) {
-    v1::JobSpec job;
-    job.set_test(t.test());
-    *job.mutable_settings() = t.settings();
-    *job.mutable_material() = material;
-    *job.mutable_parameters() = spec.fixed();
-    for (const auto& [path, value] : parameters) (*job.mutable_parameters())[path] = value;
-    job.set_seed(base_seed(t) + seed_offset);
-    job.set_threads(t.threads());
-    jobs.push_back({std_order, ++order, t.test(), kind, to_json(job)});
-  }
+  for (const auto& t : spec.tests())
+    jobs.push_back(
+        {std_order, ++order, instance_name(t), kind,
+         to_json(instance_job(spec, t, material, parameters, base_seed(t) + seed_offset))});
   return jobs;
 }
 

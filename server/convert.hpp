@@ -18,6 +18,10 @@ namespace demcal::server {
 /// inside the valid range; tests, settings and measured metrics must exist in the catalogue.
 CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs);
 
+/// The name of a test instance, which its responses carry ("<name>.<metric>"): its `name`, or the
+/// lab test's when it has none.
+std::string instance_name(const v1::LabTest& test);
+
 /// Jobs that simulate each test of the spec with `material` at one parameter set (the spec's
 /// fixed parameters, then `parameters`), as design row `std_order` of job kind `kind`, with
 /// the test's seed + `seed_offset`.

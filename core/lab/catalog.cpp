@@ -95,11 +95,13 @@ LabTestInfo shear_cell_info() {
 // rotating_drum: seed 001 §3.2.2-3.2.3, eq. 20 (runner in rotating_drum.cpp).
 LabTestInfo rotating_drum_info() {
   return {"rotating_drum",
-          "drum (D x W = 100 x 44 mm in the seed, scaled) 43 % full: dynamic angle of repose at "
-          "4 rpm from a line fitted to the projected free surface, and the area method at 4, 40, "
-          "80, 105 and 116 rpm from a raster of the projected bed",
+          "drum of D x W mm (100 x 44 in the seed), fill 43 %: the particle count follows from "
+          "the drum, the fill and the simulated sizes; dynamic angle of repose at `rpm` (4) from "
+          "a line fitted to the projected free surface, and the area method at 4, 40, 80, 105 and "
+          "116 rpm from a raster of the projected bed; also reports drum_diameter_ratio D/d and "
+          "particles",
           "seed 001 §3.2.2-3.2.3 (eq. 20, Fig. 13)",
-          {{"dynamic_angle_of_repose", "deg", "free-surface angle at 4 rpm (image fit)"},
+          {{"dynamic_angle_of_repose", "deg", "free-surface angle at `rpm` (image fit)"},
            {"csa_occupied_4", "%", "occupied cross-sectional area at 4 rpm (eq. 20)"},
            {"csa_occupied_40", "%", "occupied cross-sectional area at 40 rpm (eq. 20)"},
            {"csa_occupied_80", "%", "occupied cross-sectional area at 80 rpm (eq. 20)"},
@@ -154,6 +156,12 @@ void validate_settings(const LabTestInfo& info, const Settings& settings,
                        "value " + std::to_string(value) + " outside the valid range [" +
                            std::to_string(doc->lo) + ", " + std::to_string(doc->hi) + "]");
   }
+}
+
+void check_size(const std::string& test, const MaterialModel& material, const Settings& settings,
+                const std::string& where) {
+  if (test != "rotating_drum") return;  // the other tests are sized by their particle count
+  drum_bed(read_settings<RotatingDrumSettings>(settings, where), material.simulated_sizes(), where);
 }
 
 }  // namespace demcal::lab

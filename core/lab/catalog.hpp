@@ -11,6 +11,8 @@
 
 namespace demcal::lab {
 
+struct MaterialModel;  // material.hpp
+
 struct MetricInfo {
   std::string name, unit, description;
 };
@@ -31,6 +33,11 @@ const std::vector<LabTestInfo>& lab_catalog();
 const LabTestInfo& find_lab_info(const std::string& name);
 /// Checks every setting name and value against the test's table; errors name `where`.<setting>.
 void validate_settings(const LabTestInfo& info, const Settings& settings, const std::string& where);
+
+/// Checks what a test's settings ask of the machine for this material before anything runs (the
+/// rotating drum's particle count against its max_particles); InputError names `where`.<setting>.
+void check_size(const std::string& test, const MaterialModel& material, const Settings& settings,
+                const std::string& where);
 
 /// Reads a settings struct S (with S::table()) from a map, checking names and ranges.
 template <class S>

@@ -3,7 +3,12 @@
 // The drum (inner cylinder) and both end plates rotate rigidly about the axis; their contact law
 // is the material's wall law (the granule-boundary law of seed 001 Table 3).
 //
-// Phases: insert in the drum, settle at rest, rotate at 4 rpm until the bed has turned to its
+// The drum is given in real units (D x W in mm, the fill degree); the particle count follows
+// from it and the simulated size distribution, so coarse-graining (seed 001 eq. 15) changes
+// D / d and the count, never the drum: the scale effect of seed 001 App. B and the boundary effect
+// of Dury et al. 1998 (seed 001 ref. [46]) are both a function of D / d, which is reported.
+//
+// Phases: insert in the drum, settle at rest, rotate at `rpm` until the bed has turned to its
 // angle, then keep turning for angle_time while images are taken: dynamic_angle_of_repose is the
 // mean of the surface-fit angles. Then the area method: the speeds in ascending order, each for
 // area_time; csa_occupied_<rpm> (seed 001 eq. 20) is the mean occupied area of the images of the
@@ -41,6 +46,17 @@ bool centrifuging(const sim::World& w, double radius) {
     }
   }
   return std::count(covered.begin(), covered.end(), true) >= 0.9 * kSectors;
+}
+
+/// The drum (an inner cylinder about z) and its two end plates, all pivoting about the axis so
+/// that they turn as one body; each carries the material's wall law.
+void add_drum_walls(sim::World& w, double radius, double depth) {
+  w.walls.push_back(walls::make_wall(
+      "drum", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius, 0.0, depth}, kWallDie));
+  w.walls.push_back(walls::make_wall("back", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
+  w.walls.push_back(
+      walls::make_wall("front", walls::Plane{{0, 0, depth}, {0, 0, -1}}, kWallPiston));
+  for (auto& wall : w.walls) wall.pivot = {0, 0, 0};
 }
 
 }  // namespace
@@ -117,22 +133,13 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   const auto sizes = material.simulated_sizes();
   const double r_max = particles::max_radius(sizes);
 
-  // Drum size from the particle count: fill * pi R^2 W = solid volume / 0.6, W = aspect 2R.
+  const DrumBed bed = drum_bed(s, sizes, "settings");
+  const double radius = bed.radius, depth = bed.length;
   Rng rng(options.seed);
-  const double solid = expected_solid_volume(sizes, s.particles, options.seed);
-  const double radius =
-      std::max(6.0 * r_max, std::cbrt(solid / (0.6 * s.fill * M_PI * 2.0 * s.aspect)));
-  const double depth = std::max(2.0 * s.aspect * radius, 2.5 * r_max);
-  w.walls.push_back(walls::make_wall(
-      "drum", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius, 0.0, depth}, kWallDie));
-  w.walls.push_back(walls::make_wall("back", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
-  w.walls.push_back(
-      walls::make_wall("front", walls::Plane{{0, 0, depth}, {0, 0, -1}}, kWallPiston));
-  for (auto& wall : w.walls) wall.pivot = {0, 0, 0};
+  add_drum_walls(w, radius, depth);
 
-  particles::InsertRequest req =
-      material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth},
-                              static_cast<std::size_t>(s.particles));
+  particles::InsertRequest req = material_insert_request(
+      material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth}, bed.particles);
   const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety);
 
   sim::HealthLimits limits;
@@ -172,10 +179,11 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
     }
   };
 
-  // 4 rpm: first turn the bed up to its angle (60 deg of drum rotation at most), then measure.
-  const double w4 = set_speed(kDrumSpeeds[0]);
+  // At `rpm`: first turn the bed up to its angle (60 deg of drum rotation, 3 s at most), then
+  // measure.
+  const double w_angle = set_speed(s.rpm);
   const PhaseClock angle_clock(w);
-  run_for(std::min(60.0 * M_PI / 180.0 / w4, 3.0), {});
+  run_for(std::min(60.0 * M_PI / 180.0 / w_angle, 3.0), {});
   double angle_sum = 0.0;
   int angle_n = 0;
   run_for(s.angle_time, [&] {
@@ -188,7 +196,8 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
     }
   });
   out.metrics["dynamic_angle_of_repose"] = angle_n ? angle_sum / angle_n : 0.0;
-  out.add_phase(angle_clock.stop(w, "4 rpm", "angle_time of turning", true), {});
+  out.add_phase(angle_clock.stop(w, drum_rpm_label(s.rpm) + " rpm", "angle_time of turning", true),
+                {});
   if (options.progress) options.progress(0.4);
   if (!options.snapshot_dir.empty()) {
     const std::string p = options.snapshot_dir + "/drum_4rpm_particles.vtk";
@@ -221,6 +230,8 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
     if (options.progress) options.progress(0.4 + 0.6 * (k + 1) / kDrumSpeeds.size());
   }
   out.metrics["drum_diameter"] = 2.0 * radius;
+  out.metrics["drum_diameter_ratio"] = bed.diameter_ratio;
+  out.metrics["particles"] = static_cast<double>(w.particles.units());
   out.series["angle"] = std::move(angle_series);
   out.series["area_method"] = std::move(area);
   out.cost.close(w);

@@ -14,9 +14,15 @@ StudyResult run_study(const std::string& test, const MaterialModel& material,
     throw InputError("material.scaling.law",
                      "a scale study needs a scaling law (kottlan2018 or tiscar2019)");
   const LabTestInfo& info = find_lab_info(test);
+  // A test sized by its geometry (the rotating drum) has no particle count: the same drum holds
+  // fewer, larger particles at a larger scale factor by itself.
+  bool counted = false;
   double n0 = 300.0;
   for (const auto& d : info.settings)
-    if (d.name == "particles") n0 = d.fallback;
+    if (d.name == "particles") n0 = d.fallback, counted = true;
+  if (axis == StudyAxis::kParticles && !counted)
+    throw InputError("study",
+                     "lab test '" + test + "' has no particle count: it follows from its geometry");
   if (auto it = settings.find("particles"); it != settings.end()) n0 = it->second;
   StudyResult r;
   r.axis = axis;
@@ -30,14 +36,14 @@ StudyResult run_study(const std::string& test, const MaterialModel& material,
       m.scale_factor = v;
       // The same real system: particles fewer by the cube of the length factor.
       const double l = contact::scale_factors(m.scaling, v).length;
-      s["particles"] = std::max(20.0, std::round(n0 * std::pow(l0 / l, 3)));
+      if (counted) s["particles"] = std::max(20.0, std::round(n0 * std::pow(l0 / l, 3)));
     } else {
       s["particles"] = v;
     }
     StudyRun run;
     run.value = v;
-    run.particles = s["particles"];
     run.metrics = run_lab_test(test, m, s, options).metrics;
+    run.particles = counted ? s["particles"] : run.metrics.at("particles");
     r.runs.push_back(std::move(run));
   }
   for (const auto& [name, last] : r.runs.back().metrics) {

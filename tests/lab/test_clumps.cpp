@@ -32,7 +32,8 @@ Settings short_settings(const std::string& name) {
             {"pre_shear_travel", 1},
             {"torque_ramp_time", 0.05},
             {"consolidation_time", 0.01}};
-  if (name == "rotating_drum") return {{"particles", 40}, {"angle_time", 0.2}, {"area_time", 0.05}};
+  if (name == "rotating_drum")  // a 13 x 6 mm drum holds 49 bodies of 1 mm radius
+    return {{"diameter", 13}, {"length", 6}, {"angle_time", 0.2}, {"area_time", 0.05}};
   return {{"particles", 40}};
 }
 

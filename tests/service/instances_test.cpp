@@ -1,0 +1,183 @@
+// Named test instances: one lab test listed several times under its own names (one drum per wall
+// surface, as seed 001 Table 2), each with its own settings and wall law and each a response of
+// its own ("<name>.<metric>"). Checked through the spec parser, the coordinator's planning, and
+// a small campaign run end to end by the embedded `demcal run`.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "client/spec_yaml.hpp"
+#include "core/common/error.hpp"
+#include "server/convert.hpp"
+#include "tests/service/process.hpp"
+
+namespace demcal::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Two small drums of 57 spheres (14 x 6 mm, D/d = 7): `drum_ptfe` with a slippery wall law of
+/// its own, `drum_coated` with the material's (the particle law, §4.2 of seed 001).
+std::string drums_spec() {
+  return R"(
+name: drums
+material:
+  particle_law:
+    normal: {model: hertz, youngs_modulus: 5.0e6, restitution: 0.3}
+    tangential: {model: history, mu_s: 0.5}
+  sizes: {monodisperse: {radius: 0.001}}
+  density: 2500
+tests:
+  - name: drum_ptfe
+    test: rotating_drum
+    settings: {diameter: 14, length: 6, rpm: 20, angle_time: 0.2, area_time: 0.05}
+    wall_law:
+      normal: {model: hertz, youngs_modulus: 5.0e6, restitution: 0.3}
+      tangential: {model: history, mu_s: 0.1}
+  - name: drum_coated
+    test: rotating_drum
+    settings: {diameter: 14, length: 6, rpm: 20, angle_time: 0.2, area_time: 0.05}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.3, high: 0.7, name: mu_s}
+  - {path: particle_law.normal.restitution, low: 0.2, high: 0.5, name: e}
+design: {type: full_factorial}
+measurements:
+  - {test: drum_ptfe, metric: dynamic_angle_of_repose, value: 31.9, uncertainty: 0.5}
+  - {test: drum_coated, metric: dynamic_angle_of_repose, value: 34.6, uncertainty: 0.5}
+)";
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+TEST(TestInstances, SpecParserReadsNamesAndOwnWallLaws) {
+  const auto file = cli::parse_campaign_spec(drums_spec(), "drums.yaml");
+  ASSERT_EQ(file.spec.tests_size(), 2);
+  EXPECT_EQ(file.spec.tests(0).name(), "drum_ptfe");
+  EXPECT_EQ(file.spec.tests(0).test(), "rotating_drum");
+  // The wall law's parameters, written next to `model`, land in the slot's map.
+  EXPECT_EQ(file.spec.tests(0).wall_law().tangential().params().at("mu_s"), 0.1);
+  EXPECT_FALSE(file.spec.tests(1).has_wall_law());
+  // A misspelt field of an instance is an error with its file, line and path.
+  try {
+    cli::parse_campaign_spec(replaced(drums_spec(), "    wall_law:", "    wal_law:"), "drums.yaml");
+    ADD_FAILURE() << "wal_law accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("drums.yaml:14: tests[0].wal_law"), std::string::npos)
+        << e.what();
+  }
+  // JSON has no NaN: a NaN or an infinity in the YAML is refused with its line, not read as 0.
+  for (const char* bad : {"NaN", "inf", "-inf"}) {
+    try {
+      cli::parse_campaign_spec(
+          replaced(drums_spec(), "mu_s: 0.1}", std::string("mu_s: ") + bad + "}"), "drums.yaml");
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("drums.yaml:15: tests[0].wall_law.tangential.mu_s"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(TestInstances, EachInstanceIsAResponseAndAJobOfItsOwn) {
+  const auto file = cli::parse_campaign_spec(drums_spec(), "drums.yaml");
+  std::vector<server::NewJob> jobs;
+  const auto plan = server::plan_campaign(file.spec, jobs);
+  EXPECT_EQ(plan.tests, (std::vector<std::string>{"drum_ptfe", "drum_coated"}));
+  const auto has = [&](const std::string& r) {
+    return std::find(plan.responses.begin(), plan.responses.end(), r) != plan.responses.end();
+  };
+  EXPECT_TRUE(has("drum_ptfe.dynamic_angle_of_repose"));
+  EXPECT_TRUE(has("drum_coated.csa_occupied_116"));
+  EXPECT_FALSE(has("rotating_drum.dynamic_angle_of_repose"));
+  ASSERT_EQ(plan.targets.size(), 2u);
+  EXPECT_EQ(plan.targets[0].response, "drum_ptfe.dynamic_angle_of_repose");
+  EXPECT_EQ(plan.targets[1].response, "drum_coated.dynamic_angle_of_repose");
+  // 4 runs x 2 instances; the job row carries the instance, the payload the lab test and the
+  // instance's wall law.
+  ASSERT_EQ(jobs.size(), 8u);
+  std::map<std::string, double> wall_mu;
+  for (const auto& job : jobs) {
+    v1::JobSpec spec;
+    server::from_json(job.payload, spec);
+    EXPECT_EQ(spec.test(), "rotating_drum");
+    wall_mu[job.test] = spec.material().has_wall_law()
+                            ? spec.material().wall_law().tangential().params().at("mu_s")
+                            : -1.0;
+  }
+  EXPECT_EQ(wall_mu.at("drum_ptfe"), 0.1);
+  EXPECT_EQ(wall_mu.at("drum_coated"), -1.0);  // the material's: a copy of the particle law
+}
+
+TEST(TestInstances, BadInstancesAreRefusedNamingTheField) {
+  struct Case {
+    std::string from, to, field;
+  };
+  const std::vector<Case> cases = {
+      {"name: drum_coated", "name: drum_ptfe", "spec.tests[1].name"},
+      {"name: drum_coated", "name: drum.coated", "spec.tests[1].name"},
+      {"tangential: {model: history, mu_s: 0.1}", "tangential: {model: history, mu_s: -1}",
+       "spec.tests[0].wall_law.tangential"},
+      {"diameter: 14, length: 6, rpm: 20, angle_time: 0.2, area_time: 0.05}\n    wall_law",
+       "diameter: 400, length: 6, rpm: 20, angle_time: 0.2, area_time: 0.05}\n    wall_law",
+       "spec.tests[0].settings.max_particles"},
+      {"{path: particle_law.normal.restitution, low: 0.2, high: 0.5, name: e}",
+       "{path: wall_law.normal.restitution, low: 0.2, high: 0.5, name: e}", ""},
+  };
+  for (const auto& c : cases) {
+    const auto file = cli::parse_campaign_spec(replaced(drums_spec(), c.from, c.to), "d.yaml");
+    std::vector<server::NewJob> jobs;
+    if (c.field.empty()) {  // a wall-law factor varies every instance's wall law: accepted
+      EXPECT_NO_THROW(server::plan_campaign(file.spec, jobs)) << c.to;
+      continue;
+    }
+    try {
+      server::plan_campaign(file.spec, jobs);
+      ADD_FAILURE() << c.to << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(c.field, 0), 0u) << c.field << " vs " << e.what();
+    }
+  }
+}
+
+TEST(TestInstances, EmbeddedRunReportsEachInstanceAsItsOwnMetric) {
+  const fs::path dir = fs::temp_directory_path() / ("demcal_instances_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string spec = (dir / "drums.yaml").string();
+  std::ofstream(spec) << drums_spec();
+  Process run({DEMCAL_CLI_BIN, "run", spec, "--workdir", (dir / "work").string(), "--workers", "2",
+               "--threads", "1"},
+              (dir / "run.log").string());
+  ASSERT_EQ(run.wait_exit(200), 0) << run.log();
+  const std::string out = run.log();
+  for (const char* header : {"== drum_ptfe.dynamic_angle_of_repose (4 of 4 runs) ==",
+                             "== drum_coated.dynamic_angle_of_repose (4 of 4 runs) ==",
+                             "== drum_ptfe.csa_occupied_116 (4 of 4 runs) =="})
+    EXPECT_NE(out.find(header), std::string::npos) << header << "\n" << out;
+  EXPECT_NE(out.find("verification: done (2 jobs)"), std::string::npos) << out;
+  // The jobs table holds 4 design runs + 1 verification per instance, under the instance names.
+  std::map<std::string, int> by_test;
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open_v2((dir / "work/campaign.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr),
+            SQLITE_OK);
+  sqlite3_stmt* st = nullptr;
+  sqlite3_prepare_v2(db, "SELECT test, COUNT(*) FROM jobs WHERE state = 'done' GROUP BY test", -1,
+                     &st, nullptr);
+  while (st && sqlite3_step(st) == SQLITE_ROW)
+    by_test[reinterpret_cast<const char*>(sqlite3_column_text(st, 0))] = sqlite3_column_int(st, 1);
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  EXPECT_EQ(by_test, (std::map<std::string, int>{{"drum_coated", 5}, {"drum_ptfe", 5}})) << out;
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace demcal::test
