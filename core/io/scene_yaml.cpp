@@ -125,12 +125,17 @@ particles::SizeDistribution read_size_distribution(const YamlNode& n) {
 }
 
 Scene read_scene(const YamlNode& root) {
-  root.expect_only({"threads", "seed", "time_step", "time_step_safety", "skin", "gravity", "domain",
-                    "density", "contact_law", "wall_contact_law", "walls", "particles", "phases"});
+  root.expect_only({"threads", "particles_per_thread", "seed", "time_step", "time_step_safety",
+                    "skin", "gravity", "domain", "density", "contact_law", "wall_contact_law",
+                    "walls", "particles", "phases"});
   Scene scene;
   sim::World& w = scene.world;
   w.threads = static_cast<int>(root.number("threads", 1));
   if (w.threads < 1) root["threads"].fail("must be >= 1");
+  const double per_thread = root.number("particles_per_thread", sim::World::kParticlesPerThread);
+  if (!(per_thread >= 1 && per_thread <= 1e9))
+    root["particles_per_thread"].fail("must be in [1, 1e9]");
+  w.particles_per_thread = static_cast<int>(per_thread);
   Rng rng(static_cast<std::uint64_t>(root.number("seed", 1)));
   w.skin = root.number("skin", 0.0);
   if (auto g = root.child("gravity")) w.gravity = g->as_vec3();

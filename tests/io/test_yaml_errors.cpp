@@ -76,6 +76,10 @@ TEST(IoYamlErrors, ValidSceneReads) {
   EXPECT_EQ(s.world.dt, 1e-6);
   ASSERT_EQ(s.phases.size(), 1u);
   EXPECT_EQ(s.phases[0].steps, 10);
+  EXPECT_EQ(s.world.particles_per_thread, sim::World::kParticlesPerThread);
+  const Scene fine = read_scene(YamlNode::load_string(
+      with_line(kScene, 1, "threads: 2\nparticles_per_thread: 1"), "spec.yaml"));
+  EXPECT_EQ(fine.world.particles_per_thread, 1);
 }
 
 TEST(IoYamlErrors, SceneUnknownField) {
@@ -115,6 +119,11 @@ TEST(IoYamlErrors, SceneParameterOutOfRange) {
       with_line(kScene, 7, "  normal: {model: luding, k1: 1.0e4, k2_ratio: 0.5, phi_f: 0.05}"));
   expect_contains(k2, "spec.yaml:7");
   expect_contains(k2, "contact_law.normal.k2_ratio");
+
+  const std::string grain =
+      scene_error(with_line(kScene, 1, "threads: 2\nparticles_per_thread: 0"));
+  expect_contains(grain, "spec.yaml:2");
+  expect_contains(grain, "particles_per_thread");
 
   const std::string density = scene_error(with_line(kScene, 5, "density: -1"));
   expect_contains(density, "spec.yaml:5");
