@@ -1,5 +1,6 @@
 // packing (seed 000 §2.7.1, §3.1): cohesionless mono-sized pouring gives 0.57-0.64; frictionless
-// spheres pour to random close packing, frictional ones looser; every method runs; with van der Waals cohesion the solid fraction falls as the particle size falls (Fig. 14).
+// spheres pour to random close packing, frictional ones looser; every method runs; with van der
+// Waals cohesion the solid fraction falls as the particle size falls (Fig. 14).
 #include <gtest/gtest.h>
 
 #include <cstdint>
