@@ -221,7 +221,7 @@ void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
     o->set_uncertainty(t.uncertainty.value_or(0.0));
     o->set_noise_sd(t.noise_sd);
     o->set_noise_df(l.noise_df[m]);
-    const double tol = std::hypot(t.uncertainty.value_or(0.0), t.noise_sd);
+    const double tol = calib::tolerance(t);
     o->set_tolerance(tol);
     if (proposal) {
       const auto& p = proposal->metrics[m];

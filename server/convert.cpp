@@ -318,12 +318,12 @@ std::vector<NewJob> design_jobs(const v1::CampaignSpec& spec, const CampaignPlan
                                 int stage_offset) {
   std::vector<NewJob> jobs;
   const auto& design = plan.design;
+  const bool pinned = spec.design().simulation_seeds() == v1::Design::PINNED;
   for (int r = 0; r < design.runs(); ++r) {
     std::map<std::string, double> parameters;
     for (std::size_t f = 0; f < box.size(); ++f)
       parameters[box[f].path] = box[f].factor.to_natural(design.coded(r, Eigen::Index(f)));
     for (const auto& t : spec.tests()) {
-      const bool pinned = spec.design().simulation_seeds() == v1::Design::PINNED;
       const std::uint64_t seed = design_seed(t, spec.design(), design, r) +
                                  (pinned ? 0 : static_cast<std::uint64_t>(stage_offset));
       v1::JobSpec job = instance_job(spec, t, spec.material(), parameters, seed);

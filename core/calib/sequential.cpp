@@ -144,7 +144,7 @@ std::string not_within(const SequentialState& state, const VerifiedRound* best,
   const auto m = std::size_t(score.worst_metric);
   const auto& t = state.targets[m];
   const double sim = (*best->simulated)(Eigen::Index(m));
-  const double tol = tolerance(metric_target(t));
+  const double tol = tolerance(t);
   return "not within uncertainty after " + spent(state) + ": at the best round " + t.name +
          " simulated " + statement_number(sim) + " against " + statement_number(t.target) +
          ", off by " + statement_number(sim - t.target) +
@@ -194,13 +194,17 @@ void SequentialOptions::validate(const std::string& where) const {
   if (max_jobs < 0) throw InputError(where + ".max_jobs", "must be >= 0");
 }
 
+double tolerance(const SequentialTarget& target) {
+  return tolerance(metric_target(target));
+}
+
 PointScore score_point(const std::vector<SequentialTarget>& targets,
                        const Eigen::VectorXd& simulated) {
   PointScore s;
   s.deviation.resize(Eigen::Index(targets.size()));
   s.within = true;
   for (std::size_t m = 0; m < targets.size(); ++m) {
-    const double tol = tolerance(metric_target(targets[m]));
+    const double tol = tolerance(targets[m]);
     const double miss = std::abs(simulated(Eigen::Index(m)) - targets[m].target);
     // A failed metric (NaN) counts as infinitely far.
     const double d = std::isfinite(miss)

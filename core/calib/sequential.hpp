@@ -49,6 +49,9 @@ struct SequentialTarget {
   double noise_sd = 0.0;
 };
 
+/// Its tolerance, as calib::tolerance(const MetricTarget&): sqrt(uncertainty^2 + noise_sd^2).
+double tolerance(const SequentialTarget& target);
+
 /// One simulated stage design: its box and its runs (coded in that box), one response column
 /// per target (NaN = failed or not yet done).
 struct StageRuns {

@@ -11,8 +11,9 @@ namespace demcal::doe {
 
 namespace {
 
-// FrF2 catalogue catlg entries, copied from the FrF2 oracle, tests/data/doe-oracle/catlg_ranking.txt
-// (FrF2 2.3.4): {runs, factors} -> {entry, generating columns}.
+// FrF2 catalogue catlg entries, copied from the FrF2 oracle,
+// tests/data/doe-oracle/catlg_ranking.txt (FrF2 2.3.4): {runs, factors} -> {entry, generating
+// columns}.
 const std::map<std::pair<int, int>, std::pair<const char*, const char*>>& catalogue() {
   static const std::map<std::pair<int, int>, std::pair<const char*, const char*>> entries{
       {{32, 12}, {"12-7.1", "ABC ABD ACD BCD ABE ACE ADE"}},

@@ -1,5 +1,6 @@
 // Peer test: LIGGGHTS 3.8 (Debian's `liggghts`) and `demcal contact` run the same single-contact
-// experiments (the scripts of tests/data/liggghts/, copied from the shared peer folder) and must agree to 1e-6 relative.
+// experiments (the scripts of tests/data/liggghts/, copied from the shared peer folder) and must
+// agree to 1e-6 relative.
 #include <gtest/gtest.h>
 
 #include <array>
