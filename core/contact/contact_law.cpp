@@ -79,6 +79,27 @@ double ContactLaw::max_stiffness(double r_eff) const {
   return std::visit([&](const auto& n) { return n.max_stiffness(r_eff); }, normal);
 }
 
+double ContactLaw::reached_stiffness(double r_eff, double delta_max) const {
+  return std::visit(
+      [&](const auto& n) {
+        if constexpr (requires { n.reached_stiffness(r_eff, delta_max); })
+          return n.reached_stiffness(r_eff, delta_max);
+        else
+          return n.max_stiffness(r_eff);
+      },
+      normal);
+}
+
+bool ContactLaw::keeps_reached_overlap() const {
+  return std::visit(
+      [](const auto& n) {
+        return requires {
+          n.reached_stiffness(1.0, 0.0);
+        };
+      },
+      normal);
+}
+
 ContactLaw ContactLaw::from_spec(const ContactLawSpec& spec, const std::string& where) {
   return {make_model<NormalModel>(spec.normal, where + ".normal"),
           make_model<CohesionModel>(spec.cohesion, where + ".cohesion"),

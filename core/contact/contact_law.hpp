@@ -47,6 +47,12 @@ struct ContactLaw {
   /// Largest stiffness a contact of effective radius r_eff = 2 R* can reach (N/m), for the
   /// sqrt(m/k) time-step bound.
   double max_stiffness(double r_eff) const;
+  /// Largest stiffness a contact can present once its overlap has reached delta_max (N/m): below
+  /// max_stiffness() for a normal model whose un-/reloading stiffness grows with the overlap
+  /// (Luding); max_stiffness() for the others.
+  double reached_stiffness(double r_eff, double delta_max) const;
+  /// True when the normal model keeps the largest overlap reached as history[0] (Luding).
+  bool keeps_reached_overlap() const;
   /// Builds a law from its spec; errors name the field path below `where`.
   static ContactLaw from_spec(const ContactLawSpec& spec, const std::string& where);
 };

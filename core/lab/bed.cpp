@@ -65,7 +65,8 @@ void fill_region(sim::World& w, particles::InsertRequest req, Rng& rng, double s
     } catch (const InputError&) {
       if (round == rounds) throw;
     }
-    w.dt = sim::recommended_time_step(w, safety);
+    w.adaptive_safety = safety;
+    w.dt = sim::adapted_time_step(w, safety);
     if (w.particles.units() == goal) return;
     sim::run(w, std::max<long>(1, std::lround(pause / w.dt)));
   }
@@ -387,7 +388,7 @@ PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, 
   const double top = metrics_top(w);
   b.limits = die_limits(w, b.radius, top);
   b.piston = add_piston(w, 1e3 * top + 1.0);
-  w.dt = sim::recommended_time_step(w, safety);
+  w.dt = sim::adapted_time_step(w, safety);
   b.settled = settle(w, spec, b.limits);
   b.h0 = metrics_top(w);
   auto& disk = std::get<walls::Disk>(w.walls[b.piston].shape);

@@ -17,9 +17,19 @@ double RunCost::particle_steps_per_second() const {
 void RunCost::close(const sim::World& world) {
   time_step = world.dt;
   const sim::TimeStepLimit limit = sim::critical_time_step(world);
-  char text[256];
-  std::snprintf(text, sizeof text, "%.3g x %s (%.4g s)", world.dt / limit.critical,
-                limit.basis.c_str(), limit.critical);
+  char text[384];
+  if (world.adaptive_safety > 0.0) {
+    const sim::TimeStepLimit reached = sim::reached_time_step(world);
+    std::snprintf(text, sizeof text,
+                  "re-tuned every %d steps to %.3g x %s at the overlaps reached (%.4g s), at most "
+                  "%.3g x its largest stiffness's bound (%.4g s); at the end %.3g x the latter",
+                  sim::World::kRetuneSteps, world.adaptive_safety, reached.basis.c_str(),
+                  reached.critical, sim::kStableFraction, limit.critical,
+                  world.dt / limit.critical);
+  } else {
+    std::snprintf(text, sizeof text, "%.3g x %s (%.4g s)", world.dt / limit.critical,
+                  limit.basis.c_str(), limit.critical);
+  }
   time_step_limit = text;
   particles = world.particles.size();
   steps = 0;

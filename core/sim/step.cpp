@@ -7,6 +7,7 @@
 #include "core/integrate/rigid_body.hpp"
 #include "core/integrate/velocity_verlet.hpp"
 #include "core/sim/forces.hpp"
+#include "core/sim/time_step.hpp"
 
 namespace demcal::sim {
 namespace {
@@ -72,6 +73,8 @@ void step(World& w) {
 
   w.time += w.dt;
   ++w.step_count;
+  if (w.adaptive_safety > 0.0 && w.step_count % World::kRetuneSteps == 0)
+    w.dt = adapted_time_step(w, w.adaptive_safety);
 }
 
 void run(World& w, std::int64_t steps) {

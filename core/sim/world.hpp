@@ -19,7 +19,11 @@ class World {
   std::vector<walls::Wall> walls;
   Domain domain;
   Vec3 gravity{0.0, 0.0, -9.81};
-  double dt = 0.0;    ///< time step (s)
+  double dt = 0.0;  ///< time step (s)
+  /// > 0: step() re-tunes dt to sim::adapted_time_step(*this, adaptive_safety) every
+  /// kRetuneSteps steps, following the stiffness the contacts have reached; 0: dt stays as set.
+  double adaptive_safety = 0.0;
+  static constexpr int kRetuneSteps = 100;
   double skin = 0.0;  ///< Verlet skin (m); 0 = 10 % of the smallest particle radius
   int threads = 1;    ///< OpenMP threads at most; see active_threads()
   /// The fewest particles a thread is given: a smaller system runs on fewer threads than asked.

@@ -16,6 +16,7 @@
 // Eq. 8 of seed 000 writes the effective mass as 2 m_i m_j / (m_i + m_j); with that mass eq. 7
 // would not give restitution e, so the reduced mass m* = m_i m_j / (m_i + m_j) is used, as LIGGGHTS
 // does. History: [0] delta_max (m).
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -57,7 +58,20 @@ struct Luding {
   double loading_stiffness(double r_eff) const {
     return is_set(k1) ? k1 : (4.0 / 3.0) * youngs_modulus * r_eff * std::sqrt(delta_prime);
   }
-  double max_stiffness(double r_eff) const { return k2_ratio * loading_stiffness(r_eff); }
+  /// delta*_max of eq. 4: the overlap beyond which un-/reloading has the full k2.
+  double plastic_limit(double r_eff) const { return k2_ratio / (k2_ratio - 1.0) * phi_f * r_eff; }
+  /// The largest slope of the force-overlap curve: k2 (eq. 10) or kc (eq. 11), whichever is larger.
+  double max_stiffness(double r_eff) const {
+    return std::max(k2_ratio, kc_ratio) * loading_stiffness(r_eff);
+  }
+  /// The largest slope a contact whose overlap has reached delta_max can present: the loading k1,
+  /// the un-/reloading k2*(delta_max) of eq. 5 or the adhesive kc. Under a light load k2* stays
+  /// near k1, a step bounded by k2 alone would be f1^(1/2) times shorter than the contacts need.
+  double reached_stiffness(double r_eff, double delta_max) const {
+    const double kl = loading_stiffness(r_eff);
+    const double k2 = kl + (k2_ratio - 1.0) * kl * std::min(1.0, delta_max / plastic_limit(r_eff));
+    return std::max(k2, kc_ratio * kl);
+  }
   double damping(double m_star, double k) const {
     if (restitution >= 1.0) return 0.0;
     const double q = M_PI / std::log(restitution);
@@ -72,7 +86,7 @@ struct Luding {
     const double delta = in.delta;
     double& delta_max = history[0];
     if (delta > delta_max) delta_max = delta;
-    const double delta_lim = k2_max / (k2_max - kl) * phi_f * r_eff;
+    const double delta_lim = plastic_limit(r_eff);
 
     double f_hys;
     if (delta_max >= delta_lim) {
