@@ -560,7 +560,7 @@
       .then((text) => {
         if (text !== state.last) {
           state.last = text;
-          render(JSON.parse(text));
+          (page.mode === 'index' ? renderIndex : render)(JSON.parse(text));
         }
         document.getElementById('demcal-status').setAttribute('data-polls', String(Number(document.getElementById('demcal-status').getAttribute('data-polls') || 0) + 1));
       })
@@ -568,8 +568,24 @@
       .finally(() => setTimeout(poll, page.interval));
   }
 
+  // The live index: one line per campaign with its progress, linking to its live page (the
+  // token fragment carried along).
+  function renderIndex(list) {
+    const root = document.getElementById('report');
+    root.textContent = '';
+    root.appendChild(el('h1', {}, 'demcal campaigns'));
+    const rows = (list.campaigns || []).map((c) => {
+      const p = c.progress || {};
+      return [
+        el('td', {}, el('a', { href: '/campaigns/' + c.id + window.location.hash }, String(c.id))),
+        c.name, String(c.state).toLowerCase(), (Number(p.done || 0) + Number(p.failed || 0)) + ' of ' + (Number(p.total || 0) - Number(p.cancelled || 0)), String(p.leased || 0), c.created_at,
+      ];
+    });
+    root.appendChild(table(['id', 'name', 'state', 'finished jobs', 'running', 'created'], rows));
+  }
+
   function start() {
-    if (page.mode === 'live') {
+    if (page.mode === 'live' || page.mode === 'index') {
       poll();
     } else {
       render(JSON.parse(document.getElementById('demcal-data').textContent));
