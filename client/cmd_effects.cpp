@@ -3,6 +3,7 @@
 // demand. The liggghts format writes the calibrated material as a LIGGGHTS input fragment.
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <thread>
 

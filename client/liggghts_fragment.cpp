@@ -233,13 +233,21 @@ void cohesion_notes(Writer& w, const Law& l) {
                 "only in contact); the fragment has no cohesion");
 }
 
-/// "model hertz tangential history [rolling_friction cdt] [limitForce on] ...".
+/// "model hertz tangential history [rolling_friction cdt]".
 std::string model_words(const Law& l, const std::string& rolling) {
   std::string s = "model " + liggghts_normal(l.normal.model) + " tangential history";
-  if (rolling != "none") s += " rolling_friction " + (rolling == "epsd" ? std::string("epsd2") : rolling);
-  if (l.normal.model != "luding" && l.normal.at("clip_attraction") != 0) s += " limitForce on";
+  if (rolling != "none")
+    s += " rolling_friction " + (rolling == "epsd" ? std::string("epsd2") : rolling);
+  return s;
+}
+
+/// The model's options ("limitForce on tangential_damping off"): they follow the model words
+/// in pair_style, but the wall geometry in fix wall/gran.
+std::string model_options(const Law& l) {
+  std::string s;
+  if (l.normal.model != "luding" && l.normal.at("clip_attraction") != 0) s += "limitForce on";
   if (l.normal.model == "hertz" && l.tangential.at("gamma_t_ratio") == 0.0)
-    s += " tangential_damping off";
+    s += std::string(s.empty() ? "" : " ") + "tangential_damping off";
   return s;
 }
 
@@ -259,7 +267,8 @@ LiggghtsFragment liggghts_fragment(v1::Material material,
   w.comment(title);
   w.comment("LIGGGHTS 3.8 input fragment written by `demcal export --format liggghts`; units si.");
   w.comment("Include it after `create_box 2 ...` (atom type 1: particles, type 2: the walls'");
-  w.comment("material) and use ${demcal_wall_model} in fix wall/gran ... type 2 (docs/report.md).");
+  w.comment("material); walls: fix ID all wall/gran ${demcal_wall_model} <geometry> type 2");
+  w.comment("${demcal_wall_options} (docs/report.md).");
   if (p.normal.model != wl.normal.model)
     w.unsupported("particle law '" + p.normal.model + "' and wall law '" + wl.normal.model +
                   "' differ: each has its own model line but share the property tables");
@@ -279,8 +288,13 @@ LiggghtsFragment liggghts_fragment(v1::Material material,
   w.command("variable demcal_radius equal " + num(radius),
             "m: typical particle radius of material.sizes (gamman is exact for it)");
   w.command("variable demcal_wall_model string \"" + model_words(wl, p.rolling.model) + "\"",
-            "wall_law: fix wall/gran ${demcal_wall_model} ... type 2");
-  w.command("pair_style gran " + model_words(p, p.rolling.model), "particle_law");
+            "wall_law: fix wall/gran ${demcal_wall_model} <geometry> type 2 ...");
+  w.command("variable demcal_wall_options string \"" + model_options(wl) + "\"",
+            "wall_law: ... <geometry> ${demcal_wall_options}");
+  const std::string options = model_options(p);
+  w.command("pair_style gran " + model_words(p, p.rolling.model) + (options.empty() ? "" : " ") +
+                options,
+            "particle_law");
   w.command("pair_coeff * *", "every type pair from the property tables above");
   return w.done();
 }

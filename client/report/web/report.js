@@ -159,7 +159,7 @@
         },
       ],
       resolve: { scale: { color: 'independent' } },
-    }, 'Points: |effect| of every alias chain against half-normal quantiles; dashed lines: Lenth ME (orange) and SME (red). Seed 000 Figs. 15-16.');
+    }, 'Points: |effect| of every alias chain against half-normal quantiles (Daniel 1959); dashed lines: Lenth (1989) ME (orange) and SME (red). Not a figure of seed 000, which reads its effects from main-effect plots only.');
   }
 
   function paretoPlot(parent, m) {
@@ -246,7 +246,7 @@
         ],
       },
       resolve: { scale: { y: 'shared' } },
-    }, 'Mean response at the low and high level of each factor (line) and at the centre points (red diamond, where the design has them). Seed 000 Figs. 17-18, 24-25.');
+    }, 'Mean response at the low and high level of each factor (line) and at the centre points (red diamond, where the design has them), as seed 000 Figs. 15, 18-22 and 24-26.');
     return true;
   }
 
@@ -280,7 +280,7 @@
         y: { aggregate: 'mean', field: 'value', type: 'quantitative', title: 'mean', scale: { zero: false } },
         color: { field: 'trace', type: 'nominal', title: null },
       },
-    }, 'Mean response over ' + labels[pair.a] + ' at each level of ' + labels[pair.b] + '; non-parallel lines show the interaction (aliased as ' + pair.chain + '). Seed 000 Figs. 19-20, 26.');
+    }, 'Mean response over ' + labels[pair.a] + ' at each level of ' + labels[pair.b] + '; non-parallel lines show the interaction (aliased as ' + pair.chain + '). Not a figure of seed 000, which fits 2FIs (§2.5.2) but plots none.');
   }
 
   // ---- sections ----
@@ -338,7 +338,7 @@
   }
 
   function effectsSection(root, data) {
-    const s = section(root, 'effects', 'Effects per metric', 'Effects E = mean(high) - mean(low) per alias chain, Lenth significance (seed 000 §2.5.2, Figs. 15-26; demcal effects --format json).');
+    const s = section(root, 'effects', 'Effects per metric', 'Effects E = mean(high) - mean(low) per alias chain (seed 000 §2.5.2) with Lenth significance, as `demcal effects --format json` gives them; main-effect plots as seed 000 Figs. 15, 18-22, 24-26.');
     if (!data.effects) {
       note(s, 'No effects yet: ' + (data.notes.effects || 'the design runs are not finished'));
       return;
@@ -487,7 +487,7 @@
       const ts = el('div', { class: 'lab', 'data-test': name });
       s.appendChild(ts);
       ts.appendChild(el('h3', {}, name + ' (' + t.test + ')'));
-      note(ts, 'Curves not shown: the coordinator stores a job\'s metrics, not its time series (stress-strain cycles, yield locus and Mohr circles, drum profile, mass-time). `demcal lab run` with the same settings writes them as CSV.');
+      note(ts, 'Curves not shown: the coordinator stores a job\'s metrics, not its time series (stress-strain cycles as seed 000 Fig. 8, yield locus with Mohr circles as Fig. 23, drum profile, hopper mass-time). `demcal lab run` with the same settings writes them as CSV.');
       const values = [];
       for (const job of data.export.jobs) {
         if (job.test !== name || job.state !== 'done') continue;
