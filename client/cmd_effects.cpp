@@ -30,10 +30,9 @@ std::string liggghts_export(v1::CampaignService::Stub& stub, const proto::Channe
                                            campaign.spec().fixed().end());
   for (int i = 0; i < cal.factor_paths_size(); ++i)
     parameters[cal.factor_paths(i)] = cal.proposed_values(i);
-  const std::string title = "demcal campaign " + std::to_string(id) + " '" + campaign.name() +
-                            "': the calibrated set (" +
-                            (cal.conclusion().empty() ? cal.verification_state() : cal.conclusion()) +
-                            ")";
+  const std::string title =
+      "demcal campaign " + std::to_string(id) + " '" + campaign.name() + "': the calibrated set (" +
+      (cal.conclusion().empty() ? cal.verification_state() : cal.conclusion()) + ")";
   const LiggghtsFragment f = liggghts_fragment(campaign.spec().material(), parameters, title);
   for (const auto& w : f.warnings) std::cerr << "demcal: warning: " << w << "\n";
   return f.text;
@@ -103,8 +102,9 @@ void add_analysis_commands(CLI::App& app) {
   });
 
   auto* exp = app.add_subcommand(
-      "export", "The campaign's design and results (csv or json), or its calibrated material as "
-                "a LIGGGHTS input fragment (liggghts)");
+      "export",
+      "The campaign's design and results (csv or json), or its calibrated material as "
+      "a LIGGGHTS input fragment (liggghts)");
   add_connection_options(*exp, o->channel);
   exp->add_option("id", o->id, "campaign id")->required();
   exp->add_option("--format", o->format, "csv, json or liggghts")

@@ -40,7 +40,8 @@ std::int64_t campaign_id(const std::string& text) {
   try {
     return std::stoll(text);
   } catch (const std::exception&) {
-    throw CLI::ValidationError("campaign", "'" + text + "' is neither a spec file nor a campaign id");
+    throw CLI::ValidationError("campaign",
+                               "'" + text + "' is neither a spec file nor a campaign id");
   }
 }
 
@@ -62,9 +63,10 @@ void run(const ReportOptions& o) {
 
 void add_report_command(CLI::App& app) {
   auto o = std::make_shared<ReportOptions>();
-  auto* cmd = app.add_subcommand(
-      "report", "Write a self-contained report.html: design, effect plots, envelopes, "
-                "calibration, diagnosis");
+  auto* cmd =
+      app.add_subcommand("report",
+                         "Write a self-contained report.html: design, effect plots, envelopes, "
+                         "calibration, diagnosis");
   add_connection_options(*cmd, o->channel);
   cmd->add_option("campaign", o->campaign, "campaign id, or a spec YAML (embedded default)")
       ->required();

@@ -47,7 +47,8 @@ void apply(v1::Material& m, const std::string& path, double value) {
   if (path == "size_scale") return m.set_size_scale(value);
   const auto a = path.find('.'), b = path.find('.', a + 1);
   const std::string law = path.substr(0, a);
-  if (a == std::string::npos || b == std::string::npos || (law != "particle_law" && law != "wall_law"))
+  if (a == std::string::npos || b == std::string::npos ||
+      (law != "particle_law" && law != "wall_law"))
     throw InputError(path, "not a contact-law parameter the LIGGGHTS export knows");
   v1::ContactLaw* l = law == "particle_law" ? m.mutable_particle_law() : m.mutable_wall_law();
   const std::string slot = path.substr(a + 1, b - a - 1), param = path.substr(b + 1);
@@ -161,7 +162,8 @@ void linear_properties(Writer& w, const Law& p, const Law& wl, double radius, do
   w.pair("demcal_kn", "kn", p.normal.at("kn"), wl.normal.at("kn"),
          "N/m: particle_law / wall_law .normal.kn");
   w.pair("demcal_kt", "kt", p.tangential.at("kt_ratio") * p.normal.at("kn"),
-         wl.tangential.at("kt_ratio") * wl.normal.at("kn"), "N/m: .tangential.kt_ratio x .normal.kn");
+         wl.tangential.at("kt_ratio") * wl.normal.at("kn"),
+         "N/m: .tangential.kt_ratio x .normal.kn");
   w.pair("demcal_gn", "gamman", gpp, gpw,
          "1/s: 2 .normal.damping_ratio sqrt(kn/m*), m* of two spheres (wall: one) of radius " +
              num(radius) + " m");
@@ -169,23 +171,24 @@ void linear_properties(Writer& w, const Law& p, const Law& wl, double radius, do
          wl.tangential.at("gamma_t_ratio") * gpw, "1/s: .tangential.gamma_t_ratio x gamman");
   for (const Law* l : {&p, &wl})
     if (l->normal.at("damp_approach_only") != 0)
-      w.unsupported(l->name + ".normal.damp_approach_only = 1: LIGGGHTS hooke/stiffness damps "
+      w.unsupported(l->name +
+                    ".normal.damp_approach_only = 1: LIGGGHTS hooke/stiffness damps "
                     "throughout the contact, so its restitution is lower than demcal's");
 }
 
 void luding_properties(Writer& w, const Law& p, const Law& wl) {
   for (const Law* l : {&p, &wl})
     if (std::isnan(l->normal.at("k1")))
-      w.unsupported(l->name + ".normal.k1 from youngs_modulus (eq. 3) depends on the pair's "
+      w.unsupported(l->name +
+                    ".normal.k1 from youngs_modulus (eq. 3) depends on the pair's "
                     "radius; LIGGGHTS needs LoadingStiffness: set k1");
-  w.pair("demcal_k1", "LoadingStiffness", p.normal.at("k1"), wl.normal.at("k1"),
-         "N/m: .normal.k1");
+  w.pair("demcal_k1", "LoadingStiffness", p.normal.at("k1"), wl.normal.at("k1"), "N/m: .normal.k1");
   w.pair("demcal_k2", "UnloadingStiffness", p.normal.at("k2_ratio"), wl.normal.at("k2_ratio"),
          "-: .normal.k2_ratio (k2/k1)");
   w.pair("demcal_kc", "coefficientAdhesionStiffness", p.normal.at("kc_ratio"),
          wl.normal.at("kc_ratio"), "-: .normal.kc_ratio (kc/k1)");
-  w.pair("demcal_phif", "coefficientPlasticityDepth", p.normal.at("phi_f"),
-         wl.normal.at("phi_f"), "-: .normal.phi_f");
+  w.pair("demcal_phif", "coefficientPlasticityDepth", p.normal.at("phi_f"), wl.normal.at("phi_f"),
+         "-: .normal.phi_f");
   w.pair("demcal_e", "coefficientRestitution", p.normal.at("restitution"),
          wl.normal.at("restitution"), "-: .normal.restitution");
   w.pair("demcal_f0", "pullOffForce", 0.0, 0.0, "N: none in demcal (Luding's f0 = 0)");
@@ -202,8 +205,8 @@ void tangential_properties(Writer& w, const Law& p, const Law& wl) {
       w.unsupported(l->name + ".tangential.kt_ratio = " + num(l->tangential.at("kt_ratio")) +
                     ": LIGGGHTS hertz uses kt = 8 G* sqrt(R* delta), demcal's kt_ratio 1");
     if (l->normal.model != "linear" && l->tangential.at("gamma_t_ratio") != 0.0)
-      w.unsupported(l->name + ".tangential.gamma_t_ratio = " +
-                    num(l->tangential.at("gamma_t_ratio")) +
+      w.unsupported(l->name +
+                    ".tangential.gamma_t_ratio = " + num(l->tangential.at("gamma_t_ratio")) +
                     ": LIGGGHTS' tangential damping follows its own law");
   }
 }
@@ -211,15 +214,18 @@ void tangential_properties(Writer& w, const Law& p, const Law& wl) {
 void rolling_properties(Writer& w, const Law& p, const Law& wl) {
   const bool any = p.rolling.model != "none" || wl.rolling.model != "none";
   if (!any) return;
-  const auto mu = [](const Law& l) { return l.rolling.model == "none" ? 0.0 : l.rolling.at("mu_r"); };
+  const auto mu = [](const Law& l) {
+    return l.rolling.model == "none" ? 0.0 : l.rolling.at("mu_r");
+  };
   w.pair("demcal_mur", "coefficientRollingFriction", mu(p), mu(wl),
          "-: particle_law / wall_law .rolling.mu_r");
   if (p.rolling.model != wl.rolling.model)
-    w.unsupported("rolling: particle law '" + p.rolling.model + "', wall law '" +
-                  wl.rolling.model + "'; the fragment uses the particle law's model for both");
+    w.unsupported("rolling: particle law '" + p.rolling.model + "', wall law '" + wl.rolling.model +
+                  "'; the fragment uses the particle law's model for both");
   for (const Law* l : {&p, &wl})
     if (l->rolling.model == "epsd")
-      w.unsupported(l->name + ".rolling epsd: LIGGGHTS' epsd2 sets its rolling stiffness as "
+      w.unsupported(l->name +
+                    ".rolling epsd: LIGGGHTS' epsd2 sets its rolling stiffness as "
                     "2.25 kn mu_r^2 R*^2, demcal's as kr_ratio (" +
                     num(l->rolling.at("kr_ratio")) + ") x k_ref");
 }
@@ -292,9 +298,9 @@ LiggghtsFragment liggghts_fragment(v1::Material material,
   w.command("variable demcal_wall_options string \"" + model_options(wl) + "\"",
             "wall_law: ... <geometry> ${demcal_wall_options}");
   const std::string options = model_options(p);
-  w.command("pair_style gran " + model_words(p, p.rolling.model) + (options.empty() ? "" : " ") +
-                options,
-            "particle_law");
+  w.command(
+      "pair_style gran " + model_words(p, p.rolling.model) + (options.empty() ? "" : " ") + options,
+      "particle_law");
   w.command("pair_coeff * *", "every type pair from the property tables above");
   return w.done();
 }

@@ -38,8 +38,7 @@ std::string bearer_token(const httplib::Request& req) {
 bool same_token(const std::string& got, const std::string& expected) {
   unsigned diff = got.size() == expected.size() ? 0u : 1u;
   for (std::size_t i = 0; i < expected.size(); ++i)
-    diff |= static_cast<unsigned>(i < got.size() ? got[i] : 0) ^
-            static_cast<unsigned>(expected[i]);
+    diff |= static_cast<unsigned>(i < got.size() ? got[i] : 0) ^ static_cast<unsigned>(expected[i]);
   return diff == 0;
 }
 
@@ -84,7 +83,8 @@ HttpPage::HttpPage(std::shared_ptr<grpc::Channel> coordinator, HttpPageOptions o
   server_ = make_server(options_);
   routes();
   const auto [host, port] = split_address(options_.listen);
-  port_ = port == 0 ? server_->bind_to_any_port(host) : (server_->bind_to_port(host, port) ? port : -1);
+  port_ =
+      port == 0 ? server_->bind_to_any_port(host) : (server_->bind_to_port(host, port) ? port : -1);
   if (port_ <= 0) throw std::runtime_error("--http: cannot listen on " + options_.listen);
   thread_ = std::thread([this] { server_->listen_after_bind(); });
   spdlog::info("live report page on http{}://{}:{}/{}", options_.tls_cert.empty() ? "" : "s", host,
@@ -109,13 +109,13 @@ void HttpPage::routes() {
   server_->Get("/", [api](const httplib::Request&, httplib::Response& res) {
     res.set_content(report::live_index_html(api), "text/html; charset=utf-8");
   });
-  server_->Get(R"(/campaigns/(\d+))", [this, api](const httplib::Request& req,
-                                                   httplib::Response& res) {
-    const std::int64_t id = std::stoll(req.matches[1]);
-    res.set_content(report::live_report_html(id, api + "/" + std::to_string(id) + "/report.json",
-                                             options_.poll_ms),
-                    "text/html; charset=utf-8");
-  });
+  server_->Get(
+      R"(/campaigns/(\d+))", [this, api](const httplib::Request& req, httplib::Response& res) {
+        const std::int64_t id = std::stoll(req.matches[1]);
+        res.set_content(report::live_report_html(
+                            id, api + "/" + std::to_string(id) + "/report.json", options_.poll_ms),
+                        "text/html; charset=utf-8");
+      });
   server_->Get(api, [this](const httplib::Request& req, httplib::Response& res) {
     serve_json(req, res, 0);
   });

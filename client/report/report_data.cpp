@@ -65,8 +65,7 @@ json report_data(v1::CampaignService::StubInterface& stub, const proto::ChannelO
   get.set_id(id);
 
   v1::Campaign campaign;
-  required([&] { return stub.Get(proto::make_context(ch, 60).get(), get, &campaign); },
-           "campaign");
+  required([&] { return stub.Get(proto::make_context(ch, 60).get(), get, &campaign); }, "campaign");
   doc["campaign"] = as_json(campaign);
 
   v1::DesignReply design;

@@ -91,8 +91,8 @@ std::string script_safe_json(const json& j) {
 }
 
 std::string static_report_html(const json& data) {
-  const std::string title = "demcal report: campaign " + std::to_string(data.value("id", 0)) +
-                            " " + data["campaign"].value("name", "");
+  const std::string title = "demcal report: campaign " + std::to_string(data.value("id", 0)) + " " +
+                            data["campaign"].value("name", "");
   return page(title, {{"mode", "static"}}, script_safe_json(data));
 }
 

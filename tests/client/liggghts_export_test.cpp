@@ -62,7 +62,8 @@ region box block -0.01 0.01 -0.005 0.005 -0.005 0.005 units box
 create_box 2 box
 neighbor 0.0005 bin
 neigh_modify delay 0
-include )" + fragment_file +
+include )" +
+         fragment_file +
          R"(
 timestep 1.0e-7
 fix floor all wall/gran ${demcal_wall_model} primitive type 2 zplane -0.004 ${demcal_wall_options}
@@ -129,14 +130,14 @@ class LiggghtsExport : public ::testing::Test {
 };
 
 TEST_F(LiggghtsExport, HertzFragmentRunsAndGivesDemcalsRestitution) {
-  const auto m = material(slot("hertz", {{"youngs_modulus", 1e7}, {"poisson_ratio", 0.3},
-                                         {"restitution", 0.5}}));
+  const auto m = material(
+      slot("hertz", {{"youngs_modulus", 1e7}, {"poisson_ratio", 0.3}, {"restitution", 0.5}}));
   std::string log;
   cli::LiggghtsFragment f;
   const double e = liggghts_restitution(m, "hertz", log, f);
   ASSERT_TRUE(std::isfinite(e)) << f.text << "\n" << log;
-  const double expected =
-      demcal_restitution("{model: hertz, youngs_modulus: 1.0e7, poisson_ratio: 0.3, restitution: 0.5}");
+  const double expected = demcal_restitution(
+      "{model: hertz, youngs_modulus: 1.0e7, poisson_ratio: 0.3, restitution: 0.5}");
   EXPECT_NEAR(e, expected, 1e-6 * expected) << f.text;
   EXPECT_NE(f.text.find("pair_style gran model hertz tangential history"), std::string::npos);
   EXPECT_NE(f.text.find("particle_law.normal.youngs_modulus"), std::string::npos);
@@ -144,10 +145,9 @@ TEST_F(LiggghtsExport, HertzFragmentRunsAndGivesDemcalsRestitution) {
 
 TEST_F(LiggghtsExport, LinearFragmentRunsAndGivesDemcalsRestitution) {
   // Damping throughout the contact and no clipping: what LIGGGHTS' hooke/stiffness does.
-  const auto m = material(slot("linear", {{"kn", 1e4},
-                                          {"damping_ratio", 0.2},
-                                          {"damp_approach_only", 0},
-                                          {"clip_attraction", 0}}));
+  const auto m = material(slot(
+      "linear",
+      {{"kn", 1e4}, {"damping_ratio", 0.2}, {"damp_approach_only", 0}, {"clip_attraction", 0}}));
   std::string log;
   cli::LiggghtsFragment f;
   const double e = liggghts_restitution(m, "linear", log, f);

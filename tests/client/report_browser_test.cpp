@@ -26,8 +26,8 @@
 namespace {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 using demcal::test::Process;
+using nlohmann::json;
 
 const std::string kToken = "report-test-token";
 
@@ -109,8 +109,8 @@ std::map<std::string, std::map<std::string, int>> marks_per_plot(const std::stri
   std::map<std::string, std::map<std::string, int>> out;
   const std::regex plot_re("<div class=\"plot\" data-plot=\"([^\"]*)\"");
   std::vector<std::pair<std::size_t, std::string>> starts;
-  for (auto it = std::sregex_iterator(dom.begin(), dom.end(), plot_re); it != std::sregex_iterator();
-       ++it)
+  for (auto it = std::sregex_iterator(dom.begin(), dom.end(), plot_re);
+       it != std::sregex_iterator(); ++it)
     starts.push_back({std::size_t(it->position()), unescape((*it)[1].str())});
   const std::regex group_re("<g class=\"mark-([a-z]+) role-mark[^\"]*\"[^>]*>");
   const std::regex item_re("<(path|line|rect|text)[ >]");
@@ -126,9 +126,8 @@ std::map<std::string, std::map<std::string, int>> marks_per_plot(const std::stri
       const std::size_t from = std::size_t(g->position() + g->length());
       const std::size_t to = chunk.find("</g>", from);
       const std::string items = chunk.substr(from, to - from);
-      const int n = static_cast<int>(
-          std::distance(std::sregex_iterator(items.begin(), items.end(), item_re),
-                        std::sregex_iterator()));
+      const int n = static_cast<int>(std::distance(
+          std::sregex_iterator(items.begin(), items.end(), item_re), std::sregex_iterator()));
       counts[(*g)[1].str()] += n;
       counts[""] += n;
     }
@@ -158,7 +157,8 @@ void expect_effects_in_page(const std::string& dom, const json& effects) {
           << metric << " " << field;
     const std::size_t end = dom.find("<div class=\"metric\"", at + 1);
     const std::string section = dom.substr(at, end == std::string::npos ? dom.npos : end - at);
-    const std::regex cell("<td class=\"num effect\" data-chain=\"([^\"]*)\" data-value=\"([^\"]*)\">([^<]*)</td>");
+    const std::regex cell(
+        "<td class=\"num effect\" data-chain=\"([^\"]*)\" data-value=\"([^\"]*)\">([^<]*)</td>");
     std::map<std::string, std::pair<double, double>> shown;
     for (auto it = std::sregex_iterator(section.begin(), section.end(), cell);
          it != std::sregex_iterator(); ++it)
@@ -235,9 +235,9 @@ class ReportBrowser : public ::testing::Test {
     return std::string(DEMCAL_SOURCE_DIR) + "/" + rel;
   }
   static Output cli(const std::string& args, bool merge = true) {
-    return run(std::string(DEMCAL_CLI_BIN) + " " + args + " --coordinator " + grpc_ +
-                   " --token " + kToken,
-               merge);
+    return run(
+        std::string(DEMCAL_CLI_BIN) + " " + args + " --coordinator " + grpc_ + " --token " + kToken,
+        merge);
   }
   static httplib::Result get(const std::string& path, const std::string& token) {
     httplib::Client c("127.0.0.1", http_port_);
