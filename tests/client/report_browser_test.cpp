@@ -107,7 +107,7 @@ std::string unescape(std::string s) {
 /// type ("symbol", "rect", "line", ...; "" = every type), axes and legends not counted.
 std::map<std::string, std::map<std::string, int>> marks_per_plot(const std::string& dom) {
   std::map<std::string, std::map<std::string, int>> out;
-  const std::regex plot_re("<div class=\"plot\" data-plot=\"([^\"]*)\"");
+  const std::regex plot_re("<div class=\"plot[^\"]*\" data-plot=\"([^\"]*)\"");
   std::vector<std::pair<std::size_t, std::string>> starts;
   for (auto it = std::sregex_iterator(dom.begin(), dom.end(), plot_re);
        it != std::sregex_iterator(); ++it)
@@ -213,7 +213,9 @@ class ReportBrowser : public ::testing::Test {
     http_port_ = read_port(dir_ / "http_port");
     const Output sub = cli("submit " + source("examples/packing_demo_campaign.yaml"));
     ASSERT_EQ(sub.exit_code, 0) << sub.out;
-    id_ = std::stoll(std::regex_replace(sub.out, std::regex("^campaign (\\d+)[^]*"), "$1"));
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(sub.out, m, std::regex("campaign (\\d+) submitted"))) << sub.out;
+    id_ = std::stoll(m[1].str());
     for (int w = 1; w <= 2; ++w)
       workers_.push_back(std::make_unique<Process>(
           std::vector<std::string>{DEMCAL_WORKER_BIN, "--coordinator", grpc_, "--token", kToken,

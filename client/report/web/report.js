@@ -127,7 +127,7 @@
     }));
     plot(parent, 'half-normal:' + m.metric, {
       title: 'Half-normal plot of effects: ' + m.metric,
-      width: 420, height: 260,
+      width: 330, height: 260,
       layer: [
         {
           data: { values: points },
@@ -166,7 +166,7 @@
     const bars = m.effects.map((e) => ({ chain: e.chain, abs_effect: Math.abs(e.effect), effect: e.effect, significance: significance(e) }));
     plot(parent, 'pareto:' + m.metric, {
       title: 'Pareto chart of effects: ' + m.metric,
-      width: 420, height: Math.max(120, 18 * bars.length),
+      width: 330, height: Math.max(120, 18 * bars.length),
       layer: [
         {
           data: { values: bars },
@@ -278,7 +278,7 @@
       encoding: {
         x: { field: 'x', type: 'quantitative', title: labels[pair.a] + ' (coded)', scale: { domain: [-1.2, 1.2] }, axis: { values: [-1, 1] } },
         y: { aggregate: 'mean', field: 'value', type: 'quantitative', title: 'mean', scale: { zero: false } },
-        color: { field: 'trace', type: 'nominal', title: null },
+        color: { field: 'trace', type: 'nominal', title: null, legend: { orient: 'bottom', direction: 'vertical', labelLimit: 300 } },
       },
     }, 'Mean response over ' + labels[pair.a] + ' at each level of ' + labels[pair.b] + '; non-parallel lines show the interaction (aliased as ' + pair.chain + '). Not a figure of seed 000, which fits 2FIs (§2.5.2) but plots none.');
   }
@@ -370,7 +370,7 @@
       mainEffectsPlot(ms, m.metric, rows, labels);
       const pairs = interactionPairs(m, labels.length);
       if (pairs.length) {
-        const ig = el('div', { class: 'grid' });
+        const ig = el('div', { class: 'grid small' });
         ms.appendChild(ig);
         for (const pair of pairs) interactionPlot(ig, m.metric, rows, labels, pair);
       }
