@@ -202,8 +202,9 @@ void tangential_properties(Writer& w, const Law& p, const Law& wl) {
       w.unsupported(l->name + ".tangential.mu_d_ratio = " + num(l->tangential.at("mu_d_ratio")) +
                     ": LIGGGHTS' tangential history has one friction coefficient (mu_s used)");
     if (l->normal.model == "hertz" && std::abs(l->tangential.at("kt_ratio") - 1.0) > 1e-12)
-      w.unsupported(l->name + ".tangential.kt_ratio = " + num(l->tangential.at("kt_ratio")) +
-                    ": LIGGGHTS hertz uses kt = 8 G* sqrt(R* delta), which is demcal's kt_ratio = 1");
+      w.unsupported(
+          l->name + ".tangential.kt_ratio = " + num(l->tangential.at("kt_ratio")) +
+          ": LIGGGHTS hertz uses kt = 8 G* sqrt(R* delta), which is demcal's kt_ratio = 1");
     if (l->normal.model != "linear" && l->tangential.at("gamma_t_ratio") != 0.0)
       w.unsupported(l->name +
                     ".tangential.gamma_t_ratio = " + num(l->tangential.at("gamma_t_ratio")) +

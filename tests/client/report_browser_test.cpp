@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -323,6 +324,51 @@ TEST_F(ReportBrowser, LivePageDataNeedTheTokenAndTheIndexListsTheCampaign) {
   // Read-only: nothing but GET is served.
   httplib::Client c("127.0.0.1", http_port_);
   EXPECT_NE(c.Post(report_path().c_str(), "{}", "application/json")->status, 200);
+}
+
+// The calibrated set of the campaign as a LIGGGHTS fragment: the proposed values in the
+// property tables, the warning on standard error, and LIGGGHTS parses and runs it.
+TEST_F(ReportBrowser, ExportLiggghtsWritesTheCalibratedSetAndLiggghtsRunsIt) {
+  const fs::path dir = dir_ / "liggghts";
+  fs::create_directories(dir);
+  const Output o = cli("export " + std::to_string(id_) + " --format liggghts -o " +
+                       (dir / "material.liggghts").string());
+  ASSERT_EQ(o.exit_code, 0) << o.out;
+  EXPECT_NE(o.out.find("demcal: warning: particle_law.tangential.kt_ratio"), std::string::npos)
+      << o.out;
+  const std::string fragment = read_text(dir / "material.liggghts");
+  const json cal =
+      json::parse(cli("calibrate " + std::to_string(id_) + " --format json", false).out);
+  std::ostringstream mu;
+  mu << std::setprecision(10) << cal["proposed"]["particle_law.tangential.mu_s"].get<double>();
+  EXPECT_NE(fragment.find("coefficientFriction peratomtypepair 2 " + mu.str()), std::string::npos)
+      << fragment;
+  EXPECT_NE(fragment.find("pair_style gran model hertz tangential history"), std::string::npos);
+  std::ofstream(dir / "in.check") << R"(atom_style granular
+atom_modify map array
+boundary f f f
+newton off
+communicate single vel yes
+units si
+region box block -0.01 0.01 -0.01 0.01 -0.01 0.01 units box
+create_box 2 box
+neighbor 0.0002 bin
+include material.liggghts
+timestep 1.0e-7
+fix floor all wall/gran ${demcal_wall_model} primitive type 2 zplane -0.005 ${demcal_wall_options}
+create_atoms 1 single 0.0 0.0 0.0 units box
+create_atoms 1 single 0.0 0.0 0.0011 units box
+set group all diameter $(2*v_demcal_radius)
+set group all density ${demcal_density}
+fix integr all nve/sphere
+fix grav all gravity 9.81 vector 0.0 0.0 -1.0
+run 2000
+print "RESULT ran"
+)";
+  const Output lig =
+      run("cd '" + dir.string() + "' && script -qc 'liggghts -in in.check' /dev/null");
+  EXPECT_NE(lig.out.find("RESULT ran"), std::string::npos) << lig.out;
+  EXPECT_EQ(lig.out.find("ERROR"), std::string::npos) << lig.out;
 }
 
 }  // namespace
