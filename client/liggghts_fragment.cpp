@@ -1,5 +1,6 @@
 #include "client/liggghts_fragment.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <set>
@@ -141,6 +142,14 @@ void hertz_properties(Writer& w, const Law& p, const Law& wl) {
                   "gets the wall law's Y as it is");
     y2 = yw;
   }
+  // LIGGGHTS refuses Young's moduli outside [5e6, 1e9] Pa in SI units unless told.
+  const double lo = std::min(y1, y2), hi = std::max(y1, y2);
+  if (lo < 5e6)
+    w.command("soft_particles yes",
+              "LIGGGHTS: allow youngsModulus < 5e6 Pa (here " + num(lo) + ")");
+  if (hi > 1e9)
+    w.command("hard_particles yes",
+              "LIGGGHTS: allow youngsModulus > 1e9 Pa (here " + num(hi) + ")");
   w.type("demcal_Y", "youngsModulus", y1, y2,
          "Pa: particle_law.normal.youngs_modulus; type 2 so that the mixed Y* equals "
          "wall_law.normal's");

@@ -180,6 +180,19 @@ TEST_F(LiggghtsExport, WhatLiggghtsCannotExpressIsSaidAndTheFragmentStillRuns) {
   EXPECT_NE(f.text.find("coefficientRollingFriction"), std::string::npos);
 }
 
+// LIGGGHTS refuses moduli below 5e6 Pa in SI units unless the fragment says soft_particles.
+TEST_F(LiggghtsExport, SoftParticlesAreAllowedWhereTheModulusNeedsIt) {
+  const auto m = material(slot("hertz", {{"youngs_modulus", 1e6}, {"restitution", 0.5}}));
+  std::string log;
+  cli::LiggghtsFragment f;
+  const double e = liggghts_restitution(m, "soft", log, f);
+  ASSERT_TRUE(std::isfinite(e)) << f.text << "\n" << log;
+  EXPECT_NE(f.text.find("soft_particles yes"), std::string::npos);
+  EXPECT_EQ(cli::liggghts_fragment(material(slot("hertz", {{"youngs_modulus", 1e7}})), {}, "t")
+                .text.find("soft_particles"),
+            std::string::npos);
+}
+
 TEST_F(LiggghtsExport, CalibratedValuesReplaceTheSpecsAndUnknownPathsAreRefused) {
   const auto m = material(slot("hertz", {{"youngs_modulus", 1e7}, {"restitution", 0.5}}));
   const auto f = cli::liggghts_fragment(m, {{"particle_law.tangential.mu_s", 0.37}}, "t");
