@@ -306,6 +306,12 @@ TEST_F(ReportBrowser, LivePageFollowsTheCampaignAndDrawsTheSameReport) {
   expect_every_plot_drawn(page, effects_, 2 * 6 + 2 + 2 + 1);
   expect_effects_in_page(page.dom, effects_);
   EXPECT_NE(page.dom.find("Live page"), std::string::npos);
+  // The page kept polling its JSON (every 3 s within Chromium's 15 s of virtual time).
+  const std::size_t s = page.dom.find("id=\"demcal-status\"");
+  ASSERT_NE(s, std::string::npos);
+  const std::string polls = attribute(page.dom.substr(page.dom.rfind('<', s), 300), "data-polls");
+  ASSERT_FALSE(polls.empty());
+  EXPECT_GE(std::stoi(polls), 2);
   screenshot(url, dir_ / "live.png");
 }
 
