@@ -302,7 +302,7 @@ LiggghtsFragment liggghts_fragment(v1::Material material,
   w.command("variable demcal_density equal " + num(material.density()),
             "kg/m^3: material.density (set density of the particles)");
   w.command("variable demcal_radius equal " + num(radius),
-            "m: typical particle radius of material.sizes (gamman is exact for it)");
+            "m: typical particle radius of material.sizes (size-dependent values are for it)");
   w.command("variable demcal_wall_model string \"" + model_words(wl, p.rolling.model) + "\"",
             "wall_law: fix wall/gran ${demcal_wall_model} <geometry> type 2 ...");
   w.command("variable demcal_wall_options string \"" + model_options(wl) + "\"",
