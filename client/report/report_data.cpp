@@ -34,6 +34,61 @@ json optional(const Call& call, const std::string& what, json& notes) {
   return nullptr;
 }
 
+v1::Campaign read_campaign(v1::CampaignService::StubInterface& stub,
+                           const proto::ChannelOptions& ch, std::int64_t id) {
+  v1::GetRequest get;
+  get.set_id(id);
+  v1::Campaign campaign;
+  required([&] { return stub.Get(proto::make_context(ch, 60).get(), get, &campaign); }, "campaign");
+  return campaign;
+}
+
+json read_design(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
+                 std::int64_t id) {
+  v1::GetRequest get;
+  get.set_id(id);
+  v1::DesignReply design;
+  required([&] { return stub.GetDesign(proto::make_context(ch, 60).get(), get, &design); },
+           "design");
+  return as_json(design);
+}
+
+/// The Export reply's content is itself the JSON document `demcal export --format json` prints.
+json read_export(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
+                 std::int64_t id) {
+  v1::ExportRequest req;
+  req.set_id(id);
+  req.set_format("json");
+  v1::ExportReply exported;
+  required([&] { return stub.Export(proto::make_context(ch, 120).get(), req, &exported); },
+           "export");
+  return json::parse(exported.content());
+}
+
+/// The request `demcal effects ID --format json` sends: model 2fi, alpha 0.05 (the defaults).
+json read_effects(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
+                  std::int64_t id, json& notes) {
+  v1::EffectsRequest req;
+  req.set_id(id);
+  return optional<v1::EffectsReply>(
+      [&](v1::EffectsReply& r) {
+        return stub.GetEffects(proto::make_context(ch, kDeadlineSeconds).get(), req, &r);
+      },
+      "effects", notes);
+}
+
+/// Without verify: the proposal and the rounds so far, nothing queued.
+json read_calibration(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
+                      std::int64_t id, json& notes) {
+  v1::CalibrateRequest req;
+  req.set_id(id);
+  return optional<v1::CalibrateReply>(
+      [&](v1::CalibrateReply& r) {
+        return stub.Calibrate(proto::make_context(ch, kDeadlineSeconds).get(), req, &r);
+      },
+      "calibration", notes);
+}
+
 bool has_diagnosis_jobs(const json& exported) {
   for (const auto& j : exported.value("jobs", json::array()))
     if (j.value("kind", "").rfind("diagnose:", 0) == 0) return true;
@@ -61,47 +116,16 @@ json report_data(v1::CampaignService::StubInterface& stub, const proto::ChannelO
                  std::int64_t id) {
   json doc = {{"id", id}, {"notes", json::object()}};
   json& notes = doc["notes"];
-  v1::GetRequest get;
-  get.set_id(id);
-
-  v1::Campaign campaign;
-  required([&] { return stub.Get(proto::make_context(ch, 60).get(), get, &campaign); }, "campaign");
+  const v1::Campaign campaign = read_campaign(stub, ch, id);
   doc["campaign"] = as_json(campaign);
-
-  v1::DesignReply design;
-  required([&] { return stub.GetDesign(proto::make_context(ch, 60).get(), get, &design); },
-           "design");
-  doc["design"] = as_json(design);
-
-  v1::ExportRequest ex;
-  ex.set_id(id);
-  ex.set_format("json");
-  v1::ExportReply exported;
-  required([&] { return stub.Export(proto::make_context(ch, 120).get(), ex, &exported); },
-           "export");
-  doc["export"] = json::parse(exported.content());
-
-  v1::EffectsRequest eff;
-  eff.set_id(id);
-  doc["effects"] = optional<v1::EffectsReply>(
-      [&](v1::EffectsReply& r) {
-        return stub.GetEffects(proto::make_context(ch, kDeadlineSeconds).get(), eff, &r);
-      },
-      "effects", notes);
-
-  if (campaign.spec().measurements_size() == 0) {
-    doc["calibration"] = nullptr;
+  doc["design"] = read_design(stub, ch, id);
+  doc["export"] = read_export(stub, ch, id);
+  doc["effects"] = read_effects(stub, ch, id, notes);
+  doc["calibration"] = nullptr;
+  if (campaign.spec().measurements_size() == 0)
     notes["calibration"] = "no measurements in the spec: nothing to calibrate against";
-  } else {
-    v1::CalibrateRequest cal;
-    cal.set_id(id);
-    doc["calibration"] = optional<v1::CalibrateReply>(
-        [&](v1::CalibrateReply& r) {
-          return stub.Calibrate(proto::make_context(ch, kDeadlineSeconds).get(), cal, &r);
-        },
-        "calibration", notes);
-  }
-
+  else
+    doc["calibration"] = read_calibration(stub, ch, id, notes);
   doc["diagnosis"] = nullptr;
   if (has_diagnosis_jobs(doc["export"]))
     doc["diagnosis"] = read_diagnosis(stub, ch, id, notes);
