@@ -67,16 +67,18 @@ struct Page {
   std::vector<std::string> console;
 };
 
-std::string chromium_flags() {
+std::string chromium_flags(const fs::path& dir) {
   // Root in a container: no sandbox. Virtual time lets the page's timers (the live page's
-  // poll) and Vega's asynchronous rendering finish before the DOM is taken.
+  // poll) and Vega's asynchronous rendering finish before the DOM is taken. A profile of its
+  // own: no lock shared with a browser the user runs.
   return "chromium --headless --no-sandbox --disable-gpu --hide-scrollbars "
-         "--enable-logging=stderr --v=0 --virtual-time-budget=15000 ";
+         "--enable-logging=stderr --v=0 --virtual-time-budget=15000 --user-data-dir=" +
+         (dir / "chromium-profile").string() + " ";
 }
 
 Page open_in_chromium(const std::string& url, const fs::path& dir, const std::string& name) {
   const fs::path err = dir / (name + ".chromium.log");
-  const Output o = run(chromium_flags() + "--dump-dom '" + url + "' 2>" + err.string(), false);
+  const Output o = run(chromium_flags(dir) + "--dump-dom '" + url + "' 2>" + err.string(), false);
   Page page{o.out, {}};
   std::istringstream log(read_text(err));
   for (std::string line; std::getline(log, line);)
@@ -85,8 +87,8 @@ Page open_in_chromium(const std::string& url, const fs::path& dir, const std::st
 }
 
 void screenshot(const std::string& url, const fs::path& png) {
-  run(chromium_flags() + "--window-size=1280,4200 --screenshot=" + png.string() + " '" + url +
-      "' 2>/dev/null");
+  run(chromium_flags(png.parent_path()) + "--window-size=1280,4200 --screenshot=" + png.string() +
+      " '" + url + "' 2>/dev/null");
 }
 
 std::string attribute(const std::string& tag, const std::string& name) {
