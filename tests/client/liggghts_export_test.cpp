@@ -180,6 +180,29 @@ TEST_F(LiggghtsExport, WhatLiggghtsCannotExpressIsSaidAndTheFragmentStillRuns) {
   EXPECT_NE(f.text.find("coefficientRollingFriction"), std::string::npos);
 }
 
+// Luding's normal law and EPSD rolling resistance have LIGGGHTS counterparts (model luding,
+// rolling_friction epsd2): the fragment parses and runs, the stiffness law of EPSD warned.
+TEST_F(LiggghtsExport, LudingWithEpsdRollingParsesAndRuns) {
+  auto m = material(slot(
+      "luding",
+      {{"k1", 1e4}, {"k2_ratio", 5}, {"kc_ratio", 0.5}, {"phi_f", 0.05}, {"restitution", 0.5}}));
+  *m.mutable_particle_law()->mutable_rolling() = slot("epsd", {{"mu_r", 0.1}});
+  std::string log;
+  cli::LiggghtsFragment f;
+  const double e = liggghts_restitution(m, "luding", log, f);
+  ASSERT_TRUE(std::isfinite(e)) << f.text << "\n" << log;
+  EXPECT_GT(e, 0.0);
+  EXPECT_NE(f.text.find("pair_style gran model luding tangential history rolling_friction epsd2"),
+            std::string::npos)
+      << f.text;
+  EXPECT_NE(f.text.find("LoadingStiffness peratomtypepair 2 10000"), std::string::npos);
+  EXPECT_EQ(
+      std::count_if(f.warnings.begin(), f.warnings.end(),
+                    [](const std::string& w) { return w.find("epsd2") != std::string::npos; }),
+      2)
+      << f.text;
+}
+
 // LIGGGHTS refuses moduli below 5e6 Pa in SI units unless the fragment says soft_particles.
 TEST_F(LiggghtsExport, SoftParticlesAreAllowedWhereTheModulusNeedsIt) {
   const auto m = material(slot("hertz", {{"youngs_modulus", 1e6}, {"restitution", 0.5}}));
