@@ -78,6 +78,9 @@ HttpPage::HttpPage(std::shared_ptr<grpc::Channel> coordinator, HttpPageOptions o
   if (options_.token.empty() && !is_loopback(options_.listen))
     throw std::invalid_argument("--http beyond loopback needs a token");
   if (options_.poll_ms < 200) throw std::invalid_argument("--http: poll interval below 200 ms");
+  if (options_.tls_cert.empty() && !is_loopback(options_.listen))
+    spdlog::warn("live page on {} without TLS: the bearer token travels in clear text",
+                 options_.listen);
   server_ = make_server(options_);
   routes();
   const auto [host, port] = split_address(options_.listen);
