@@ -1,14 +1,44 @@
 // `demcal effects ID [--format table|csv|json]`, `demcal calibrate ID [--verify [--wait]]`,
-// `demcal export ID [--format csv|json] [-o FILE]`: analysis on the coordinator, on demand.
+// `demcal export ID [--format csv|json|liggghts] [-o FILE]`: analysis on the coordinator, on
+// demand. The liggghts format writes the calibrated material as a LIGGGHTS input fragment.
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <thread>
 
 #include "client/commands.hpp"
+#include "client/liggghts_fragment.hpp"
 #include "client/service_client.hpp"
 
 namespace demcal::cli {
+namespace {
+
+/// The spec's fixed parameters, then the calibrated set, as a LIGGGHTS fragment; what it
+/// cannot export exactly is warned about on standard error.
+std::string liggghts_export(v1::CampaignService::Stub& stub, const proto::ChannelOptions& channel,
+                            std::int64_t id) {
+  v1::GetRequest get;
+  get.set_id(id);
+  v1::Campaign campaign;
+  check(stub.Get(proto::make_context(channel, 60).get(), get, &campaign), "campaign");
+  v1::CalibrateRequest req;
+  req.set_id(id);
+  v1::CalibrateReply cal;
+  check(stub.Calibrate(proto::make_context(channel, 300).get(), req, &cal), "calibrate");
+  std::map<std::string, double> parameters(campaign.spec().fixed().begin(),
+                                           campaign.spec().fixed().end());
+  for (int i = 0; i < cal.factor_paths_size(); ++i)
+    parameters[cal.factor_paths(i)] = cal.proposed_values(i);
+  const std::string title =
+      "demcal campaign " + std::to_string(id) + " '" + campaign.name() + "': the calibrated set (" +
+      (cal.conclusion().empty() ? cal.verification_state() : cal.conclusion()) + ")";
+  const LiggghtsFragment f = liggghts_fragment(campaign.spec().material(), parameters, title);
+  for (const auto& w : f.warnings) std::cerr << "demcal: warning: " << w << "\n";
+  return f.text;
+}
+
+}  // namespace
 
 void add_analysis_commands(CLI::App& app) {
   struct Options {
@@ -71,23 +101,32 @@ void add_analysis_commands(CLI::App& app) {
     print_calibration(std::cout, reply, o->format);
   });
 
-  auto* exp = app.add_subcommand("export", "The campaign's design and results (csv or json)");
+  auto* exp = app.add_subcommand(
+      "export",
+      "The campaign's design and results (csv or json), or its calibrated material as "
+      "a LIGGGHTS input fragment (liggghts)");
   add_connection_options(*exp, o->channel);
   exp->add_option("id", o->id, "campaign id")->required();
-  exp->add_option("--format", o->format, "csv or json")->check(CLI::IsMember({"csv", "json"}));
+  exp->add_option("--format", o->format, "csv, json or liggghts")
+      ->check(CLI::IsMember({"csv", "json", "liggghts"}));
   exp->add_option("-o,--output", o->out, "file (default: standard output)");
   exp->callback([o] {
-    v1::ExportRequest req;
-    req.set_id(o->id);
-    req.set_format(o->format == "table" ? "json" : o->format);
-    v1::ExportReply reply;
-    check(
-        campaign_stub(o->channel)->Export(proto::make_context(o->channel, 120).get(), req, &reply),
-        "export");
-    if (o->out.empty()) {
-      std::cout << reply.content();
+    auto stub = campaign_stub(o->channel);
+    std::string content;
+    if (o->format == "liggghts") {
+      content = liggghts_export(*stub, o->channel, o->id);
     } else {
-      std::ofstream(o->out) << reply.content();
+      v1::ExportRequest req;
+      req.set_id(o->id);
+      req.set_format(o->format == "table" ? "json" : o->format);
+      v1::ExportReply reply;
+      check(stub->Export(proto::make_context(o->channel, 120).get(), req, &reply), "export");
+      content = reply.content();
+    }
+    if (o->out.empty()) {
+      std::cout << content;
+    } else {
+      std::ofstream(o->out) << content;
       std::cerr << "wrote " << o->out << "\n";
     }
   });

@@ -20,6 +20,7 @@ struct RunOptions {
   bool verify = true;
   bool verbose = false;
   std::string format = "table";
+  std::string http;  ///< HOST:PORT of the live report page; empty: none
 };
 
 /// With `--format json` the one JSON document is all that goes to standard output: the
@@ -34,6 +35,8 @@ void run_embedded(const RunOptions& opt) {
   const auto& channel = service.channel();
   text << "work directory: " << workdir.string() << " (SQLite: " << service.db() << ")\n";
   const std::int64_t id = service.submit_or_resume(file, text);
+  if (!opt.http.empty())
+    std::cerr << "live report page: " << service.serve_http(opt.http, id) << std::endl;
   text << std::flush;
   const v1::Progress p = watch_campaign(*stub, channel, id, std::cerr);
   text << "\n" << progress_line(p) << "\n";
@@ -81,6 +84,8 @@ void add_run_command(CLI::App& app) {
   add_local_worker_options(*cmd, o->local);
   cmd->add_flag("!--no-verify", o->verify, "do not simulate the proposed set");
   cmd->add_flag("-v,--verbose", o->verbose, "coordinator and worker logs");
+  cmd->add_option("--http", o->http,
+                  "HOST:PORT: serve the live report page while the campaign runs (docs/report.md)");
   cmd->add_option("--format", o->format,
                   "table, csv (effects) or json (one document: design, effects, calibration)")
       ->check(CLI::IsMember({"table", "csv", "json"}));

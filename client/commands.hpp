@@ -15,5 +15,6 @@ void add_campaign_commands(CLI::App& app);  // list, status, watch, cancel
 void add_analysis_commands(CLI::App& app);  // effects, calibrate, export
 void add_run_command(CLI::App& app);
 void add_diagnose_command(CLI::App& app);
+void add_report_command(CLI::App& app);
 
 }  // namespace demcal::cli

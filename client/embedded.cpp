@@ -64,6 +64,7 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
 }
 
 EmbeddedService::~EmbeddedService() {
+  if (http_) http_->stop();
   flags_.stop = true;
   for (auto& w : workers_) w.join();
   coordinator_->shutdown();
@@ -89,6 +90,18 @@ std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostrea
   out << "campaign " << reply.id() << " '" << file.spec.name() << "'\n";
   print_design_summary(out, reply.design());
   return reply.id();
+}
+
+}  // namespace demcal::cli
+
+namespace demcal::cli {
+
+std::string EmbeddedService::serve_http(const std::string& address, std::int64_t id) {
+  http_ = std::make_unique<server::HttpPage>(coordinator_->in_process_channel(),
+                                             server::HttpPageOptions{address, channel_.token});
+  const std::string host = address.substr(0, address.rfind(':'));
+  return "http://" + host + ":" + std::to_string(http_->port()) + "/campaigns/" +
+         std::to_string(id) + "#token=" + channel_.token;
 }
 
 }  // namespace demcal::cli

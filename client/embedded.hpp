@@ -12,6 +12,7 @@
 #include "client/service_client.hpp"
 #include "client/spec_yaml.hpp"
 #include "server/coordinator.hpp"
+#include "server/http_page.hpp"
 #include "worker/worker.hpp"
 
 namespace demcal::cli {
@@ -41,9 +42,15 @@ class EmbeddedService {
   /// or the spec submitted now (its design summary printed to `out`). Returns its id.
   std::int64_t submit_or_resume(const SpecFile& file, std::ostream& out);
 
+  /// Serves the live report page on `address` (HOST:PORT, loopback or with the embedded
+  /// token) while this service lives. Returns the page's URL of campaign `id`, the token in
+  /// its fragment (never sent to the server by a browser).
+  std::string serve_http(const std::string& address, std::int64_t id);
+
  private:
   std::string db_;
   std::unique_ptr<server::Coordinator> coordinator_;
+  std::unique_ptr<server::HttpPage> http_;
   proto::ChannelOptions channel_;
   worker::StopFlags flags_;
   std::vector<std::thread> workers_;

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   demcal::cli::add_analysis_commands(app);
   demcal::cli::add_run_command(app);
   demcal::cli::add_diagnose_command(app);
+  demcal::cli::add_report_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -34,6 +34,10 @@ class Coordinator {
   ~Coordinator();
   int port() const { return port_; }
   Store& store() { return *store_; }
+  /// A channel to this coordinator's services inside the process (the live report page).
+  std::shared_ptr<grpc::Channel> in_process_channel() {
+    return server_->InProcessChannel(grpc::ChannelArguments());
+  }
   /// Stops accepting calls, ends watches, waits for handlers and stops the reaper.
   void shutdown();
   void wait();

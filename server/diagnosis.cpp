@@ -150,7 +150,8 @@ nlohmann::json report_json(const diagnose::Report& r) {
 
 }  // namespace
 
-v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::uint64_t seed) {
+v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::uint64_t seed,
+                                    bool read_only) {
   v1::DiagnoseReply reply;
   const CampaignPlan plan = plan_from_json(row.design_json);
   v1::CampaignSpec spec;
@@ -175,6 +176,7 @@ v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::u
         jobs_at(spec, switched(spec.material(), req.switches), req.parameters, req.row, kind);
     fresh.insert(fresh.end(), add.begin(), add.end());
   }
+  if (read_only) fresh.clear();
   if (!fresh.empty()) {
     store.add_jobs(row.id, fresh);
     spdlog::info("campaign {}: diagnosis queued {} jobs", row.id, fresh.size());

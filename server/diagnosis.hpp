@@ -9,8 +9,10 @@
 
 namespace demcal::server {
 
-/// Advances the diagnosis of a campaign: queues the runs it needs that are not stored yet and
-/// fills the reply. Throws InputError when the campaign cannot be diagnosed.
-v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::uint64_t seed);
+/// Advances the diagnosis of a campaign: queues the runs it needs that are not stored yet
+/// (unless `read_only`) and fills the reply. Throws InputError when the campaign cannot be
+/// diagnosed.
+v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::uint64_t seed,
+                                    bool read_only = false);
 
 }  // namespace demcal::server

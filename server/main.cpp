@@ -8,10 +8,23 @@
 
 #include "proto/channel.hpp"
 #include "server/coordinator.hpp"
+#include "server/http_page.hpp"
+
+namespace {
+
+/// The port, written atomically (a reader never sees a half-written file).
+void write_port_file(const std::string& path, int port) {
+  if (path.empty()) return;
+  const std::string tmp = path + ".tmp";
+  std::ofstream(tmp) << port << "\n";
+  std::rename(tmp.c_str(), path.c_str());
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   demcal::server::CoordinatorOptions o;
-  std::string port_file, token_file;
+  std::string port_file, token_file, http, http_port_file;
   CLI::App app{"demcal-server - the calibration coordinator (SQLite store, gRPC services)"};
   app.add_option("--listen", o.listen, "address:port (port 0 = any free port)")
       ->capture_default_str();
@@ -30,6 +43,9 @@ int main(int argc, char** argv) {
   app.add_option("--tls-key", o.tls_key, "PEM private key");
   app.add_flag("--insecure", o.insecure, "plain TCP: tokens and data in clear text");
   app.add_option("--port-file", port_file, "write the port listened on to this file");
+  app.add_option("--http", http,
+                 "HOST:PORT of the live report page (read-only, same token; docs/report.md)");
+  app.add_option("--http-port-file", http_port_file, "write the HTTP port to this file");
   CLI11_PARSE(app, argc, argv);
   if (!token_file.empty()) try {
       o.token = demcal::proto::read_token_file(token_file);
@@ -45,14 +61,18 @@ int main(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &set, nullptr);
   try {
     demcal::server::Coordinator coordinator(o);
-    if (!port_file.empty()) {
-      const std::string tmp = port_file + ".tmp";
-      std::ofstream(tmp) << coordinator.port() << "\n";
-      std::rename(tmp.c_str(), port_file.c_str());
+    write_port_file(port_file, coordinator.port());
+    std::unique_ptr<demcal::server::HttpPage> page;
+    if (!http.empty()) {
+      page = std::make_unique<demcal::server::HttpPage>(
+          coordinator.in_process_channel(),
+          demcal::server::HttpPageOptions{http, o.token, o.tls_cert, o.tls_key});
+      write_port_file(http_port_file, page->port());
     }
     int sig = 0;
     sigwait(&set, &sig);
     spdlog::info("signal {}: shutting down", sig);
+    if (page) page->stop();
     coordinator.shutdown();
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());

@@ -231,7 +231,7 @@ grpc::Status CampaignServiceImpl::Diagnose(grpc::ServerContext* ctx, const v1::D
   try {
     // One diagnosis step at a time: two concurrent calls must not queue the same runs twice.
     std::lock_guard lock(diagnose_mutex_);
-    *reply = diagnose_campaign(store_, *row, req->seed());
+    *reply = diagnose_campaign(store_, *row, req->seed(), req->read_only());
     return grpc::Status::OK;
   } catch (const InputError& e) {
     return {grpc::StatusCode::FAILED_PRECONDITION, e.what()};

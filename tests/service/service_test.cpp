@@ -571,9 +571,19 @@ TEST_F(Service, CentrePointsDifferCurvatureIsTestedAndTheCalibrationRoundsAreSho
   EXPECT_GE(status.at("jobs").size(), 6u + rounds.size());
   const auto exported = cli_json(dir_, "export", {"export", ids, "--format", "json"}, channel_);
   EXPECT_EQ(exported.at("calibration_rounds").size(), rounds.size());
+  // A read-only diagnosis (what the report pages ask) reports and queues nothing.
+  const int jobs_before = results(id).jobs_size();
+  v1::DiagnoseRequest read_only;
+  read_only.set_id(id);
+  read_only.set_read_only(true);
+  v1::DiagnoseReply peek;
+  ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), read_only, &peek).ok());
+  EXPECT_EQ(peek.jobs_queued(), 0);
+  EXPECT_EQ(results(id).jobs_size(), jobs_before);
   const auto diagnosis =
       cli_json(dir_, "diagnose", {"diagnose", ids, "--no-wait", "--format", "json"}, channel_);
   EXPECT_TRUE(diagnosis.is_object() && !diagnosis.empty()) << diagnosis.dump();
+  EXPECT_GT(results(id).jobs_size(), jobs_before) << "the diagnosis proper queues its runs";
 }
 
 TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {

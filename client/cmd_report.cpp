@@ -1,0 +1,81 @@
+// `demcal report CAMPAIGN -o DIR`: one self-contained report.html (docs/report.md) of a
+// campaign on a coordinator (an id) or of a spec on the embedded default (its design is run
+// first when the work directory has no finished campaign of that name). The page carries its
+// data and its charting libraries inline: it opens without network.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include "client/commands.hpp"
+#include "client/embedded.hpp"
+#include "client/report/report_data.hpp"
+#include "client/report/report_html.hpp"
+
+namespace demcal::cli {
+namespace {
+
+struct ReportOptions {
+  proto::ChannelOptions channel;
+  std::string campaign;
+  std::string out_dir = ".";
+  std::string workdir;
+  LocalWorkers local;
+  bool verbose = false;
+  bool data = false;
+};
+
+std::filesystem::path write_report(v1::CampaignService::Stub& stub,
+                                   const proto::ChannelOptions& channel, std::int64_t id,
+                                   const ReportOptions& o) {
+  const nlohmann::json data = report::report_data(stub, channel, id);
+  std::filesystem::create_directories(o.out_dir);
+  const auto html = std::filesystem::path(o.out_dir) / "report.html";
+  std::ofstream(html) << report::static_report_html(data);
+  if (o.data) std::ofstream(std::filesystem::path(o.out_dir) / "report.json") << data.dump(1);
+  return html;
+}
+
+std::int64_t campaign_id(const std::string& text) {
+  try {
+    return std::stoll(text);
+  } catch (const std::exception&) {
+    throw CLI::ValidationError("campaign",
+                               "'" + text + "' is neither a spec file nor a campaign id");
+  }
+}
+
+void run(const ReportOptions& o) {
+  std::filesystem::path html;
+  if (std::filesystem::is_regular_file(o.campaign)) {
+    const SpecFile file = read_campaign_spec(o.campaign);
+    EmbeddedService service(work_directory(o.campaign, o.workdir), o.local, o.verbose);
+    const std::int64_t id = service.submit_or_resume(file, std::cerr);
+    watch_campaign(service.stub(), service.channel(), id, std::cerr);
+    html = write_report(service.stub(), service.channel(), id, o);
+  } else {
+    html = write_report(*campaign_stub(o.channel), o.channel, campaign_id(o.campaign), o);
+  }
+  std::cout << std::filesystem::absolute(html).string() << "\n";
+}
+
+}  // namespace
+
+void add_report_command(CLI::App& app) {
+  auto o = std::make_shared<ReportOptions>();
+  auto* cmd =
+      app.add_subcommand("report",
+                         "Write a self-contained report.html: design, effect plots, envelopes, "
+                         "calibration, diagnosis");
+  add_connection_options(*cmd, o->channel);
+  cmd->add_option("campaign", o->campaign, "campaign id, or a spec YAML (embedded default)")
+      ->required();
+  cmd->add_option("-o,--output", o->out_dir, "directory for report.html")->capture_default_str();
+  cmd->add_flag("--data", o->data, "also write the report's data as report.json");
+  cmd->add_option("--workdir", o->workdir, "embedded: directory of the SQLite file");
+  add_local_worker_options(*cmd, o->local);
+  cmd->add_flag("-v,--verbose", o->verbose, "embedded: coordinator and worker logs");
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace demcal::cli
