@@ -19,10 +19,18 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
   if (options_.max_attempts < 1) throw std::invalid_argument("max attempts must be >= 1");
   if (options_.token.empty() && !is_loopback(options_.listen))
     throw std::invalid_argument("a coordinator listening beyond loopback needs --token");
-  store_ = std::make_unique<Store>(options_.db,
-                                   StoreLimits{options_.lease_seconds, options_.max_attempts});
+  if (!(options_.grace_seconds >= 0.0 && options_.grace_seconds <= 3600.0))
+    throw std::invalid_argument("--grace must lie in [0, 3600] s");
+  store_ = std::make_unique<Store>(
+      options_.db,
+      StoreLimits{options_.lease_seconds, options_.max_attempts, options_.grace_seconds});
+  if (options_.max_starts < 1 || options_.max_starts > 1000)
+    throw std::invalid_argument("--max-starts must lie in [1, 1000]");
+  if (!(options_.max_watch_interval >= kMinWatchInterval && options_.max_watch_interval <= 3600))
+    throw std::invalid_argument("--max-watch-interval must lie in [0.05, 3600] s");
   ServiceConfig config{options_.token, options_.heartbeat_seconds,
-                       std::min(1.0, options_.heartbeat_seconds)};
+                       std::min(1.0, options_.heartbeat_seconds), options_.max_starts,
+                       options_.max_watch_interval};
   campaigns_ = std::make_unique<CampaignServiceImpl>(*store_, config, stopping_);
   workers_ = std::make_unique<WorkerServiceImpl>(*store_, config);
 
@@ -40,9 +48,11 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
   server_ = builder.BuildAndStart();
   if (!server_ || port_ == 0) throw std::runtime_error("cannot listen on " + options_.listen);
   if (auto* health = server_->GetHealthCheckService()) health->SetServingStatus(true);
-  spdlog::info("coordinator on port {} (db {}, lease {} s, heartbeat {} s, {} attempts{})", port_,
-               options_.db, options_.lease_seconds, options_.heartbeat_seconds,
-               options_.max_attempts, options_.token.empty() ? ", NO AUTH" : "");
+  spdlog::info(
+      "coordinator on port {} (db {}, lease {} s, heartbeat {} s, {} attempts, grace {} s{})",
+      port_, options_.db, options_.lease_seconds, options_.heartbeat_seconds, options_.max_attempts,
+      std::max(options_.grace_seconds, options_.lease_seconds),
+      options_.token.empty() ? ", NO AUTH" : "");
   for (const auto& c : store_->campaigns())
     if (c.state == "running") spdlog::info("resuming campaign {} '{}'", c.id, c.name);
   reaper_ = std::thread([this] { reap_loop(); });
@@ -57,7 +67,7 @@ void Coordinator::reap_loop() {
   while (!shut_) {
     lock.unlock();
     try {
-      if (const int n = store_->reap(now_seconds()); n > 0)
+      if (const int n = store_->reap(steady_seconds()); n > 0)
         spdlog::warn("reaper: {} expired lease(s) returned to the queue or failed", n);
     } catch (const std::exception& e) {
       spdlog::error("reaper: {}", e.what());

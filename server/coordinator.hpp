@@ -22,7 +22,12 @@ struct CoordinatorOptions {
   double lease_seconds = 60.0;
   double heartbeat_seconds = 10.0;
   double reaper_seconds = 1.0;
+  /// A lease found in the file at start-up expires no sooner than this (nor than a lease)
+  /// after start-up: workers that ran on while the coordinator was down reconnect and report.
+  double grace_seconds = 30.0;
   int max_attempts = 3;
+  int max_starts = 256;              ///< Calibrate `starts`, at most
+  double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
   std::string tls_cert, tls_key;
   bool insecure = false;  ///< plain TCP (behind a trusted network or a TLS-terminating proxy)
 };

@@ -24,7 +24,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--reaper-interval", o.reaper_seconds, "how often expired leases are reaped (s)")
       ->capture_default_str();
+  app.add_option("--grace", o.grace_seconds,
+                 "leases found at start-up expire no sooner than this after it (s)")
+      ->capture_default_str();
   app.add_option("--max-attempts", o.max_attempts, "leases per job before it fails")
+      ->capture_default_str();
+  app.add_option("--max-starts", o.max_starts, "Calibrate starts a client may ask for, at most")
+      ->capture_default_str();
+  app.add_option("--max-watch-interval", o.max_watch_interval,
+                 "Watch interval a client may ask for, at most (s)")
       ->capture_default_str();
   app.add_option("--tls-cert", o.tls_cert, "PEM certificate chain (enables TLS)");
   app.add_option("--tls-key", o.tls_key, "PEM private key");

@@ -16,7 +16,12 @@ struct ServiceConfig {
   std::string token;
   double heartbeat_seconds = 10.0;
   double idle_retry_seconds = 1.0;
+  int max_starts = 256;              ///< Calibrate `starts`, at most
+  double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
 };
+
+/// The shortest Watch interval: each tick reads the store.
+constexpr double kMinWatchInterval = 0.05;
 
 double now_seconds();
 

@@ -25,6 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kToken = "test-token-123";
+/// Particles of a packing job that runs for minutes on one thread (cancelled or stopped long
+/// before it would end).
+constexpr int kLongJobParticles = 20000;
 
 /// A packing campaign of 2^2 runs (+ centre points) at `particles` particles; by default its
 /// calibration verifies one round only.
@@ -70,15 +73,27 @@ class Service : public ::testing::Test {
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   /// Starts (or restarts on the same port and file) the coordinator.
-  void start_server(double lease = 1.5, double heartbeat = 0.3, int port = 0) {
+  void start_server(double lease = 1.5, double heartbeat = 0.3, int port = 0,
+                    const std::vector<std::string>& extra = {}) {
     const std::string port_file = path("port");
     fs::remove(port_file);
-    server_ = std::make_unique<Process>(
-        std::vector<std::string>{DEMCAL_SERVER_BIN, "--listen", "127.0.0.1:" + std::to_string(port),
-                                 "--db", path("c.db"), "--token", kToken, "--lease",
-                                 std::to_string(lease), "--heartbeat", std::to_string(heartbeat),
-                                 "--reaper-interval", "0.1", "--port-file", port_file},
-        path("server.log"));
+    std::vector<std::string> argv{DEMCAL_SERVER_BIN,
+                                  "--listen",
+                                  "127.0.0.1:" + std::to_string(port),
+                                  "--db",
+                                  path("c.db"),
+                                  "--token",
+                                  kToken,
+                                  "--lease",
+                                  std::to_string(lease),
+                                  "--heartbeat",
+                                  std::to_string(heartbeat),
+                                  "--reaper-interval",
+                                  "0.1",
+                                  "--port-file",
+                                  port_file};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    server_ = std::make_unique<Process>(argv, path("server.log"));
     ASSERT_TRUE(wait_until([&] { return fs::exists(port_file); }, 20)) << server_->log();
     std::ifstream(port_file) >> port_;
     channel_.address = "127.0.0.1:" + std::to_string(port_);
@@ -87,12 +102,36 @@ class Service : public ::testing::Test {
     workers_stub_ = v1::WorkerService::NewStub(proto::make_channel(channel_));
   }
 
-  Process& start_worker(const std::string& id, const std::string& token = kToken) {
-    workers_.push_back(std::make_unique<Process>(
-        std::vector<std::string>{DEMCAL_WORKER_BIN, "--coordinator", channel_.address, "--token",
-                                 token, "--threads", "1", "--id", id, "--max-backoff", "0.5"},
-        path(id + ".log")));
+  Process& start_worker(const std::string& id, const std::string& token = kToken,
+                        const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> argv{DEMCAL_WORKER_BIN,
+                                  "--coordinator",
+                                  channel_.address,
+                                  "--token",
+                                  token,
+                                  "--threads",
+                                  "1",
+                                  "--id",
+                                  id,
+                                  "--max-backoff",
+                                  "0.5"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    workers_.push_back(std::make_unique<Process>(argv, path(id + ".log")));
     return *workers_.back();
+  }
+
+  /// The id of a job in state `state`, polled for at most `seconds` (0 if none appeared).
+  std::int64_t wait_for_job(std::int64_t campaign, const std::string& state, double seconds) {
+    std::int64_t found = 0;
+    wait_until(
+        [&] {
+          const auto now = results(campaign);
+          for (const auto& j : now.jobs())
+            if (j.state() == state) found = j.job_id();
+          return found != 0;
+        },
+        seconds);
+    return found;
   }
 
   std::unique_ptr<grpc::ClientContext> ctx(double seconds = 30) {
@@ -232,6 +271,12 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
       {tiny_spec(30, 0, "", "calibration: {model: quadratic}\n"), "spec.calibration.model"},
       {tiny_spec(30, 0, "", "calibration: {surrogate: kriging}\n"), "spec.calibration.surrogate"},
       {tiny_spec(30, 0, "", "calibration: {batch: -1}\n"), "spec.calibration.batch"},
+      {[] {
+         auto s = tiny_spec(30);
+         s.replace(s.find("  - test: packing\n"), 18, "  - test: packing\n    threads: 100000\n");
+         return s;
+       }(),
+       "spec.tests[0].threads"},
   };
   for (const auto& c : cases) {
     const auto s = submit(c.yaml);
@@ -316,9 +361,25 @@ TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
     const auto st = workers_stub_->Complete(ctx().get(), *bad, &cr);
     EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << st.error_message();
   }
+  // Only the lease's holder may report it; another worker is denied and changes nothing.
+  v1::CompleteRequest intruder = good;
+  intruder.set_worker("intruder");
+  EXPECT_EQ(workers_stub_->Complete(ctx().get(), intruder, &cr).error_code(),
+            grpc::StatusCode::PERMISSION_DENIED);
+  v1::FailRequest intruder_fail;
+  intruder_fail.set_job_id(job);
+  intruder_fail.set_attempt(2);
+  intruder_fail.set_worker("intruder");
+  v1::FailReply fr;
+  EXPECT_EQ(workers_stub_->Fail(ctx().get(), intruder_fail, &fr).error_code(),
+            grpc::StatusCode::PERMISSION_DENIED);
   EXPECT_TRUE(workers_stub_->Complete(ctx().get(), good, &cr).ok());
-  EXPECT_EQ(workers_stub_->Complete(ctx().get(), good, &cr).error_code(),
-            grpc::StatusCode::FAILED_PRECONDITION);  // once only
+  // A retry of the stored result (its answer lost on the way) succeeds; another result does not.
+  EXPECT_TRUE(workers_stub_->Complete(ctx().get(), good, &cr).ok());
+  v1::CompleteRequest other = good;
+  (*other.mutable_metrics())["solid_fraction"] = 0.59;
+  EXPECT_EQ(workers_stub_->Complete(ctx().get(), other, &cr).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
   EXPECT_EQ(stored_results().at(job), 1);
   const auto after = results(id);
   for (const auto& j : after.jobs())
@@ -328,6 +389,152 @@ TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
       EXPECT_EQ(j.worker(), "fast");
       EXPECT_DOUBLE_EQ(j.metrics().at("solid_fraction"), 0.58);
     }
+}
+
+TEST_F(Service, AResultFinishedWhileTheCoordinatorWasDownLongerThanTheLeaseIsAccepted) {
+  // With one attempt per job, a lease expired by the coordinator's own downtime would fail the
+  // job although its simulation succeeded, and a second attempt would run it again.
+  const std::vector<std::string> one_attempt{"--max-attempts", "1"};
+  start_server(/*lease=*/2, /*heartbeat=*/0.3, 0, one_attempt);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(400), &id).ok());  // 4 jobs of ~1 s
+  start_worker("w");
+  ASSERT_NE(wait_for_job(id, "leased", 30), 0);
+  const int port = port_;
+  server_->signal(SIGTERM);
+  ASSERT_EQ(server_->wait_exit(20), 0) << server_->log();
+  std::this_thread::sleep_for(std::chrono::milliseconds(3500));  // down longer than the lease
+  start_server(2, 0.3, port, one_attempt);
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 120)) << workers_[0]->log();
+  const auto r = results(id);
+  const auto stored = stored_results();
+  ASSERT_EQ(r.jobs_size(), 4);
+  for (const auto& j : r.jobs()) {
+    EXPECT_EQ(j.state(), "done") << j.error();
+    EXPECT_EQ(j.attempt(), 1) << "job " << j.job_id() << " ran again";
+    EXPECT_EQ(stored.count(j.job_id()), 1u);
+  }
+  EXPECT_EQ(workers_[0]->log().find("refused the report"), std::string::npos) << workers_[0]->log();
+}
+
+TEST_F(Service, CancellingACampaignStopsTheWorkersSimulationAndFreesTheWorker) {
+  start_server(/*lease=*/30, /*heartbeat=*/0.3);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(kLongJobParticles), &id).ok());  // jobs of minutes
+  auto& worker = start_worker("w");
+  ASSERT_NE(wait_for_job(id, "leased", 30), 0);
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // well into the simulation
+  v1::CancelRequest cancel;
+  cancel.set_id(id);
+  v1::Campaign c;
+  ASSERT_TRUE(campaigns_->Cancel(ctx().get(), cancel, &c).ok());
+  ASSERT_TRUE(
+      wait_until([&] { return worker.log().find("simulation stopped") != std::string::npos; }, 60))
+      << worker.log();
+  // The worker is free again: it runs the next campaign's jobs.
+  std::int64_t next = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &next).ok());
+  ASSERT_TRUE(wait_until([&] { return campaign_done(next); }, 90)) << worker.log();
+  const auto next_results = results(next);
+  for (const auto& j : next_results.jobs()) EXPECT_EQ(j.state(), "done") << j.error();
+  EXPECT_EQ(stored_results().size(), 4u) << "the cancelled job reported nothing";
+}
+
+TEST_F(Service, AJobOverTheWorkersLimitsFailsWithTheLimitNamed) {
+  start_server(/*lease=*/30, /*heartbeat=*/0.3, 0, {"--max-attempts", "1"});
+  // More particles than --max-particles: refused unrun.
+  std::int64_t big = 0;
+  ASSERT_TRUE(submit(tiny_spec(400), &big).ok());
+  auto& small = start_worker("small", kToken, {"--max-particles", "300"});
+  ASSERT_TRUE(wait_until([&] { return campaign_done(big); }, 60)) << small.log();
+  const auto refused = results(big);
+  for (const auto& j : refused.jobs()) {
+    EXPECT_EQ(j.state(), "failed");
+    EXPECT_NE(j.error().find("400 particles, more than this worker's --max-particles 300"),
+              std::string::npos)
+        << j.error();
+  }
+  small.signal(SIGKILL);
+  small.wait_exit(10);
+  // Longer than --max-job-seconds: the simulation is stopped and the job failed.
+  std::int64_t slow = 0;
+  ASSERT_TRUE(submit(tiny_spec(kLongJobParticles), &slow).ok());
+  auto& hasty = start_worker("hasty", kToken, {"--max-job-seconds", "2"});
+  ASSERT_NE(wait_for_job(slow, "failed", 90), 0) << hasty.log();
+  bool named = false;
+  const auto stopped = results(slow);
+  for (const auto& j : stopped.jobs())
+    named |= j.error().find("--max-job-seconds 2") != std::string::npos;
+  EXPECT_TRUE(named) << hasty.log();
+}
+
+TEST_F(Service, ASpecAskingForMoreThreadsThanTheWorkerHasRunsOnTheWorkersThreads) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::string spec = tiny_spec(30);
+  spec.replace(spec.find("  - test: packing\n"), 18, "  - test: packing\n    threads: 16\n");
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(spec, &id).ok());
+  auto& worker = start_worker("w");  // --threads 1
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 90)) << worker.log();
+  EXPECT_NE(worker.log().find("on 1 thread(s)"), std::string::npos) << worker.log();
+  EXPECT_EQ(worker.log().find("on 16 thread(s)"), std::string::npos) << worker.log();
+}
+
+TEST_F(Service, DiagnoseOrVerifyOnACancelledCampaignIsRefusedAndQueuesNothing) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  v1::CancelRequest cancel;
+  cancel.set_id(id);
+  v1::Campaign c;
+  ASSERT_TRUE(campaigns_->Cancel(ctx().get(), cancel, &c).ok());
+  // Cancelling again is refused: only a running campaign can be cancelled.
+  EXPECT_EQ(campaigns_->Cancel(ctx().get(), cancel, &c).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  v1::DiagnoseRequest diagnose;
+  diagnose.set_id(id);
+  v1::DiagnoseReply dr;
+  const auto ds = campaigns_->Diagnose(ctx().get(), diagnose, &dr);
+  EXPECT_EQ(ds.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_NE(ds.error_message().find("cancelled"), std::string::npos) << ds.error_message();
+  v1::CalibrateRequest verify;
+  verify.set_id(id);
+  verify.set_verify(true);
+  v1::CalibrateReply cr;
+  EXPECT_EQ(campaigns_->Calibrate(ctx().get(), verify, &cr).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  const auto r = results(id);
+  EXPECT_EQ(r.jobs_size(), 4);
+  for (const auto& j : r.jobs()) EXPECT_EQ(j.state(), "cancelled");
+}
+
+TEST_F(Service, OutOfRangeNumbersInRequestsAreInvalidArgumentNamingTheField) {
+  start_server(/*lease=*/30, /*heartbeat=*/5, 0, {"--max-starts", "64"});
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  for (const int starts : {-1, 65, 1 << 30}) {
+    v1::CalibrateRequest req;
+    req.set_id(id);
+    req.set_starts(starts);
+    v1::CalibrateReply reply;
+    const auto st = campaigns_->Calibrate(ctx().get(), req, &reply);
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << starts;
+    EXPECT_NE(st.error_message().find("starts: must lie in [0, 64]"), std::string::npos)
+        << st.error_message();
+  }
+  for (const double interval : {1e-9, -1.0, 61.0, std::nan(""), 1e300}) {
+    v1::WatchRequest req;
+    req.set_id(id);
+    req.set_interval_seconds(interval);
+    auto context = ctx();
+    auto reader = campaigns_->Watch(context.get(), req);
+    v1::Progress p;
+    while (reader->Read(&p)) {
+    }
+    const auto st = reader->Finish();
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << interval;
+    EXPECT_NE(st.error_message().find("interval_seconds"), std::string::npos) << st.error_message();
+  }
 }
 
 TEST_F(Service, WorkersRacingNeverShareAJob) {
@@ -442,6 +649,9 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
       {DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--workers", "2", "--threads", "1"},
       path("run.log"));
   ASSERT_EQ(run.wait_exit(150), 0) << run.log();
+  // The new work directory (it holds the database) is its owner's alone.
+  EXPECT_EQ(fs::status(path("work")).permissions() & (fs::perms::group_all | fs::perms::others_all),
+            fs::perms::none);
   const std::string out = run.log();
   EXPECT_NE(out.find("resolution full factorial"), std::string::npos) << out;
   EXPECT_NE(out.find("== packing.solid_fraction (5 of 5 runs) =="), std::string::npos) << out;
