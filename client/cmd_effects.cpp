@@ -80,14 +80,18 @@ void add_analysis_commands(CLI::App& app) {
     v1::ExportRequest req;
     req.set_id(o->id);
     req.set_format(o->format == "table" ? "json" : o->format);
-    v1::ExportReply reply;
-    check(
-        campaign_stub(o->channel)->Export(proto::make_context(o->channel, 120).get(), req, &reply),
-        "export");
+    // The document arrives in pieces (it may exceed a gRPC message); nothing is written unless
+    // all of it arrived.
+    const auto context = proto::make_context(o->channel, 600);
+    auto reader = campaign_stub(o->channel)->Export(context.get(), req);
+    std::string content;
+    v1::ExportReply piece;
+    while (reader->Read(&piece)) content += piece.content();
+    check(reader->Finish(), "export");
     if (o->out.empty()) {
-      std::cout << reply.content();
+      std::cout << content;
     } else {
-      std::ofstream(o->out) << reply.content();
+      std::ofstream(o->out) << content;
       std::cerr << "wrote " << o->out << "\n";
     }
   });

@@ -18,7 +18,10 @@ namespace demcal::server {
 struct CoordinatorOptions {
   std::string listen = "127.0.0.1:7311";  ///< port 0 picks a free one (see port())
   std::string db = "demcal.db";
-  std::string token;  ///< empty: no auth (only allowed on loopback)
+  std::string token;         ///< opens both services (all three empty: no auth, loopback only)
+  std::string worker_token;  ///< opens only the WorkerService
+  std::string client_token;  ///< opens only the CampaignService
+  bool reflection = false;   ///< serve gRPC server reflection
   double lease_seconds = 60.0;
   double heartbeat_seconds = 10.0;
   double reaper_seconds = 1.0;

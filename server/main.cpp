@@ -11,14 +11,20 @@
 
 int main(int argc, char** argv) {
   demcal::server::CoordinatorOptions o;
-  std::string port_file, token_file;
+  std::string port_file, token_file, worker_token_file, client_token_file;
   CLI::App app{"demcal-server - the calibration coordinator (SQLite store, gRPC services)"};
   app.add_option("--listen", o.listen, "address:port (port 0 = any free port)")
       ->capture_default_str();
   app.add_option("--db", o.db, "SQLite file")->capture_default_str();
   app.add_option("--token", o.token, "bearer token workers and clients must send")
       ->envname("DEMCAL_TOKEN");
-  app.add_option("--token-file", token_file, "read the token from a file");
+  app.add_option("--token-file", token_file,
+                 "read the token from a file (it opens both services: the operator's)");
+  app.add_option("--worker-token-file", worker_token_file,
+                 "the token of workers: Lease, Heartbeat, Complete, Fail only");
+  app.add_option("--client-token-file", client_token_file,
+                 "the token of clients: the campaign service only (submit, cancel, queries)");
+  app.add_flag("--reflection", o.reflection, "serve gRPC server reflection (off by default)");
   app.add_option("--lease", o.lease_seconds, "lease duration (s)")->capture_default_str();
   app.add_option("--heartbeat", o.heartbeat_seconds, "heartbeat interval asked of workers (s)")
       ->capture_default_str();
@@ -39,12 +45,16 @@ int main(int argc, char** argv) {
   app.add_flag("--insecure", o.insecure, "plain TCP: tokens and data in clear text");
   app.add_option("--port-file", port_file, "write the port listened on to this file");
   CLI11_PARSE(app, argc, argv);
-  if (!token_file.empty()) try {
-      o.token = demcal::proto::read_token_file(token_file);
-    } catch (const std::exception& e) {
-      spdlog::critical("{}", e.what());
-      return 2;
-    }
+  // A token file that was named and cannot be read stops the server: it never means "no token".
+  try {
+    for (auto [file, token] :
+         {std::pair{&token_file, &o.token}, std::pair{&worker_token_file, &o.worker_token},
+          std::pair{&client_token_file, &o.client_token}})
+      if (!file->empty()) *token = demcal::proto::read_token_file(*file);
+  } catch (const std::exception& e) {
+    spdlog::critical("{}", e.what());
+    return 2;
+  }
   // Signals are taken synchronously by this thread; every other thread inherits the mask.
   sigset_t set;
   sigemptyset(&set);

@@ -248,12 +248,23 @@ Store::Store(const std::string& path, StoreLimits limits, std::optional<double> 
   }
   sqlite3_busy_timeout(db_, 10000);
   exec("PRAGMA journal_mode=WAL");
+  require_wal(path);
   exec("PRAGMA synchronous=FULL");
   // Foreign keys are enforced from here on; migrations that rebuild a table run before.
   migrate();
   exec("PRAGMA foreign_keys=ON");
   drop_unfinished_campaigns();
   restore_leases(opened.value_or(steady_seconds()));
+}
+
+void Store::require_wal(const std::string& path) {
+  // SQLite keeps the old journal mode, silently, where WAL is impossible (a file system without
+  // shared memory, a read-only directory): the crash guarantees in the header would not hold.
+  if (path.empty() || path == ":memory:") return;  // no file: nothing to recover after a crash
+  const std::string mode = journal_mode_unlocked();
+  if (mode != "wal")
+    throw std::runtime_error("cannot put " + path + " in WAL mode (journal_mode is " + mode +
+                             "): use a local file system the coordinator can write to");
 }
 
 void Store::restore_leases(double opened) {
@@ -297,6 +308,10 @@ int Store::schema_version() {
 
 std::string Store::journal_mode() {
   Guard lock(*this);
+  return journal_mode_unlocked();
+}
+
+std::string Store::journal_mode_unlocked() {
   Statement s(db_, "PRAGMA journal_mode");
   s.step();
   return s.text(0);

@@ -178,6 +178,9 @@ class Store {
   bool already_stored(std::int64_t job_id, int attempt, const std::string& worker,
                       const std::string& metrics_json, double wall_seconds);
   void restore_leases(double opened);
+  /// Throws unless the file is in WAL mode (checked at opening).
+  void require_wal(const std::string& path);
+  std::string journal_mode_unlocked();
   /// Adds `seconds` to every lease deadline (the lock was held that long).
   void extend_deadlines(double seconds);
   void exec(const char* sql);

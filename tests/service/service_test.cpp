@@ -2,6 +2,7 @@
 // a worker SIGKILLed mid-job, workers racing, the coordinator SIGKILLed and restarted, a late
 // Complete from an expired lease, invalid specs, missing or wrong tokens, and the CLI end to
 // end. Leases and heartbeats are short (flags); every wait is bounded.
+#include <grpcpp/generic/generic_stub.h>
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -213,6 +214,109 @@ TEST_F(Service, MissingOrWrongTokenIsUnauthenticated) {
   // A worker with a wrong token stops with exit code 2 instead of retrying forever.
   auto& w = start_worker("intruder", "nope");
   EXPECT_EQ(w.wait_exit(20), 2) << w.log();
+}
+
+TEST_F(Service, AWorkerTokenCannotSubmitOrCancelAndAClientTokenCannotLeaseOrComplete) {
+  std::ofstream(path("worker.token")) << "worker-secret\n";
+  std::ofstream(path("client.token")) << "client-secret\n";
+  start_server(
+      /*lease=*/30, /*heartbeat=*/5, 0,
+      {"--worker-token-file", path("worker.token"), "--client-token-file", path("client.token")});
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());  // the operator's token opens both
+  auto as = [&](const std::string& token) {
+    proto::ChannelOptions o = channel_;
+    o.token = token;
+    return o;
+  };
+  const auto worker = as("worker-secret"), client = as("client-secret");
+  auto campaigns_as = [&](const proto::ChannelOptions& o) {
+    return v1::CampaignService::NewStub(proto::make_channel(o));
+  };
+  auto workers_as = [&](const proto::ChannelOptions& o) {
+    return v1::WorkerService::NewStub(proto::make_channel(o));
+  };
+  // The worker token: the worker service only.
+  v1::SubmitRequest sreq;
+  *sreq.mutable_spec() = cli::parse_campaign_spec(tiny_spec(30), "spec.yaml").spec;
+  v1::SubmitReply sr;
+  auto st = campaigns_as(worker)->Submit(proto::make_context(worker, 10).get(), sreq, &sr);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::PERMISSION_DENIED) << st.error_message();
+  v1::CancelRequest cancel;
+  cancel.set_id(id);
+  v1::Campaign c;
+  EXPECT_EQ(
+      campaigns_as(worker)->Cancel(proto::make_context(worker, 10).get(), cancel, &c).error_code(),
+      grpc::StatusCode::PERMISSION_DENIED);
+  v1::LeaseRequest lr;
+  lr.set_worker("w");
+  v1::LeaseReply lease;
+  ASSERT_TRUE(workers_as(worker)->Lease(proto::make_context(worker, 10).get(), lr, &lease).ok());
+  ASSERT_TRUE(lease.has_job());
+  // The client token: the campaign service only.
+  v1::LeaseReply other;
+  EXPECT_EQ(
+      workers_as(client)->Lease(proto::make_context(client, 10).get(), lr, &other).error_code(),
+      grpc::StatusCode::PERMISSION_DENIED);
+  v1::CompleteRequest done;
+  done.set_job_id(lease.job().job_id());
+  done.set_attempt(lease.job().attempt());
+  done.set_worker("w");
+  (*done.mutable_metrics())["solid_fraction"] = 0.5;
+  (*done.mutable_metrics())["coordination_number"] = 4.0;
+  v1::CompleteReply cr;
+  EXPECT_EQ(
+      workers_as(client)->Complete(proto::make_context(client, 10).get(), done, &cr).error_code(),
+      grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_TRUE(workers_as(worker)->Complete(proto::make_context(worker, 10).get(), done, &cr).ok());
+  v1::ListReply list;
+  EXPECT_TRUE(campaigns_as(client)->List(proto::make_context(client, 10).get(), {}, &list).ok());
+  EXPECT_EQ(campaigns_as(as("nope"))
+                ->List(proto::make_context(as("nope"), 10).get(), {}, &list)
+                .error_code(),
+            grpc::StatusCode::UNAUTHENTICATED);
+  // The CLI reads its token from a file (not the command line); a missing file is an error.
+  Process cli({DEMCAL_CLI_BIN, "list", "--coordinator", channel_.address, "--token-file",
+               path("client.token")},
+              path("list.log"));
+  EXPECT_EQ(cli.wait_exit(30), 0) << cli.log();
+  EXPECT_NE(cli.log().find("tiny"), std::string::npos) << cli.log();
+  Process missing({DEMCAL_CLI_BIN, "list", "--coordinator", channel_.address, "--token-file",
+                   path("missing.token")},
+                  path("missing.log"));
+  EXPECT_EQ(missing.wait_exit(30), 2) << missing.log();
+  EXPECT_NE(missing.log().find(path("missing.token")), std::string::npos) << missing.log();
+}
+
+/// The status of one call to a method by name, with an empty message (for services the test
+/// has no stub of, such as reflection).
+grpc::Status call_by_name(const proto::ChannelOptions& o, const std::string& method) {
+  grpc::GenericStub stub(proto::make_channel(o));
+  grpc::CompletionQueue cq;
+  auto context = proto::make_context(o, 10);
+  grpc::ByteBuffer request, response;
+  grpc::Slice empty("");
+  request = grpc::ByteBuffer(&empty, 1);
+  auto call = stub.PrepareUnaryCall(context.get(), method, request, &cq);
+  call->StartCall();
+  grpc::Status status;
+  call->Finish(&response, &status, reinterpret_cast<void*>(1));
+  void* tag = nullptr;
+  bool ok = false;
+  cq.Next(&tag, &ok);
+  cq.Shutdown();
+  while (cq.Next(&tag, &ok)) {
+  }
+  return status;
+}
+
+TEST_F(Service, ReflectionIsServedOnlyWhenAskedFor) {
+  const std::string method = "/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo";
+  start_server();
+  EXPECT_EQ(call_by_name(channel_, method).error_code(), grpc::StatusCode::UNIMPLEMENTED);
+  server_.reset();
+  start_server(1.5, 0.3, 0, {"--reflection"});
+  EXPECT_NE(call_by_name(channel_, method).error_code(), grpc::StatusCode::UNIMPLEMENTED);
 }
 
 TEST_F(Service, AMissingOrEmptyTokenFileStopsServerAndWorkerInsteadOfTurningAuthOff) {
@@ -784,6 +888,41 @@ TEST_F(Service, CentrePointsDifferCurvatureIsTestedAndTheCalibrationRoundsAreSho
   const auto diagnosis =
       cli_json(dir_, "diagnose", {"diagnose", ids, "--no-wait", "--format", "json"}, channel_);
   EXPECT_TRUE(diagnosis.is_object() && !diagnosis.empty()) << diagnosis.dump();
+}
+
+TEST_F(Service, AnExportLargerThanAGrpcMessageArrivesWhole) {
+  // Synthetic results through the real worker protocol, no physics: each with a cost block of
+  // 5,000 long-named phases (about 1.5 MB of JSON), so that the export exceeds gRPC's 4 MB.
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());  // 4 jobs
+  for (int k = 0; k < 4; ++k) {
+    v1::LeaseRequest lr;
+    lr.set_worker("fake");
+    v1::LeaseReply lease;
+    ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
+    ASSERT_TRUE(lease.has_job());
+    v1::CompleteRequest c;
+    c.set_job_id(lease.job().job_id());
+    c.set_attempt(lease.job().attempt());
+    c.set_worker("fake");
+    (*c.mutable_metrics())["solid_fraction"] = 0.55 + 0.01 * k;
+    (*c.mutable_metrics())["coordination_number"] = 4.0;
+    for (int p = 0; p < 5000; ++p) {
+      auto* phase = c.mutable_cost()->add_phases();
+      phase->set_name("phase " + std::to_string(p) + std::string(200, '.'));
+      phase->set_steps(p);
+    }
+    v1::CompleteReply cr;
+    const auto st = workers_stub_->Complete(ctx().get(), c, &cr);
+    ASSERT_TRUE(st.ok()) << st.error_message();
+  }
+  ASSERT_TRUE(campaign_done(id));
+  const auto exported =
+      cli_json(dir_, "export", {"export", std::to_string(id), "--format", "json"}, channel_);
+  EXPECT_GT(fs::file_size(path("export.json")), 4u << 20);
+  ASSERT_EQ(exported.at("jobs").size(), 4u);
+  for (const auto& j : exported.at("jobs")) EXPECT_EQ(j.at("cost").at("phases").size(), 5000u);
 }
 
 TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {
