@@ -18,8 +18,8 @@ TMP=$(mktemp -d)
 # Every process is ended by its id: the coordinator's in SERVER_PID, each worker's in its pid file.
 cleanup() {
   touch "$TMP"/*/stop 2>/dev/null || true
-  for f in "$TMP"/*/w*.pid; do [ -e "$f" ] && kill -9 "$(cat "$f")" 2>/dev/null; done
-  [ -n "${SERVER_PID:-}" ] && kill -9 "$SERVER_PID" 2>/dev/null
+  for f in "$TMP"/*/w*.pid; do [ -e "$f" ] && kill -9 "$(cat "$f")" 2>/dev/null || true; done
+  [ -n "${SERVER_PID:-}" ] && kill -9 "$SERVER_PID" 2>/dev/null || true
   rm -rf "$TMP"
 }
 trap cleanup EXIT

@@ -52,8 +52,9 @@ struct JobStop {
   void check() const {
     if (lease_lost) throw lab::RunCancelled("the lease is gone (expired, or campaign cancelled)");
     if (deadline && Clock::now() > *deadline)
-      throw lab::RunCancelled("the job ran longer than this worker's --max-job-seconds " +
-                              std::to_string(max_seconds) + " s and was stopped");
+      throw lab::RunCancelled(fmt::format(
+          "the job ran longer than this worker's --max-job-seconds {:g} s and was stopped",
+          max_seconds));
   }
 };
 
