@@ -23,7 +23,7 @@ cleanup() {
   rm -rf "$TMP"
 }
 trap cleanup EXIT
-openssl rand -hex 16 > "$TMP/token"
+od -An -tx1 -N16 /dev/urandom | tr -d " \n" > "$TMP/token"
 cat > "$TMP/spec.yaml" <<YAML
 name: soak
 material:
