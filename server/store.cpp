@@ -206,10 +206,10 @@ class Store::Transaction {
 /// to every lease deadline, so workers whose heartbeats waited for the lock keep their leases.
 class Store::Guard {
  public:
-  explicit Guard(Store& s) : s_(s), lock_(s.mutex_), start_(steady_seconds()) {}
+  explicit Guard(Store& s) : s_(s), lock_(s.mutex_), start_(s.clock_now()) {}
   ~Guard() {
     constexpr double kStallSeconds = 0.25;
-    if (const double held = steady_seconds() - start_; held > kStallSeconds)
+    if (const double held = s_.clock_now() - start_; held > kStallSeconds)
       s_.extend_deadlines(held);
   }
   Guard(const Guard&) = delete;

@@ -22,6 +22,7 @@
 #include <sqlite3.h>
 
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -88,6 +89,9 @@ struct StoreLimits {
   /// sooner than a lease): workers that ran on while the coordinator was down need time to
   /// reconnect (gRPC's reconnection back-off) and report.
   double restart_grace_seconds = 0.0;
+  /// The monotonic clock that measures how long the lock is held (empty: steady_seconds);
+  /// tests give a fake one.
+  std::function<double()> clock;
 };
 
 /// Seconds on the monotonic clock the store's lease deadlines are kept on.
@@ -178,6 +182,8 @@ class Store {
   bool already_stored(std::int64_t job_id, int attempt, const std::string& worker,
                       const std::string& metrics_json, double wall_seconds);
   void restore_leases(double opened);
+  /// Seconds on the clock of limits().clock.
+  double clock_now() const { return limits_.clock ? limits_.clock() : steady_seconds(); }
   /// Throws unless the file is in WAL mode (checked at opening).
   void require_wal(const std::string& path);
   std::string journal_mode_unlocked();

@@ -188,6 +188,30 @@ TEST(Store, ACampaignWhoseJobsWereNotAllInsertedIsDroppedOnOpening) {
   std::filesystem::remove(path.string() + "-shm");
 }
 
+TEST(Store, TimeTheLockIsHeldByOneLongWriteIsAddedToEveryLeaseDeadline) {
+  // A write holding the store's lock for 100 s (a stalled disk; here the lock-hold clock jumps
+  // while the write holds it): the workers whose heartbeats waited behind it keep their leases.
+  double t = 0.0;
+  int reads_until_jump = 0;
+  StoreLimits limits{10.0, 3};
+  limits.clock = [&] {
+    if (reads_until_jump > 0 && --reads_until_jump == 0) t += 100.0;
+    return t;
+  };
+  Store s(":memory:", limits);
+  s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  const auto a = s.lease("w", 0.0);
+  ASSERT_EQ(*s.lease_deadline(a->id), 10.0);
+  reads_until_jump = 2;  // the second reading is the end of the next hold: held 100 s
+  s.create_campaign("d", "{}", "{}", jobs(1), 0.0);
+  EXPECT_EQ(*s.lease_deadline(a->id), 110.0);
+  EXPECT_EQ(s.reap(105.0), 0);
+  EXPECT_EQ(s.heartbeat(a->id, 1, "w", 105.0), kOk);
+  // A short hold adds nothing.
+  s.create_campaign("e", "{}", "{}", jobs(1), 0.0);
+  EXPECT_EQ(*s.lease_deadline(a->id), 115.0);
+}
+
 TEST(Store, ExpiredBeforeTheReaperRunsIsAlsoRefused) {
   Store s(":memory:", {10.0, 3});
   s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
