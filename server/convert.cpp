@@ -223,6 +223,8 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
       throw InputError(where + ".path", "'" + f.path() + "' is also in spec.fixed");
     if (!seen.insert(f.path()).second)
       throw InputError(where + ".path", "'" + f.path() + "' is a factor twice");
+    if (!std::isfinite(f.low())) throw InputError(where + ".low", "must be finite");
+    if (!std::isfinite(f.high())) throw InputError(where + ".high", "must be finite");
     if (!(f.low() < f.high()))
       throw InputError(where + ".high", "must be above low (" + fmt(f.low()) + ")");
     if (f.low() < info->lo)

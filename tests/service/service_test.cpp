@@ -388,16 +388,30 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
     EXPECT_NE(s.error_message().find(c.field), std::string::npos)
         << c.field << " not in: " << s.error_message();
   }
-  // A NaN the YAML reader would refuse, sent straight over gRPC, is refused by the coordinator.
-  {
+  // A NaN or an infinity the YAML reader would refuse, sent straight over gRPC, is refused by
+  // the coordinator, naming the field.
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<std::pair<std::function<void(v1::CampaignSpec&)>, std::string>> numbers = {
+      {[](v1::CampaignSpec& s) { s.mutable_measurements(0)->set_uncertainty(std::nan("")); },
+       "spec.measurements[0].uncertainty"},
+      {[&](v1::CampaignSpec& s) { s.mutable_measurements(0)->set_weight(inf); },
+       "spec.measurements[0].weight"},
+      {[&](v1::CampaignSpec& s) { s.mutable_factors(0)->set_low(-inf); }, "spec.factors[0].low"},
+      {[&](v1::CampaignSpec& s) { s.mutable_factors(1)->set_high(std::nan("")); },
+       "spec.factors[1].high"},
+      {[&](v1::CampaignSpec& s) {
+         (*s.mutable_tests(0)->mutable_settings())["particles"] = std::nan("");
+       },
+       "spec.tests[0].settings.particles"},
+  };
+  for (const auto& [spoil, field] : numbers) {
     v1::SubmitRequest req;
     *req.mutable_spec() = cli::parse_campaign_spec(tiny_spec(30), "spec.yaml").spec;
-    req.mutable_spec()->mutable_measurements(0)->set_uncertainty(std::nan(""));
+    spoil(*req.mutable_spec());
     v1::SubmitReply reply;
     const auto s = campaigns_->Submit(ctx().get(), req, &reply);
-    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-    EXPECT_NE(s.error_message().find("spec.measurements[0].uncertainty"), std::string::npos)
-        << s.error_message();
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << field;
+    EXPECT_NE(s.error_message().find(field), std::string::npos) << s.error_message();
   }
   // Mistakes the JSON parser catches name the field and the YAML line before anything is sent.
   std::string typo = tiny_spec(30);
