@@ -111,17 +111,20 @@ void add_analysis_commands(CLI::App& app) {
       ->check(CLI::IsMember({"csv", "json", "liggghts"}));
   exp->add_option("-o,--output", o->out, "file (default: standard output)");
   exp->callback([o] {
-    auto stub = campaign_stub(o->channel);
     std::string content;
     if (o->format == "liggghts") {
-      content = liggghts_export(*stub, o->channel, o->id);
+      content = liggghts_export(*campaign_stub(o->channel), o->channel, o->id);
     } else {
       v1::ExportRequest req;
       req.set_id(o->id);
       req.set_format(o->format == "table" ? "json" : o->format);
-      v1::ExportReply reply;
-      check(stub->Export(proto::make_context(o->channel, 120).get(), req, &reply), "export");
-      content = reply.content();
+      // The document arrives in pieces (it may exceed a gRPC message); nothing is written unless
+      // all of it arrived.
+      const auto context = proto::make_context(o->channel, 600);
+      auto reader = campaign_stub(o->channel)->Export(context.get(), req);
+      v1::ExportReply piece;
+      while (reader->Read(&piece)) content += piece.content();
+      check(reader->Finish(), "export");
     }
     if (o->out.empty()) {
       std::cout << content;

@@ -36,7 +36,9 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
 
 EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local,
                                  bool verbose) {
-  std::filesystem::create_directories(workdir);
+  // The work directory holds the campaign's database: a new one is its owner's alone (0700).
+  if (std::filesystem::create_directories(workdir))
+    std::filesystem::permissions(workdir, std::filesystem::perms::owner_all);
   // Logs of the embedded coordinator and workers go to standard error: standard output is the
   // command's result (one JSON document with --format json).
   static const auto logger = [] {
@@ -50,6 +52,7 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
   co.listen = "127.0.0.1:0";
   co.db = db_ = (workdir / "campaign.db").string();
   co.token = random_token();
+  co.grace_seconds = 0.0;  // its workers die with it: no lease of a previous run is still worked on
   coordinator_ = std::make_unique<server::Coordinator>(co);
   channel_.address = "127.0.0.1:" + std::to_string(coordinator_->port());
   channel_.token = co.token;

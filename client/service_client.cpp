@@ -61,7 +61,20 @@ void add_connection_options(CLI::App& cmd, proto::ChannelOptions& o) {
   cmd.add_option("--coordinator", o.address, "host:port of demcal-server")
       ->envname("DEMCAL_COORDINATOR")
       ->capture_default_str();
-  cmd.add_option("--token", o.token, "bearer token")->envname("DEMCAL_TOKEN");
+  cmd.add_option("--token", o.token,
+                 "bearer token (visible in the process list: prefer "
+                 "--token-file or DEMCAL_TOKEN)")
+      ->envname("DEMCAL_TOKEN");
+  cmd.add_option_function<std::string>(
+      "--token-file",
+      [&o](const std::string& file) {
+        try {
+          o.token = proto::read_token_file(file);
+        } catch (const std::exception& e) {
+          throw InputError("--token-file", e.what());  // never "no token": exit code 2
+        }
+      },
+      "read the bearer token from the first line of this file");
   cmd.add_option("--tls-ca", o.tls_ca, "CA certificate (PEM) for a TLS coordinator");
   cmd.add_flag("--insecure", o.insecure, "plain TCP (coordinator started with --insecure)");
 }

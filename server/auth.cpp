@@ -11,20 +11,34 @@ bool is_loopback(const std::string& address) {
          address.rfind("[::1]", 0) == 0 || address.rfind("ipv4:127.", 0) == 0;
 }
 
-grpc::Status authorize(const grpc::ServerContext& context, const std::string& token) {
-  if (token.empty()) return grpc::Status::OK;
+namespace {
+
+/// Whether the call's authorization header is "Bearer <token>", in time independent of how
+/// much of it matches. An empty token never matches.
+bool presents(const grpc::ServerContext& context, const std::string& token) {
+  if (token.empty()) return false;
   const auto& md = context.client_metadata();
   const auto it = md.find("authorization");
+  if (it == md.end()) return false;
   const std::string expected = "Bearer " + token;
-  if (it != md.end()) {
-    const std::string_view got(it->second.data(), it->second.size());
-    // Constant-time comparison: the time taken does not tell how much of the token matched.
-    unsigned diff = got.size() == expected.size() ? 0u : 1u;
-    for (std::size_t i = 0; i < expected.size(); ++i)
-      diff |=
-          static_cast<unsigned>(i < got.size() ? got[i] : 0) ^ static_cast<unsigned>(expected[i]);
-    if (diff == 0) return grpc::Status::OK;
-  }
+  const std::string_view got(it->second.data(), it->second.size());
+  unsigned diff = got.size() == expected.size() ? 0u : 1u;
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    diff |= static_cast<unsigned>(i < got.size() ? got[i] : 0) ^ static_cast<unsigned>(expected[i]);
+  return diff == 0;
+}
+
+}  // namespace
+
+grpc::Status authorize(const grpc::ServerContext& context, const Tokens& tokens, Caller caller) {
+  if (tokens.empty()) return grpc::Status::OK;
+  const std::string& own = caller == Caller::kWorker ? tokens.worker : tokens.client;
+  const std::string& other = caller == Caller::kWorker ? tokens.client : tokens.worker;
+  if (presents(context, tokens.both) || presents(context, own)) return grpc::Status::OK;
+  if (presents(context, other))
+    return {grpc::StatusCode::PERMISSION_DENIED,
+            caller == Caller::kWorker ? "a client token cannot call the worker service"
+                                      : "a worker token cannot call the campaign service"};
   return {grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"};
 }
 

@@ -1,5 +1,6 @@
 #pragma once
-// Bearer-token auth, checked in every handler through this one helper. The token travels as
+// Bearer-token auth with two kinds of callers (workers and clients), checked in every handler
+// through this one function. The token travels as
 // metadata ("authorization: Bearer <token>") added by the client to each call, not as gRPC
 // call credentials (Debian's gRPC 1.51 drops call credentials on insecure channels); the
 // channel itself is protected by local credentials on loopback or by TLS elsewhere.
@@ -9,9 +10,22 @@
 
 namespace demcal::server {
 
-/// OK when the call carries the token (or when `token` is empty: auth disabled), else
-/// UNAUTHENTICATED without saying which part was wrong.
-grpc::Status authorize(const grpc::ServerContext& context, const std::string& token);
+/// Who may call what. `both` opens every service (the operator's token); `worker` only the
+/// WorkerService (Lease, Heartbeat, Complete, Fail), `client` only the CampaignService (Submit,
+/// Cancel, queries). All empty: auth disabled (only allowed on loopback).
+struct Tokens {
+  std::string both, worker, client;
+  bool empty() const { return both.empty() && worker.empty() && client.empty(); }
+};
+
+/// The caller a service admits.
+enum class Caller { kWorker, kClient };
+
+/// The one authorization check, called by every handler of both services: OK when the call
+/// carries `both` or the token of `caller` (or when auth is disabled); PERMISSION_DENIED for a
+/// valid token of the other kind; else UNAUTHENTICATED without saying which part was wrong.
+/// Tokens are compared in constant time.
+grpc::Status authorize(const grpc::ServerContext& context, const Tokens& tokens, Caller caller);
 
 /// Server credentials for an address: TLS when a certificate is given, local (LOCAL_TCP) on a
 /// loopback address, plain TCP only when `insecure` is asked for.

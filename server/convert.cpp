@@ -60,6 +60,8 @@ std::uint64_t base_seed(const v1::LabTest& t) {
 /// replicates each within their range, and the campaign's jobs (design rows x replicates x
 /// tests) at most kMaxCampaignJobs, so a submission cannot stall the store's lock or its disk.
 constexpr int kMaxCentrePoints = 64, kMaxReplicates = 16, kMaxCampaignJobs = 8192;
+/// Simulation threads a test may ask for (each worker caps them at its own --threads).
+constexpr int kMaxThreads = 256;
 void check_repeats(const v1::Design& d, int runs, int tests) {
   if (d.centre_points() < 0 || d.centre_points() > kMaxCentrePoints)
     throw InputError("spec.design.centre_points",
@@ -176,7 +178,9 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
                        "test '" + name + "' appears twice (give each instance its own `name`)");
     const lab::Settings settings = proto::to_settings(t.settings());
     lab::validate_settings(*info, settings, where + ".settings");
-    if (t.threads() < 0) throw InputError(where + ".threads", "must be >= 0");
+    if (t.threads() < 0 || t.threads() > kMaxThreads)
+      throw InputError(where + ".threads", "must be in [0, " + std::to_string(kMaxThreads) +
+                                               "] (a worker runs at most its own --threads)");
     lab::MaterialModel instance = instance_model(spec, t, where);
     lab::check_size(t.test(), instance, settings, where + ".settings");
     instances.emplace_back(name, std::move(instance));
@@ -219,6 +223,8 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
       throw InputError(where + ".path", "'" + f.path() + "' is also in spec.fixed");
     if (!seen.insert(f.path()).second)
       throw InputError(where + ".path", "'" + f.path() + "' is a factor twice");
+    if (!std::isfinite(f.low())) throw InputError(where + ".low", "must be finite");
+    if (!std::isfinite(f.high())) throw InputError(where + ".high", "must be finite");
     if (!(f.low() < f.high()))
       throw InputError(where + ".high", "must be above low (" + fmt(f.low()) + ")");
     if (f.low() < info->lo)

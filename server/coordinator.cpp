@@ -1,6 +1,6 @@
 #include "server/coordinator.hpp"
 
-#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <dlfcn.h>
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
@@ -10,6 +10,19 @@
 
 namespace demcal::server {
 
+namespace {
+
+/// Loads gRPC's reflection library, whose static initializer registers the reflection plugin
+/// with every ServerBuilder made afterwards (there is no way to leave out a registered plugin,
+/// so the library is not linked).
+void load_reflection() {
+  if (!dlopen(DEMCAL_GRPC_REFLECTION_LIB, RTLD_NOW | RTLD_GLOBAL))
+    throw std::runtime_error(std::string("--reflection: cannot load ") +
+                             DEMCAL_GRPC_REFLECTION_LIB + ": " + dlerror());
+}
+
+}  // namespace
+
 Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(options)) {
   if (options_.lease_seconds <= 0 || options_.heartbeat_seconds <= 0 ||
       options_.heartbeat_seconds >= options_.lease_seconds)
@@ -17,17 +30,29 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
                                 std::to_string(options_.heartbeat_seconds) + " s, lease " +
                                 std::to_string(options_.lease_seconds) + " s)");
   if (options_.max_attempts < 1) throw std::invalid_argument("max attempts must be >= 1");
-  if (options_.token.empty() && !is_loopback(options_.listen))
-    throw std::invalid_argument("a coordinator listening beyond loopback needs --token");
-  store_ = std::make_unique<Store>(options_.db,
-                                   StoreLimits{options_.lease_seconds, options_.max_attempts});
-  ServiceConfig config{options_.token, options_.heartbeat_seconds,
-                       std::min(1.0, options_.heartbeat_seconds)};
+  const Tokens tokens{options_.token, options_.worker_token, options_.client_token};
+  if (tokens.empty() && !is_loopback(options_.listen))
+    throw std::invalid_argument(
+        "a coordinator listening beyond loopback needs --token-file (or "
+        "--worker-token-file and --client-token-file)");
+  if (!(options_.grace_seconds >= 0.0 && options_.grace_seconds <= 3600.0))
+    throw std::invalid_argument("--grace must lie in [0, 3600] s");
+  store_ = std::make_unique<Store>(
+      options_.db,
+      StoreLimits{options_.lease_seconds, options_.max_attempts, options_.grace_seconds});
+  if (options_.max_starts < 1 || options_.max_starts > 1000)
+    throw std::invalid_argument("--max-starts must lie in [1, 1000]");
+  if (!(options_.max_watch_interval >= kMinWatchInterval && options_.max_watch_interval <= 3600))
+    throw std::invalid_argument("--max-watch-interval must lie in [0.05, 3600] s");
+  ServiceConfig config{tokens, options_.heartbeat_seconds,
+                       std::min(1.0, options_.heartbeat_seconds), options_.max_starts,
+                       options_.max_watch_interval};
   campaigns_ = std::make_unique<CampaignServiceImpl>(*store_, config, stopping_);
   workers_ = std::make_unique<WorkerServiceImpl>(*store_, config);
 
   grpc::EnableDefaultHealthCheckService(true);
-  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  // Reflection describes every service and message to anyone who can connect: off unless asked.
+  if (options_.reflection) load_reflection();
   grpc::ServerBuilder builder;
   const auto creds =
       server_credentials(options_.listen, options_.tls_cert, options_.tls_key, options_.insecure);
@@ -40,9 +65,11 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
   server_ = builder.BuildAndStart();
   if (!server_ || port_ == 0) throw std::runtime_error("cannot listen on " + options_.listen);
   if (auto* health = server_->GetHealthCheckService()) health->SetServingStatus(true);
-  spdlog::info("coordinator on port {} (db {}, lease {} s, heartbeat {} s, {} attempts{})", port_,
-               options_.db, options_.lease_seconds, options_.heartbeat_seconds,
-               options_.max_attempts, options_.token.empty() ? ", NO AUTH" : "");
+  spdlog::info(
+      "coordinator on port {} (db {}, lease {} s, heartbeat {} s, {} attempts, grace {} s{}{})",
+      port_, options_.db, options_.lease_seconds, options_.heartbeat_seconds, options_.max_attempts,
+      std::max(options_.grace_seconds, options_.lease_seconds), tokens.empty() ? ", NO AUTH" : "",
+      options_.reflection ? ", reflection" : "");
   for (const auto& c : store_->campaigns())
     if (c.state == "running") spdlog::info("resuming campaign {} '{}'", c.id, c.name);
   reaper_ = std::thread([this] { reap_loop(); });
@@ -57,7 +84,7 @@ void Coordinator::reap_loop() {
   while (!shut_) {
     lock.unlock();
     try {
-      if (const int n = store_->reap(now_seconds()); n > 0)
+      if (const int n = store_->reap(steady_seconds()); n > 0)
         spdlog::warn("reaper: {} expired lease(s) returned to the queue or failed", n);
     } catch (const std::exception& e) {
       spdlog::error("reaper: {}", e.what());

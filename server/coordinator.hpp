@@ -18,11 +18,19 @@ namespace demcal::server {
 struct CoordinatorOptions {
   std::string listen = "127.0.0.1:7311";  ///< port 0 picks a free one (see port())
   std::string db = "demcal.db";
-  std::string token;  ///< empty: no auth (only allowed on loopback)
+  std::string token;         ///< opens both services (all three empty: no auth, loopback only)
+  std::string worker_token;  ///< opens only the WorkerService
+  std::string client_token;  ///< opens only the CampaignService
+  bool reflection = false;   ///< serve gRPC server reflection
   double lease_seconds = 60.0;
   double heartbeat_seconds = 10.0;
   double reaper_seconds = 1.0;
+  /// A lease found in the file at start-up expires no sooner than this (nor than a lease)
+  /// after start-up: workers that ran on while the coordinator was down reconnect and report.
+  double grace_seconds = 30.0;
   int max_attempts = 3;
+  int max_starts = 256;              ///< Calibrate `starts`, at most
+  double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
   std::string tls_cert, tls_key;
   bool insecure = false;  ///< plain TCP (behind a trusted network or a TLS-terminating proxy)
 };

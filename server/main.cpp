@@ -24,20 +24,34 @@ void write_port_file(const std::string& path, int port) {
 
 int main(int argc, char** argv) {
   demcal::server::CoordinatorOptions o;
-  std::string port_file, token_file, http, http_port_file;
+  std::string port_file, token_file, worker_token_file, client_token_file, http, http_port_file;
   CLI::App app{"demcal-server - the calibration coordinator (SQLite store, gRPC services)"};
   app.add_option("--listen", o.listen, "address:port (port 0 = any free port)")
       ->capture_default_str();
   app.add_option("--db", o.db, "SQLite file")->capture_default_str();
   app.add_option("--token", o.token, "bearer token workers and clients must send")
       ->envname("DEMCAL_TOKEN");
-  app.add_option("--token-file", token_file, "read the token from a file");
+  app.add_option("--token-file", token_file,
+                 "read the token from a file (it opens both services: the operator's)");
+  app.add_option("--worker-token-file", worker_token_file,
+                 "the token of workers: Lease, Heartbeat, Complete, Fail only");
+  app.add_option("--client-token-file", client_token_file,
+                 "the token of clients: the campaign service only (submit, cancel, queries)");
+  app.add_flag("--reflection", o.reflection, "serve gRPC server reflection (off by default)");
   app.add_option("--lease", o.lease_seconds, "lease duration (s)")->capture_default_str();
   app.add_option("--heartbeat", o.heartbeat_seconds, "heartbeat interval asked of workers (s)")
       ->capture_default_str();
   app.add_option("--reaper-interval", o.reaper_seconds, "how often expired leases are reaped (s)")
       ->capture_default_str();
+  app.add_option("--grace", o.grace_seconds,
+                 "leases found at start-up expire no sooner than this after it (s)")
+      ->capture_default_str();
   app.add_option("--max-attempts", o.max_attempts, "leases per job before it fails")
+      ->capture_default_str();
+  app.add_option("--max-starts", o.max_starts, "Calibrate starts a client may ask for, at most")
+      ->capture_default_str();
+  app.add_option("--max-watch-interval", o.max_watch_interval,
+                 "Watch interval a client may ask for, at most (s)")
       ->capture_default_str();
   app.add_option("--tls-cert", o.tls_cert, "PEM certificate chain (enables TLS)");
   app.add_option("--tls-key", o.tls_key, "PEM private key");
@@ -47,12 +61,16 @@ int main(int argc, char** argv) {
                  "HOST:PORT of the live report page (read-only, same token; docs/report.md)");
   app.add_option("--http-port-file", http_port_file, "write the HTTP port to this file");
   CLI11_PARSE(app, argc, argv);
-  if (!token_file.empty()) try {
-      o.token = demcal::proto::read_token_file(token_file);
-    } catch (const std::exception& e) {
-      spdlog::critical("{}", e.what());
-      return 2;
-    }
+  // A token file that was named and cannot be read stops the server: it never means "no token".
+  try {
+    for (auto [file, token] :
+         {std::pair{&token_file, &o.token}, std::pair{&worker_token_file, &o.worker_token},
+          std::pair{&client_token_file, &o.client_token}})
+      if (!file->empty()) *token = demcal::proto::read_token_file(*file);
+  } catch (const std::exception& e) {
+    spdlog::critical("{}", e.what());
+    return 2;
+  }
   // Signals are taken synchronously by this thread; every other thread inherits the mask.
   sigset_t set;
   sigemptyset(&set);
@@ -64,9 +82,11 @@ int main(int argc, char** argv) {
     write_port_file(port_file, coordinator.port());
     std::unique_ptr<demcal::server::HttpPage> page;
     if (!http.empty()) {
+      // The page is a read-only client: it takes the client token where one is set.
+      const std::string& page_token = o.client_token.empty() ? o.token : o.client_token;
       page = std::make_unique<demcal::server::HttpPage>(
           coordinator.in_process_channel(),
-          demcal::server::HttpPageOptions{http, o.token, o.tls_cert, o.tls_key});
+          demcal::server::HttpPageOptions{http, page_token, o.tls_cert, o.tls_key});
       write_port_file(http_port_file, page->port());
     }
     int sig = 0;

@@ -17,7 +17,7 @@
 namespace demcal::server {
 
 double now_seconds() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return wall_seconds();
 }
 
 namespace {
@@ -28,16 +28,55 @@ grpc::Status invalid(const InputError& e) {
 grpc::Status not_found(std::int64_t id) {
   return {grpc::StatusCode::NOT_FOUND, "no campaign " + std::to_string(id)};
 }
+/// The answer to a call naming a lease that is not the caller's current one.
+grpc::Status lease_refused(LeaseAnswer answer, std::int64_t job_id, int attempt,
+                           const std::string& worker, const std::string& consequence) {
+  const std::string lease = "job " + std::to_string(job_id) + " attempt " + std::to_string(attempt);
+  if (answer == LeaseAnswer::kNotHolder)
+    return {grpc::StatusCode::PERMISSION_DENIED,
+            lease + " is leased to another worker than '" + worker + "'" + consequence};
+  return {grpc::StatusCode::FAILED_PRECONDITION, lease + " is not the current lease" + consequence};
+}
+
+/// A cancelled campaign runs nothing more: work that would queue jobs on it is refused (the
+/// jobs would never be leased and the caller would wait for them forever).
+grpc::Status refuse_if_cancelled(const CampaignRow& row, const std::string& what) {
+  if (row.state != "cancelled") return grpc::Status::OK;
+  return {grpc::StatusCode::FAILED_PRECONDITION,
+          "campaign " + std::to_string(row.id) + " is cancelled: " + what +
+              " would queue jobs that never run (submit the spec again)"};
+}
+
+/// Streams `content` in pieces of at most kExportPiece bytes (one empty piece for empty content).
+grpc::Status write_in_pieces(const std::string& content, const std::string& format,
+                             grpc::ServerWriter<v1::ExportReply>& writer,
+                             const grpc::ServerContext& ctx) {
+  constexpr std::size_t kExportPiece = std::size_t(1) << 20;
+  std::size_t at = 0;
+  do {
+    v1::ExportReply piece;
+    piece.set_format(format);
+    piece.set_content(content.substr(at, kExportPiece));
+    if (ctx.IsCancelled() || !writer.Write(piece))
+      return {grpc::StatusCode::CANCELLED, "export: the client went away"};
+    at += kExportPiece;
+  } while (at < content.size());
+  return grpc::Status::OK;
+}
+
 grpc::Status internal(const std::exception& e) {
   spdlog::error("internal error: {}", e.what());
   return {grpc::StatusCode::INTERNAL, e.what()};
 }
 
-#define DEMCAL_AUTHORIZE(ctx)                                    \
-  if (auto s = authorize(*(ctx), config_.token); !s.ok()) {      \
-    spdlog::warn("unauthenticated call from {}", (ctx)->peer()); \
-    return s;                                                    \
-  }
+/// The authorization check (auth.hpp) and its log line; every handler starts with it.
+grpc::Status admit(const grpc::ServerContext& ctx, const Tokens& tokens, Caller caller) {
+  auto s = authorize(ctx, tokens, caller);
+  if (!s.ok())
+    spdlog::warn("{} call from {}: {}", caller == Caller::kWorker ? "worker" : "client", ctx.peer(),
+                 s.error_message());
+  return s;
+}
 
 doe::ModelKind model_kind(const std::string& text, const std::string& where) {
   return text.empty() ? doe::ModelKind::kTwoFactor : doe::parse_model_kind(text, where);
@@ -47,7 +86,7 @@ doe::ModelKind model_kind(const std::string& text, const std::string& where) {
 
 grpc::Status CampaignServiceImpl::Submit(grpc::ServerContext* ctx, const v1::SubmitRequest* req,
                                          v1::SubmitReply* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
   try {
     std::vector<NewJob> jobs;
     const CampaignPlan plan = plan_campaign(req->spec(), jobs);
@@ -68,7 +107,7 @@ grpc::Status CampaignServiceImpl::Submit(grpc::ServerContext* ctx, const v1::Sub
 
 grpc::Status CampaignServiceImpl::Get(grpc::ServerContext* ctx, const v1::GetRequest* req,
                                       v1::Campaign* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   try {
@@ -82,7 +121,7 @@ grpc::Status CampaignServiceImpl::Get(grpc::ServerContext* ctx, const v1::GetReq
 
 grpc::Status CampaignServiceImpl::List(grpc::ServerContext* ctx, const v1::ListRequest*,
                                        v1::ListReply* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
   const double now = now_seconds();
   for (const auto& row : store_.campaigns())
     *reply->add_campaigns() = campaign_message(row, store_.counts(row.id), now, false);
@@ -91,11 +130,13 @@ grpc::Status CampaignServiceImpl::List(grpc::ServerContext* ctx, const v1::ListR
 
 grpc::Status CampaignServiceImpl::Cancel(grpc::ServerContext* ctx, const v1::CancelRequest* req,
                                          v1::Campaign* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
   if (!store_.cancel(req->id(), now_seconds())) {
-    if (!store_.campaign(req->id())) return not_found(req->id());
+    const auto row = store_.campaign(req->id());
+    if (!row) return not_found(req->id());
     return {grpc::StatusCode::FAILED_PRECONDITION,
-            "campaign " + std::to_string(req->id()) + " is done: nothing to cancel"};
+            "campaign " + std::to_string(req->id()) + " is " + row->state +
+                ": only a running campaign can be cancelled"};
   }
   spdlog::info("campaign {} cancelled", req->id());
   const auto row = store_.campaign(req->id());
@@ -105,10 +146,12 @@ grpc::Status CampaignServiceImpl::Cancel(grpc::ServerContext* ctx, const v1::Can
 
 grpc::Status CampaignServiceImpl::Watch(grpc::ServerContext* ctx, const v1::WatchRequest* req,
                                         grpc::ServerWriter<v1::Progress>* writer) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
   const double interval = req->interval_seconds() != 0.0 ? req->interval_seconds() : 0.5;
-  if (!(interval > 0.0 && interval <= 60.0))
-    return {grpc::StatusCode::INVALID_ARGUMENT, "interval_seconds: must lie in (0, 60]"};
+  if (!(interval >= kMinWatchInterval && interval <= config_.max_watch_interval))
+    return {grpc::StatusCode::INVALID_ARGUMENT,
+            fmt::format("interval_seconds: must lie in [{}, {}] (or 0 for 0.5)", kMinWatchInterval,
+                        config_.max_watch_interval)};
   std::string last;
   double last_sent = 0.0;
   while (!ctx->IsCancelled() && !stopping_) {
@@ -133,7 +176,7 @@ grpc::Status CampaignServiceImpl::Watch(grpc::ServerContext* ctx, const v1::Watc
 
 grpc::Status CampaignServiceImpl::GetDesign(grpc::ServerContext* ctx, const v1::GetRequest* req,
                                             v1::DesignReply* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   *reply = design_reply(plan_from_json(row->design_json), int(store_.counts(row->id).total()));
@@ -142,7 +185,7 @@ grpc::Status CampaignServiceImpl::GetDesign(grpc::ServerContext* ctx, const v1::
 
 grpc::Status CampaignServiceImpl::GetResults(grpc::ServerContext* ctx, const v1::GetRequest* req,
                                              v1::ResultsReply* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
   if (!store_.campaign(req->id())) return not_found(req->id());
   try {
     for (const auto& job : store_.jobs(req->id())) *reply->add_jobs() = job_message(job);
@@ -155,7 +198,7 @@ grpc::Status CampaignServiceImpl::GetResults(grpc::ServerContext* ctx, const v1:
 grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
                                              const v1::EffectsRequest* req,
                                              v1::EffectsReply* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   try {
@@ -205,9 +248,14 @@ grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
 grpc::Status CampaignServiceImpl::Calibrate(grpc::ServerContext* ctx,
                                             const v1::CalibrateRequest* req,
                                             v1::CalibrateReply* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (req->starts() < 0 || req->starts() > config_.max_starts)
+    return {grpc::StatusCode::INVALID_ARGUMENT,
+            "starts: must lie in [0, " + std::to_string(config_.max_starts) + "] (0 for 16)"};
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
+  if (req->verify())
+    if (auto s = refuse_if_cancelled(*row, "calibrate --verify"); !s.ok()) return s;
   try {
     // One calibration step at a time: two concurrent calls must not queue the same round twice.
     std::lock_guard lock(calibrate_mutex_);
@@ -225,9 +273,10 @@ grpc::Status CampaignServiceImpl::Calibrate(grpc::ServerContext* ctx,
 
 grpc::Status CampaignServiceImpl::Diagnose(grpc::ServerContext* ctx, const v1::DiagnoseRequest* req,
                                            v1::DiagnoseReply* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
+  if (auto s = refuse_if_cancelled(*row, "diagnose"); !s.ok()) return s;
   try {
     // One diagnosis step at a time: two concurrent calls must not queue the same runs twice.
     std::lock_guard lock(diagnose_mutex_);
@@ -241,32 +290,32 @@ grpc::Status CampaignServiceImpl::Diagnose(grpc::ServerContext* ctx, const v1::D
 }
 
 grpc::Status CampaignServiceImpl::Export(grpc::ServerContext* ctx, const v1::ExportRequest* req,
-                                         v1::ExportReply* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+                                         grpc::ServerWriter<v1::ExportReply>* writer) {
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   const std::string format = req->format().empty() ? "json" : req->format();
   if (format != "json" && format != "csv")
     return {grpc::StatusCode::INVALID_ARGUMENT, "format: expected csv or json"};
-  reply->set_format(format);
+  std::string content;
   try {
-    reply->set_content(export_campaign(*row, plan_from_json(row->design_json), store_.jobs(row->id),
-                                       calibration_rounds(store_, *row), format));
+    content = export_campaign(*row, plan_from_json(row->design_json), store_.jobs(row->id),
+                              calibration_rounds(store_, *row), format);
   } catch (const std::exception& e) {
     return internal(e);
   }
-  return grpc::Status::OK;
+  return write_in_pieces(content, format, *writer, *ctx);
 }
 
 // ---- WorkerService ----
 
 grpc::Status WorkerServiceImpl::Lease(grpc::ServerContext* ctx, const v1::LeaseRequest* req,
                                       v1::LeaseReply* reply) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
   reply->set_lease_seconds(store_.limits().lease_seconds);
   reply->set_heartbeat_seconds(config_.heartbeat_seconds);
   reply->set_retry_after_seconds(config_.idle_retry_seconds);
-  const auto job = store_.lease(req->worker(), now_seconds());
+  const auto job = store_.lease(req->worker(), steady_seconds());
   if (!job) return grpc::Status::OK;
   v1::JobSpec spec;
   try {
@@ -285,11 +334,11 @@ grpc::Status WorkerServiceImpl::Lease(grpc::ServerContext* ctx, const v1::LeaseR
 
 grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* ctx, const v1::HeartbeatRequest* req,
                                           v1::HeartbeatReply* reply) {
-  DEMCAL_AUTHORIZE(ctx);
-  if (!store_.heartbeat(req->job_id(), req->attempt(), now_seconds()))
-    return {grpc::StatusCode::FAILED_PRECONDITION,
-            "job " + std::to_string(req->job_id()) + " attempt " + std::to_string(req->attempt()) +
-                " is not the current lease"};
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
+  if (const auto answer =
+          store_.heartbeat(req->job_id(), req->attempt(), req->worker(), steady_seconds());
+      answer != LeaseAnswer::kOk)
+    return lease_refused(answer, req->job_id(), req->attempt(), req->worker(), "");
   reply->set_lease_seconds(store_.limits().lease_seconds);
   return grpc::Status::OK;
 }
@@ -336,19 +385,20 @@ std::string result_error(const v1::CompleteRequest& req) {
 
 grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::CompleteRequest* req,
                                          v1::CompleteReply*) {
-  DEMCAL_AUTHORIZE(ctx);
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
   if (const std::string error = result_error(*req); !error.empty())
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
   std::map<std::string, double> metrics(req->metrics().begin(), req->metrics().end());
   const nlohmann::json flags(
       std::map<std::string, std::string>(req->flags().begin(), req->flags().end()));
-  if (!store_.complete(req->job_id(), req->attempt(), req->worker(), metrics_to_json(metrics),
-                       req->wall_seconds(), now_seconds(), flags.dump(), to_json(req->cost()))) {
-    spdlog::warn("job {}: result of attempt {} from {} rejected (not the current lease)",
-                 req->job_id(), req->attempt(), req->worker());
-    return {grpc::StatusCode::FAILED_PRECONDITION,
-            "job " + std::to_string(req->job_id()) + " attempt " + std::to_string(req->attempt()) +
-                " is not the current lease; result not stored"};
+  if (const auto answer = store_.complete(req->job_id(), req->attempt(), req->worker(),
+                                          metrics_to_json(metrics), req->wall_seconds(),
+                                          steady_seconds(), flags.dump(), to_json(req->cost()));
+      answer != LeaseAnswer::kOk) {
+    spdlog::warn("job {}: result of attempt {} from {} rejected", req->job_id(), req->attempt(),
+                 req->worker());
+    return lease_refused(answer, req->job_id(), req->attempt(), req->worker(),
+                         "; result not stored");
   }
   spdlog::info("job {} done by {} in {:.2f} s", req->job_id(), req->worker(), req->wall_seconds());
   return grpc::Status::OK;
@@ -356,12 +406,11 @@ grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::Com
 
 grpc::Status WorkerServiceImpl::Fail(grpc::ServerContext* ctx, const v1::FailRequest* req,
                                      v1::FailReply*) {
-  DEMCAL_AUTHORIZE(ctx);
-  if (!store_.fail(req->job_id(), req->attempt(), req->reason(), req->retryable(), req->give_back(),
-                   now_seconds()))
-    return {grpc::StatusCode::FAILED_PRECONDITION,
-            "job " + std::to_string(req->job_id()) + " attempt " + std::to_string(req->attempt()) +
-                " is not the current lease"};
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
+  if (const auto answer = store_.fail(req->job_id(), req->attempt(), req->worker(), req->reason(),
+                                      req->retryable(), req->give_back(), steady_seconds());
+      answer != LeaseAnswer::kOk)
+    return lease_refused(answer, req->job_id(), req->attempt(), req->worker(), "");
   spdlog::info("job {} attempt {} {} by {}: {}", req->job_id(), req->attempt(),
                req->give_back() ? "given back" : "failed", req->worker(), req->reason());
   return grpc::Status::OK;

@@ -8,15 +8,21 @@
 
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
+#include "server/auth.hpp"
 #include "server/store.hpp"
 
 namespace demcal::server {
 
 struct ServiceConfig {
-  std::string token;
+  Tokens tokens;
   double heartbeat_seconds = 10.0;
   double idle_retry_seconds = 1.0;
+  int max_starts = 256;              ///< Calibrate `starts`, at most
+  double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
 };
+
+/// The shortest Watch interval: each tick reads the store.
+constexpr double kMinWatchInterval = 0.05;
 
 double now_seconds();
 
@@ -39,7 +45,8 @@ class CampaignServiceImpl final : public v1::CampaignService::Service {
                          v1::CalibrateReply*) override;
   grpc::Status Diagnose(grpc::ServerContext*, const v1::DiagnoseRequest*,
                         v1::DiagnoseReply*) override;
-  grpc::Status Export(grpc::ServerContext*, const v1::ExportRequest*, v1::ExportReply*) override;
+  grpc::Status Export(grpc::ServerContext*, const v1::ExportRequest*,
+                      grpc::ServerWriter<v1::ExportReply>*) override;
 
  private:
   Store& store_;

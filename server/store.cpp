@@ -3,10 +3,21 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <stdexcept>
 #include <tuple>
 
 namespace demcal::server {
+
+double steady_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
 namespace {
 
 /// Schema migrations: migration i takes user_version i to i + 1. Never edit a released one.
@@ -117,6 +128,11 @@ const std::vector<const char*>& migrations() {
         created REAL NOT NULL,
         PRIMARY KEY (campaign_id, stage));
       )sql",
+      // 5: a campaign's jobs are inserted in batches, each in its own short transaction; the
+      // campaign is invisible (ready = 0) until the last batch is in.
+      R"sql(
+      ALTER TABLE campaigns ADD COLUMN ready INTEGER NOT NULL DEFAULT 1;
+      )sql",
   };
   return m;
 }
@@ -144,6 +160,11 @@ class Store::Statement {
     return *this;
   }
   /// True while there is a row.
+  /// Ready to run again with new bindings.
+  void reset() {
+    sqlite3_reset(stmt_);
+    sqlite3_clear_bindings(stmt_);
+  }
   bool step() {
     const int rc = sqlite3_step(stmt_);
     if (rc == SQLITE_ROW) return true;
@@ -181,6 +202,29 @@ class Store::Transaction {
   bool done_ = false;
 };
 
+/// The store's lock. A hold longer than a quarter second (a large insert, a slow disk) is added
+/// to every lease deadline, so workers whose heartbeats waited for the lock keep their leases.
+class Store::Guard {
+ public:
+  explicit Guard(Store& s) : s_(s), lock_(s.mutex_), start_(s.clock_now()) {}
+  ~Guard() {
+    constexpr double kStallSeconds = 0.25;
+    if (const double held = s_.clock_now() - start_; held > kStallSeconds)
+      s_.extend_deadlines(held);
+  }
+  Guard(const Guard&) = delete;
+  Guard& operator=(const Guard&) = delete;
+
+ private:
+  Store& s_;
+  std::lock_guard<std::mutex> lock_;
+  double start_;
+};
+
+void Store::extend_deadlines(double seconds) {
+  for (auto& [job, deadline] : deadlines_) deadline += seconds;
+}
+
 namespace {
 /// Creates a new database file readable by its owner only (0600): it holds every spec and result.
 /// SQLite gives the -wal and -shm files the main file's permissions. An existing file is left as
@@ -192,7 +236,8 @@ void create_private_file(const std::string& path) {
 }
 }  // namespace
 
-Store::Store(const std::string& path, StoreLimits limits) : limits_(limits) {
+Store::Store(const std::string& path, StoreLimits limits, std::optional<double> opened)
+    : limits_(limits) {
   create_private_file(path);
   if (sqlite3_open_v2(path.c_str(), &db_,
                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
@@ -203,10 +248,38 @@ Store::Store(const std::string& path, StoreLimits limits) : limits_(limits) {
   }
   sqlite3_busy_timeout(db_, 10000);
   exec("PRAGMA journal_mode=WAL");
+  require_wal(path);
   exec("PRAGMA synchronous=FULL");
   // Foreign keys are enforced from here on; migrations that rebuild a table run before.
   migrate();
   exec("PRAGMA foreign_keys=ON");
+  drop_unfinished_campaigns();
+  restore_leases(opened.value_or(steady_seconds()));
+}
+
+void Store::require_wal(const std::string& path) {
+  // SQLite keeps the old journal mode, silently, where WAL is impossible (a file system without
+  // shared memory, a read-only directory): the crash guarantees in the header would not hold.
+  if (path.empty() || path == ":memory:") return;  // no file: nothing to recover after a crash
+  const std::string mode = journal_mode_unlocked();
+  if (mode != "wal")
+    throw std::runtime_error("cannot put " + path + " in WAL mode (journal_mode is " + mode +
+                             "): use a local file system the coordinator can write to");
+}
+
+void Store::restore_leases(double opened) {
+  // The deadlines of the previous run are gone with its clock: a worker still running a job
+  // leased before a restart has a whole lease from the opening to report or heartbeat again.
+  Statement s(db_, "SELECT id FROM jobs WHERE state = 'leased'");
+  const double deadline = opened + std::max(limits_.lease_seconds, limits_.restart_grace_seconds);
+  while (s.step()) deadlines_[s.i64(0)] = deadline;
+}
+
+std::optional<double> Store::lease_deadline(std::int64_t job_id) {
+  Guard lock(*this);
+  const auto it = deadlines_.find(job_id);
+  if (it == deadlines_.end()) return std::nullopt;
+  return it->second;
 }
 
 Store::~Store() {
@@ -227,14 +300,18 @@ int Store::latest_schema_version() {
 }
 
 int Store::schema_version() {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Statement s(db_, "PRAGMA user_version");
   s.step();
   return s.i32(0);
 }
 
 std::string Store::journal_mode() {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
+  return journal_mode_unlocked();
+}
+
+std::string Store::journal_mode_unlocked() {
   Statement s(db_, "PRAGMA journal_mode");
   s.step();
   return s.text(0);
@@ -260,39 +337,74 @@ void Store::migrate() {
 std::int64_t Store::create_campaign(const std::string& name, const std::string& spec_json,
                                     const std::string& design_json, const std::vector<NewJob>& jobs,
                                     double now) {
-  std::lock_guard lock(mutex_);
-  Transaction tx(*this);
-  Statement c(db_,
-              "INSERT INTO campaigns (name, state, spec_json, design_json, created) "
-              "VALUES (?, 'running', ?, ?, ?)");
-  c.bind(1, name).bind(2, spec_json).bind(3, design_json).bind(4, now).step();
-  const std::int64_t id = sqlite3_last_insert_rowid(db_);
-  for (const auto& job : jobs) {
-    Statement s(db_,
-                "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state) "
-                "VALUES (?, ?, ?, ?, ?, ?, 'queued')");
-    s.bind(1, id).bind(2, job.std_order).bind(3, job.run_order).bind(4, job.test);
-    s.bind(5, job.kind).bind(6, job.payload).step();
+  std::int64_t id = 0;
+  {
+    Guard lock(*this);
+    Transaction tx(*this);
+    Statement c(db_,
+                "INSERT INTO campaigns (name, state, spec_json, design_json, created, ready) "
+                "VALUES (?, 'running', ?, ?, ?, 0)");
+    c.bind(1, name).bind(2, spec_json).bind(3, design_json).bind(4, now).step();
+    id = sqlite3_last_insert_rowid(db_);
+    tx.commit();
   }
+  // Between two batches the lock is free for heartbeats, leases and results of other campaigns.
+  for (std::size_t first = 0; first < jobs.size(); first += kInsertBatch) {
+    Guard lock(*this);
+    Transaction tx(*this);
+    insert_job_rows(id, jobs, first, std::min(jobs.size(), first + kInsertBatch));
+    tx.commit();
+  }
+  Guard lock(*this);
+  Transaction tx(*this);
+  Statement r(db_, "UPDATE campaigns SET ready = 1 WHERE id = ?");
+  r.bind(1, id).step();
   tx.commit();
   return id;
 }
 
+std::vector<std::int64_t> Store::insert_job_rows(std::int64_t campaign_id,
+                                                 const std::vector<NewJob>& jobs, std::size_t first,
+                                                 std::size_t end) {
+  std::vector<std::int64_t> ids;
+  Statement s(db_,
+              "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state) "
+              "VALUES (?, ?, ?, ?, ?, ?, 'queued')");
+  for (std::size_t i = first; i < end; ++i) {
+    const auto& job = jobs[i];
+    s.bind(1, campaign_id).bind(2, job.std_order).bind(3, job.run_order).bind(4, job.test);
+    s.bind(5, job.kind).bind(6, job.payload).step();
+    s.reset();
+    ids.push_back(sqlite3_last_insert_rowid(db_));
+  }
+  return ids;
+}
+
+void Store::drop_unfinished_campaigns() {
+  // A coordinator stopped while inserting a campaign's jobs: the submission never answered, so
+  // nobody knows the campaign; it goes with its jobs.
+  Transaction tx(*this);
+  exec("DELETE FROM jobs WHERE campaign_id IN (SELECT id FROM campaigns WHERE ready = 0)");
+  exec("DELETE FROM campaigns WHERE ready = 0");
+  tx.commit();
+}
+
 namespace {
 constexpr const char* kCampaignColumns =
-    "SELECT id, name, state, spec_json, design_json, created, finished FROM campaigns";
+    "SELECT id, name, state, spec_json, design_json, created, finished FROM campaigns WHERE "
+    "ready = 1";
 }
 
 std::optional<CampaignRow> Store::campaign(std::int64_t id) {
-  std::lock_guard lock(mutex_);
-  Statement s(db_, (std::string(kCampaignColumns) + " WHERE id = ?").c_str());
+  Guard lock(*this);
+  Statement s(db_, (std::string(kCampaignColumns) + " AND id = ?").c_str());
   s.bind(1, id);
   if (!s.step()) return std::nullopt;
   return CampaignRow{s.i64(0), s.text(1), s.text(2), s.text(3), s.text(4), s.f64(5), s.f64(6)};
 }
 
 std::vector<CampaignRow> Store::campaigns() {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Statement s(db_, (std::string(kCampaignColumns) + " ORDER BY id").c_str());
   std::vector<CampaignRow> out;
   while (s.step())
@@ -301,7 +413,7 @@ std::vector<CampaignRow> Store::campaigns() {
 }
 
 Counts Store::counts(std::int64_t campaign_id, const std::string& kind) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Statement s(db_,
               "SELECT state, COUNT(*) FROM jobs WHERE campaign_id = ? AND (? = '' OR kind = ?) "
               "GROUP BY state");
@@ -352,7 +464,7 @@ JobRow read_job(const S& s) {
 }
 
 std::vector<JobRow> Store::jobs(std::int64_t campaign_id) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Statement s(db_, (std::string(kJobColumns) + " WHERE j.campaign_id = ? ORDER BY j.id").c_str());
   s.bind(1, campaign_id);
   std::vector<JobRow> out;
@@ -361,7 +473,7 @@ std::vector<JobRow> Store::jobs(std::int64_t campaign_id) {
 }
 
 std::optional<JobRow> Store::job(std::int64_t job_id) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Statement s(db_, (std::string(kJobColumns) + " WHERE j.id = ?").c_str());
   s.bind(1, job_id);
   if (!s.step()) return std::nullopt;
@@ -369,13 +481,13 @@ std::optional<JobRow> Store::job(std::int64_t job_id) {
 }
 
 bool Store::cancel(std::int64_t campaign_id, double now) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Transaction tx(*this);
-  // A done campaign stays done: its results are complete, and a later verification or diagnosis
-  // reopens it (add_jobs) rather than finding it cancelled.
+  // Only a running campaign is cancelled. A done one stays done: its results are complete, and
+  // a later verification or diagnosis reopens it (add_jobs) rather than finding it cancelled.
   Statement c(db_,
-              "UPDATE campaigns SET state = 'cancelled', finished = ? WHERE id = ? AND state <> "
-              "'done'");
+              "UPDATE campaigns SET state = 'cancelled', finished = ? WHERE id = ? AND state = "
+              "'running'");
   c.bind(1, now).bind(2, campaign_id).step();
   if (sqlite3_changes(db_) == 0) return false;
   Statement j(db_,
@@ -388,15 +500,7 @@ bool Store::cancel(std::int64_t campaign_id, double now) {
 
 std::vector<std::int64_t> Store::insert_jobs(std::int64_t campaign_id,
                                              const std::vector<NewJob>& jobs) {
-  std::vector<std::int64_t> ids;
-  for (const auto& job : jobs) {
-    Statement s(db_,
-                "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state) "
-                "VALUES (?, ?, ?, ?, ?, ?, 'queued')");
-    s.bind(1, campaign_id).bind(2, job.std_order).bind(3, job.run_order).bind(4, job.test);
-    s.bind(5, job.kind).bind(6, job.payload).step();
-    ids.push_back(sqlite3_last_insert_rowid(db_));
-  }
+  auto ids = insert_job_rows(campaign_id, jobs, 0, jobs.size());
   Statement c(
       db_, "UPDATE campaigns SET state = 'running', finished = 0 WHERE id = ? AND state = 'done'");
   c.bind(1, campaign_id).step();
@@ -405,7 +509,7 @@ std::vector<std::int64_t> Store::insert_jobs(std::int64_t campaign_id,
 
 std::vector<std::int64_t> Store::add_jobs(std::int64_t campaign_id,
                                           const std::vector<NewJob>& jobs) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Transaction tx(*this);
   auto ids = insert_jobs(campaign_id, jobs);
   tx.commit();
@@ -415,7 +519,7 @@ std::vector<std::int64_t> Store::add_jobs(std::int64_t campaign_id,
 std::vector<std::int64_t> Store::add_calibration_round(std::int64_t campaign_id,
                                                        const CalibrationRoundRow& round,
                                                        const std::vector<NewJob>& jobs) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Transaction tx(*this);
   Statement s(db_,
               "INSERT INTO calibration_rounds (campaign_id, round, stage, proposal_json, created) "
@@ -430,7 +534,7 @@ std::vector<std::int64_t> Store::add_calibration_round(std::int64_t campaign_id,
 std::vector<std::int64_t> Store::add_calibration_stage(std::int64_t campaign_id,
                                                        const CalibrationStageRow& stage,
                                                        const std::vector<NewJob>& jobs) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Transaction tx(*this);
   Statement s(db_,
               "INSERT INTO calibration_stages (campaign_id, stage, box_json, created) "
@@ -443,7 +547,7 @@ std::vector<std::int64_t> Store::add_calibration_stage(std::int64_t campaign_id,
 }
 
 std::vector<CalibrationRoundRow> Store::calibration_rounds(std::int64_t campaign_id) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Statement s(db_,
               "SELECT round, stage, proposal_json, created FROM calibration_rounds "
               "WHERE campaign_id = ? ORDER BY round");
@@ -454,7 +558,7 @@ std::vector<CalibrationRoundRow> Store::calibration_rounds(std::int64_t campaign
 }
 
 std::vector<CalibrationStageRow> Store::calibration_stages(std::int64_t campaign_id) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Statement s(db_,
               "SELECT stage, box_json, created FROM calibration_stages "
               "WHERE campaign_id = ? ORDER BY stage");
@@ -465,56 +569,76 @@ std::vector<CalibrationStageRow> Store::calibration_stages(std::int64_t campaign
 }
 
 std::optional<JobRow> Store::lease(const std::string& worker, double now) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Transaction tx(*this);
   Statement s(db_,
               "SELECT j.id FROM jobs j JOIN campaigns c ON c.id = j.campaign_id "
-              "WHERE j.state = 'queued' AND c.state = 'running' "
+              "WHERE j.state = 'queued' AND c.state = 'running' AND c.ready = 1 "
               "ORDER BY j.campaign_id, j.kind, j.run_order, j.id LIMIT 1");
   if (!s.step()) return std::nullopt;
   const std::int64_t id = s.i64(0);
   Statement u(db_,
               "UPDATE jobs SET state = 'leased', attempt = attempt + 1, counted = counted + 1, "
-              "lease_deadline = ?, worker = ? WHERE id = ? AND state = 'queued'");
-  u.bind(1, now + limits_.lease_seconds).bind(2, worker).bind(3, id).step();
+              "worker = ? WHERE id = ? AND state = 'queued'");
+  u.bind(1, worker).bind(2, id).step();
   Statement r(db_, (std::string(kJobColumns) + " WHERE j.id = ?").c_str());
   r.bind(1, id);
   r.step();
   JobRow job = read_job(r);
   tx.commit();
+  deadlines_[id] = now + limits_.lease_seconds;
+  job.lease_deadline = deadlines_[id];
   return job;
 }
 
-bool Store::heartbeat(std::int64_t job_id, int attempt, double now) {
-  std::lock_guard lock(mutex_);
-  Transaction tx(*this);
-  Statement u(db_,
-              "UPDATE jobs SET lease_deadline = ? WHERE id = ? AND attempt = ? AND "
-              "state = 'leased' AND lease_deadline >= ?");
-  u.bind(1, now + limits_.lease_seconds).bind(2, job_id).bind(3, attempt).bind(4, now).step();
-  const bool ok = sqlite3_changes(db_) == 1;
-  tx.commit();
-  return ok;
+LeaseAnswer Store::check_lease(std::int64_t job_id, int attempt, const std::string& worker,
+                               double now) {
+  Statement s(db_, "SELECT worker FROM jobs WHERE id = ? AND attempt = ? AND state = 'leased'");
+  s.bind(1, job_id).bind(2, attempt);
+  if (!s.step()) return LeaseAnswer::kStale;
+  const auto it = deadlines_.find(job_id);
+  if (it == deadlines_.end() || it->second < now) return LeaseAnswer::kStale;
+  return s.text(0) == worker ? LeaseAnswer::kOk : LeaseAnswer::kNotHolder;
 }
 
-bool Store::complete(std::int64_t job_id, int attempt, const std::string& worker,
-                     const std::string& metrics_json, double wall_seconds, double now,
-                     const std::string& flags_json, const std::string& cost_json) {
-  std::lock_guard lock(mutex_);
+bool Store::already_stored(std::int64_t job_id, int attempt, const std::string& worker,
+                           const std::string& metrics_json, double wall_seconds) {
+  Statement s(db_,
+              "SELECT 1 FROM results r JOIN jobs j ON j.id = r.job_id WHERE r.job_id = ? AND "
+              "r.attempt = ? AND r.worker = ? AND r.metrics_json = ? AND r.wall_seconds = ? AND "
+              "j.state = 'done'");
+  s.bind(1, job_id).bind(2, attempt).bind(3, worker).bind(4, metrics_json).bind(5, wall_seconds);
+  return s.step();
+}
+
+LeaseAnswer Store::heartbeat(std::int64_t job_id, int attempt, const std::string& worker,
+                             double now) {
+  Guard lock(*this);
+  const LeaseAnswer answer = check_lease(job_id, attempt, worker, now);
+  if (answer == LeaseAnswer::kOk) deadlines_[job_id] = now + limits_.lease_seconds;
+  return answer;
+}
+
+LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string& worker,
+                            const std::string& metrics_json, double wall_seconds, double now,
+                            const std::string& flags_json, const std::string& cost_json) {
+  Guard lock(*this);
   Transaction tx(*this);
-  Statement u(db_,
-              "UPDATE jobs SET state = 'done', finished = ?, error = '' WHERE id = ? AND "
-              "attempt = ? AND state = 'leased' AND lease_deadline >= ?");
-  u.bind(1, now).bind(2, job_id).bind(3, attempt).bind(4, now).step();
-  if (sqlite3_changes(db_) != 1) return false;  // rolled back: not the current lease
+  if (already_stored(job_id, attempt, worker, metrics_json, wall_seconds)) return LeaseAnswer::kOk;
+  if (const auto answer = check_lease(job_id, attempt, worker, now); answer != LeaseAnswer::kOk)
+    return answer;
+  const double stored = server::wall_seconds();
+  Statement u(db_, "UPDATE jobs SET state = 'done', finished = ?, error = '' WHERE id = ?");
+  u.bind(1, stored).bind(2, job_id).step();
   Statement r(db_,
               "INSERT INTO results (job_id, attempt, worker, metrics_json, wall_seconds, stored, "
               "flags_json, cost_json) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
   r.bind(1, job_id).bind(2, attempt).bind(3, worker).bind(4, metrics_json);
-  r.bind(5, wall_seconds).bind(6, now).bind(7, flags_json).bind(8, cost_json).step();
-  finish_campaigns(now);
+  r.bind(5, wall_seconds).bind(6, stored).bind(7, flags_json).bind(8, cost_json).step();
+  finish_campaigns(stored);
   tx.commit();
-  return true;
+  deadlines_.erase(job_id);
+  return LeaseAnswer::kOk;
 }
 
 bool Store::requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason,
@@ -528,57 +652,68 @@ bool Store::requeue_or_fail(std::int64_t job_id, int counted, const std::string&
   return fail_now;
 }
 
-bool Store::fail(std::int64_t job_id, int attempt, const std::string& reason, bool retryable,
-                 bool give_back, double now) {
-  std::lock_guard lock(mutex_);
+LeaseAnswer Store::fail(std::int64_t job_id, int attempt, const std::string& worker,
+                        const std::string& reason, bool retryable, bool give_back, double now) {
+  Guard lock(*this);
   Transaction tx(*this);
-  Statement s(db_,
-              "SELECT counted FROM jobs WHERE id = ? AND attempt = ? AND state = 'leased' AND "
-              "lease_deadline >= ?");
-  s.bind(1, job_id).bind(2, attempt).bind(3, now);
-  if (!s.step()) return false;
+  if (const auto answer = check_lease(job_id, attempt, worker, now); answer != LeaseAnswer::kOk)
+    return answer;
+  Statement s(db_, "SELECT counted FROM jobs WHERE id = ?");
+  s.bind(1, job_id).step();
   const int counted = s.i32(0);
+  const double at = wall_seconds();
   if (give_back) {
     Statement u(db_,
                 "UPDATE jobs SET state = 'queued', counted = counted - 1, lease_deadline = 0, "
                 "error = ? WHERE id = ?");
     u.bind(1, "given back: " + reason).bind(2, job_id).step();
   } else {
-    requeue_or_fail(job_id, counted, reason, retryable, now);
+    requeue_or_fail(job_id, counted, reason, retryable, at);
   }
-  finish_campaigns(now);
+  finish_campaigns(at);
   tx.commit();
-  return true;
+  deadlines_.erase(job_id);
+  return LeaseAnswer::kOk;
 }
 
 int Store::reap(double now) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
+  std::vector<std::int64_t> due;
+  for (const auto& [job, deadline] : deadlines_)
+    if (deadline < now) due.push_back(job);
+  if (due.empty()) return 0;
   Transaction tx(*this);
-  Statement s(db_,
-              "SELECT id, counted, worker FROM jobs WHERE state = 'leased' AND lease_deadline < ?");
-  s.bind(1, now);
-  std::vector<std::tuple<std::int64_t, int, std::string>> expired;
-  while (s.step()) expired.emplace_back(s.i64(0), s.i32(1), s.text(2));
-  for (const auto& [id, counted, worker] : expired)
+  const double at = wall_seconds();
+  int reaped = 0;
+  for (const auto id : due) {
+    Statement s(db_, "SELECT counted, worker FROM jobs WHERE id = ? AND state = 'leased'");
+    s.bind(1, id);
+    if (!s.step()) continue;  // completed, failed or cancelled meanwhile
+    const int counted = s.i32(0);
     requeue_or_fail(id, counted,
-                    "lease of worker '" + worker + "' expired (attempt " + std::to_string(counted) +
-                        " of " + std::to_string(limits_.max_attempts) + ")",
-                    true, now);
-  if (!expired.empty()) finish_campaigns(now);
+                    "lease of worker '" + s.text(1) + "' expired (attempt " +
+                        std::to_string(counted) + " of " + std::to_string(limits_.max_attempts) +
+                        ")",
+                    true, at);
+    ++reaped;
+  }
+  if (reaped > 0) finish_campaigns(at);
   tx.commit();
-  return static_cast<int>(expired.size());
+  for (const auto id : due) deadlines_.erase(id);
+  return reaped;
 }
 
 void Store::finish_campaigns(double now) {
   Statement u(db_,
               "UPDATE campaigns SET state = 'done', finished = ? WHERE state = 'running' AND "
+              "ready = 1 AND "
               "NOT EXISTS (SELECT 1 FROM jobs j WHERE j.campaign_id = campaigns.id AND "
               "j.state IN ('queued', 'leased'))");
   u.bind(1, now).step();
 }
 
 int Store::result_count(std::int64_t job_id) {
-  std::lock_guard lock(mutex_);
+  Guard lock(*this);
   Statement s(db_, "SELECT COUNT(*) FROM results WHERE job_id = ?");
   s.bind(1, job_id);
   s.step();

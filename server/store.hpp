@@ -11,14 +11,22 @@
 //                                       leased --Fail(give_back)--> queued (attempt not counted)
 //                      queued|leased --Cancel--> cancelled
 // Every lease increments the job's attempt number; Heartbeat, Complete and Fail name
-// (job, attempt) and change nothing unless that lease is the current one and has not expired.
-// A result is stored at most once per job (results.job_id is the primary key).
+// (job, attempt, worker) and change nothing unless that lease is the current one, has not
+// expired and is the caller's. A result is stored at most once per job (results.job_id is the
+// primary key); a retried Complete of the stored result is answered as a success.
+//
+// Lease deadlines live in memory on a monotonic clock (the `now` of lease, heartbeat, complete,
+// fail and reap is steady_seconds()), never in the file: a wall-clock jump cannot expire them,
+// a coordinator restart gives every lease found in the file a fresh deadline (opening + lease),
+// and time the store's lock is held by one long operation is added to every deadline.
 #include <sqlite3.h>
 
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace demcal::server {
@@ -77,21 +85,49 @@ struct Counts {
 struct StoreLimits {
   double lease_seconds = 60.0;
   int max_attempts = 3;
+  /// A lease found in the file at opening expires no sooner than this after the opening (nor
+  /// sooner than a lease): workers that ran on while the coordinator was down need time to
+  /// reconnect (gRPC's reconnection back-off) and report.
+  double restart_grace_seconds = 0.0;
+  /// The monotonic clock that measures how long the lock is held (empty: steady_seconds);
+  /// tests give a fake one.
+  std::function<double()> clock;
+};
+
+/// Seconds on the monotonic clock the store's lease deadlines are kept on.
+double steady_seconds();
+/// Seconds since the Unix epoch, for the records (created, finished, stored).
+double wall_seconds();
+
+/// What became of a call naming a lease (Heartbeat, Complete, Fail).
+enum class LeaseAnswer {
+  kOk,         ///< done; for Complete also a retry of the result already stored
+  kStale,      ///< not the current, unexpired lease of a leased job: nothing changed
+  kNotHolder,  ///< the current lease, but another worker's: nothing changed
 };
 
 class Store {
  public:
-  /// Opens (creating if needed) and migrates; path ":memory:" for tests.
-  explicit Store(const std::string& path, StoreLimits limits = {});
+  /// Opens (creating if needed) and migrates; path ":memory:" for tests. Leases found in the
+  /// file get the deadline `opened + max(lease, restart grace)` (opened: steady_seconds()
+  /// unless given).
+  explicit Store(const std::string& path, StoreLimits limits = {},
+                 std::optional<double> opened = std::nullopt);
   ~Store();
   Store(const Store&) = delete;
   Store& operator=(const Store&) = delete;
+
+  /// Jobs a campaign's creation inserts per transaction: the lock is held for milliseconds.
+  static constexpr std::size_t kInsertBatch = 256;
 
   static int latest_schema_version();
   int schema_version();
   std::string journal_mode();
   const StoreLimits& limits() const { return limits_; }
 
+  /// A new running campaign with its jobs, inserted in batches of kInsertBatch (each its own
+  /// transaction, the lock free in between); the campaign is leased from, listed and finished
+  /// only once all of them are in, and dropped on opening if the coordinator stopped before.
   std::int64_t create_campaign(const std::string& name, const std::string& spec_json,
                                const std::string& design_json, const std::vector<NewJob>& jobs,
                                double now);
@@ -100,7 +136,8 @@ class Store {
   Counts counts(std::int64_t campaign_id, const std::string& kind = "");
   std::vector<JobRow> jobs(std::int64_t campaign_id);
   std::optional<JobRow> job(std::int64_t job_id);
-  /// Cancels every queued or leased job; false when the campaign does not exist or is done.
+  /// Cancels every queued or leased job of a running campaign; false when the campaign does not
+  /// exist or is not running (done or already cancelled).
   bool cancel(std::int64_t campaign_id, double now);
   /// Adds jobs to an existing campaign (verification runs); the campaign runs again.
   std::vector<std::int64_t> add_jobs(std::int64_t campaign_id, const std::vector<NewJob>& jobs);
@@ -115,28 +152,51 @@ class Store {
   std::vector<CalibrationRoundRow> calibration_rounds(std::int64_t campaign_id);
   std::vector<CalibrationStageRow> calibration_stages(std::int64_t campaign_id);
 
-  /// The next queued job (oldest campaign first, then run order), leased to `worker`.
+  /// The next queued job (oldest campaign first, then run order), leased to `worker` until
+  /// `now + lease` (`now` on the monotonic clock, as for the calls below).
   std::optional<JobRow> lease(const std::string& worker, double now);
-  /// Extends the current, unexpired lease; false otherwise.
-  bool heartbeat(std::int64_t job_id, int attempt, double now);
-  /// Stores the result of the current, unexpired lease exactly once; false otherwise.
-  bool complete(std::int64_t job_id, int attempt, const std::string& worker,
-                const std::string& metrics_json, double wall_seconds, double now,
-                const std::string& flags_json = "{}", const std::string& cost_json = "{}");
-  /// See the state machine above; false when the lease is not the current one.
-  bool fail(std::int64_t job_id, int attempt, const std::string& reason, bool retryable,
-            bool give_back, double now);
+  /// Extends the current, unexpired lease held by `worker`.
+  LeaseAnswer heartbeat(std::int64_t job_id, int attempt, const std::string& worker, double now);
+  /// Stores the result of the current, unexpired lease held by `worker` exactly once; a retry
+  /// with the result already stored for that lease (same metrics and wall time) is kOk too.
+  LeaseAnswer complete(std::int64_t job_id, int attempt, const std::string& worker,
+                       const std::string& metrics_json, double wall_seconds, double now,
+                       const std::string& flags_json = "{}", const std::string& cost_json = "{}");
+  /// See the state machine above; only the current lease's holder may fail it.
+  LeaseAnswer fail(std::int64_t job_id, int attempt, const std::string& worker,
+                   const std::string& reason, bool retryable, bool give_back, double now);
   /// Expired leases go back to the queue, or fail at the attempt cap. Returns jobs reaped.
   int reap(double now);
+  /// The current lease's deadline on the monotonic clock, if the job has one (for tests).
+  std::optional<double> lease_deadline(std::int64_t job_id);
   /// Results stored for a job (0 or 1: the primary key makes 2 impossible), for tests.
   int result_count(std::int64_t job_id);
 
  private:
   class Transaction;
   class Statement;
+  class Guard;
+  /// The job's current lease named by (attempt, worker), leased and unexpired at `now`.
+  LeaseAnswer check_lease(std::int64_t job_id, int attempt, const std::string& worker, double now);
+  /// A retried Complete: the job is done with this very result of this lease.
+  bool already_stored(std::int64_t job_id, int attempt, const std::string& worker,
+                      const std::string& metrics_json, double wall_seconds);
+  void restore_leases(double opened);
+  /// Seconds on the clock of limits().clock.
+  double clock_now() const { return limits_.clock ? limits_.clock() : steady_seconds(); }
+  /// Throws unless the file is in WAL mode (checked at opening).
+  void require_wal(const std::string& path);
+  std::string journal_mode_unlocked();
+  /// Adds `seconds` to every lease deadline (the lock was held that long).
+  void extend_deadlines(double seconds);
   void exec(const char* sql);
   void migrate();
   void finish_campaigns(double now);
+  /// Inserts jobs[first, end) as queued jobs of the campaign; inside a transaction.
+  std::vector<std::int64_t> insert_job_rows(std::int64_t campaign_id,
+                                            const std::vector<NewJob>& jobs, std::size_t first,
+                                            std::size_t end);
+  void drop_unfinished_campaigns();
   /// Inserts queued jobs and reopens a finished campaign; inside a transaction.
   std::vector<std::int64_t> insert_jobs(std::int64_t campaign_id, const std::vector<NewJob>& jobs);
   bool requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason, bool retryable,
@@ -145,6 +205,7 @@ class Store {
   sqlite3* db_ = nullptr;
   StoreLimits limits_;
   std::mutex mutex_;
+  std::unordered_map<std::int64_t, double> deadlines_;  ///< job -> its lease's deadline
 };
 
 }  // namespace demcal::server

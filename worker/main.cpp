@@ -21,12 +21,20 @@ int main(int argc, char** argv) {
   app.add_option("--token-file", token_file, "read the token from a file");
   app.add_option("--tls-ca", o.channel.tls_ca, "CA certificate (PEM) for a TLS coordinator");
   app.add_flag("--insecure", o.channel.insecure, "plain TCP (coordinator started with --insecure)");
-  app.add_option("--threads", o.threads, "simulation threads per job")->capture_default_str();
+  app.add_option("--threads", o.threads, "simulation threads per job, at most")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--id", o.id, "worker name in the coordinator's records (default host:pid)");
   app.add_option("--max-jobs", o.max_jobs, "exit after this many jobs (0 = no limit)");
   app.add_option("--idle-exit", o.idle_exit, "exit after this many idle seconds (0 = never)");
   app.add_option("--drain", o.drain_seconds,
                  "on SIGTERM, give the lease back after this many seconds (0 = finish the job)");
+  app.add_option("--max-particles", o.max_particles,
+                 "refuse jobs with more particles than this (0 = no limit)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-job-seconds", o.max_job_seconds,
+                 "stop and fail a job running longer than this (s; 0 = no limit)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--max-backoff", o.max_backoff, "longest reconnection back-off (s)")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);

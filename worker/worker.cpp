@@ -14,6 +14,7 @@
 
 #include "core/common/error.hpp"
 #include "core/lab/lab_test.hpp"
+#include "core/lab/run_cancelled.hpp"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "proto/material_convert.hpp"
 
@@ -36,7 +37,36 @@ struct Outcome {
   v1::RunCost cost;
   std::string reason;
   bool retryable = false;
+  bool cancelled = false;  ///< stopped on request (lease lost or over the time limit)
 };
+
+/// What may stop a running job from outside, read by its progress callback: the heartbeat
+/// thread learning that the lease is gone (expired, cancelled, taken over) and the worker's
+/// wall-time limit.
+struct JobStop {
+  std::atomic<bool> lease_lost{false};
+  std::optional<Clock::time_point> deadline;  ///< --max-job-seconds after the start
+  double max_seconds = 0.0;
+
+  /// Throws RunCancelled when the job must stop.
+  void check() const {
+    if (lease_lost) throw lab::RunCancelled("the lease is gone (expired, or campaign cancelled)");
+    if (deadline && Clock::now() > *deadline)
+      throw lab::RunCancelled(fmt::format(
+          "the job ran longer than this worker's --max-job-seconds {:g} s and was stopped",
+          max_seconds));
+  }
+};
+
+/// A job this worker refuses before running it (empty: none): more particles than its
+/// --max-particles.
+std::string refusal(const v1::JobSpec& job, double max_particles) {
+  const auto it = job.settings().find("particles");
+  if (max_particles <= 0 || it == job.settings().end() || !(it->second > max_particles)) return {};
+  return "job asks for " + std::to_string(std::llround(it->second)) +
+         " particles, more than this worker's --max-particles " +
+         std::to_string(std::llround(max_particles));
+}
 
 v1::RunCost to_proto(const lab::RunCost& c) {
   v1::RunCost r;
@@ -59,21 +89,32 @@ v1::RunCost to_proto(const lab::RunCost& c) {
   return r;
 }
 
-Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progress) {
+/// The worker's --threads is what its machine gives it: a spec may ask for fewer, never more.
+int job_threads(const v1::JobSpec& job, int worker_threads) {
+  return job.threads() > 0 ? std::min(job.threads(), worker_threads) : worker_threads;
+}
+
+Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progress,
+                const JobStop& stop) {
   Outcome o;
   try {
     const lab::MaterialModel material = proto::job_material(job);
     lab::RunOptions ro;
-    // The worker's --threads is what its machine gives it: a spec may ask for fewer, never more.
-    ro.threads = job.threads() > 0 ? std::min(job.threads(), threads) : threads;
+    ro.threads = job_threads(job, threads);
     ro.seed = job.seed() ? job.seed() : 1;
-    ro.progress = [&progress](double f) { progress = f; };
+    ro.progress = [&progress, &stop](double f) {
+      progress = f;
+      stop.check();
+    };
     const lab::LabOutput out =
         lab::run_lab_test(job.test(), material, proto::to_settings(job.settings()), ro);
     o.ok = true;
     o.metrics = out.metrics;
     o.flags = out.flags;
     o.cost = to_proto(out.cost);
+  } catch (const lab::RunCancelled& e) {
+    o.cancelled = true;
+    o.reason = e.what();
   } catch (const SimulationFailure& e) {
     o.reason = std::string("simulation failed (") + to_string(e.reason()) + "): " + e.what();
   } catch (const InputError& e) {
@@ -105,6 +146,21 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
     nap(backoff * (0.75 + 0.5 * std::uniform_real_distribution<>(0, 1)(jitter)), flags);
     backoff = std::min(opt.max_backoff, backoff * 2);
   };
+  // A job this worker will not run goes back as a failed attempt with the reason, so that the
+  // coordinator can give it to another worker (and fails it at the attempt cap).
+  auto report_refusal = [&](const v1::JobSpec& job, const std::string& why) {
+    v1::FailRequest f;
+    f.set_job_id(job.job_id());
+    f.set_attempt(job.attempt());
+    f.set_worker(id);
+    f.set_reason(why);
+    f.set_retryable(true);
+    v1::FailReply fr;
+    const auto s = stub->Fail(proto::make_context(opt.channel, 10).get(), f, &fr);
+    ++stats.refused_jobs;
+    spdlog::warn("job {} refused: {} ({})", job.job_id(), why,
+                 s.ok() ? "reported" : s.error_message());
+  };
   auto idle_since = Clock::now();
   spdlog::info("worker {} -> {} ({} threads)", id, opt.channel.address, opt.threads);
 
@@ -132,13 +188,22 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
       continue;
     }
     const v1::JobSpec job = lease.job();
-    spdlog::info("job {} attempt {}: {} (campaign {})", job.job_id(), job.attempt(), job.test(),
-                 job.campaign_id());
+    spdlog::info("job {} attempt {}: {} (campaign {}) on {} thread(s)", job.job_id(), job.attempt(),
+                 job.test(), job.campaign_id(), job_threads(job, opt.threads));
     const auto started = Clock::now();
+    if (const std::string why = refusal(job, opt.max_particles); !why.empty()) {
+      report_refusal(job, why);
+      continue;
+    }
 
     // Heartbeats from their own thread, so a long simulation step never lets the lease lapse.
     std::atomic<double> progress{0.0};
-    std::atomic<bool> lease_lost{false};
+    JobStop job_stop;
+    job_stop.max_seconds = opt.max_job_seconds;
+    if (opt.max_job_seconds > 0)
+      job_stop.deadline = started + std::chrono::duration_cast<Clock::duration>(
+                                        std::chrono::duration<double>(opt.max_job_seconds));
+    std::atomic<bool>& lease_lost = job_stop.lease_lost;
     std::mutex hb_mutex;
     std::condition_variable hb_cv;
     bool hb_stop = false;
@@ -155,9 +220,11 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
         h.set_progress(progress);
         v1::HeartbeatReply hr;
         const auto s = stub->Heartbeat(proto::make_context(opt.channel, 5).get(), h, &hr);
-        if (s.error_code() == grpc::StatusCode::FAILED_PRECONDITION && !lease_lost) {
+        const bool gone = s.error_code() == grpc::StatusCode::FAILED_PRECONDITION ||
+                          s.error_code() == grpc::StatusCode::PERMISSION_DENIED;
+        if (gone && !lease_lost) {
           lease_lost = true;
-          spdlog::warn("job {}: lease {} lost ({}); its result will be refused", job.job_id(),
+          spdlog::warn("job {}: lease {} lost ({}); stopping its simulation", job.job_id(),
                        job.attempt(), s.error_message());
         } else if (!s.ok() && !lease_lost) {
           spdlog::warn("job {}: heartbeat failed: {}", job.job_id(), s.error_message());
@@ -175,8 +242,12 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
     };
 
     // The simulation runs on its own thread so that a stop request can give the lease back.
+    // It reads `progress` and `job_stop` only until it returns; a detached simulation (give-back
+    // on abort) is followed by the process exiting.
     auto task = std::make_shared<std::packaged_task<Outcome()>>(
-        [job, threads = opt.threads, &progress] { return run_job(job, threads, progress); });
+        [job, threads = opt.threads, &progress, &job_stop] {
+          return run_job(job, threads, progress, job_stop);
+        });
     auto future = task->get_future();
     std::thread sim([task] { (*task)(); });
     std::optional<Clock::time_point> stop_seen;
@@ -213,6 +284,14 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
     Outcome out = future.get();
     stop_heartbeat();
     const double wall = std::chrono::duration<double>(Clock::now() - started).count();
+    if (out.cancelled && lease_lost) {
+      // Nobody wants this result any more: the coordinator refuses it and may have given the
+      // job to another worker.
+      ++stats.abandoned;
+      spdlog::warn("job {}: simulation stopped after {:.2f} s: {}", job.job_id(), wall, out.reason);
+      idle_since = Clock::now();
+      continue;
+    }
 
     // Report; retried while the coordinator is away (a restart must not lose a result).
     for (int tries = 0;; ++tries) {
@@ -262,8 +341,11 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
     }
     idle_since = Clock::now();
   }
-  spdlog::info("worker {} stopping: {} done, {} failed, {} refused, {} given back", id,
-               stats.completed, stats.failed, stats.rejected, stats.given_back);
+  spdlog::info(
+      "worker {} stopping: {} done, {} failed, {} refused, {} given back, {} abandoned, {} jobs "
+      "refused",
+      id, stats.completed, stats.failed, stats.rejected, stats.given_back, stats.abandoned,
+      stats.refused_jobs);
   return stats;
 }
 

@@ -13,13 +13,15 @@ namespace demcal::worker {
 
 struct WorkerOptions {
   proto::ChannelOptions channel;
-  int threads = 2;            ///< simulation threads per job (unless the job says otherwise)
-  std::string id;             ///< default: host:pid
-  double max_backoff = 10.0;  ///< seconds between reconnection attempts, at most
-  int max_jobs = 0;           ///< stop after this many jobs (0 = no limit)
-  double idle_exit = 0.0;     ///< stop after this long without work (0 = never)
-  double drain_seconds = 0;   ///< after a stop request, give the lease back after this long
-                              ///< (0 = finish the job however long it takes)
+  int threads = 2;             ///< simulation threads per job, at most (a job may ask for fewer)
+  std::string id;              ///< default: host:pid
+  double max_backoff = 10.0;   ///< seconds between reconnection attempts, at most
+  int max_jobs = 0;            ///< stop after this many jobs (0 = no limit)
+  double idle_exit = 0.0;      ///< stop after this long without work (0 = never)
+  double drain_seconds = 0;    ///< after a stop request, give the lease back after this long
+                               ///< (0 = finish the job however long it takes)
+  double max_particles = 0;    ///< refuse jobs with more particles (0 = no limit)
+  double max_job_seconds = 0;  ///< stop a job's simulation after this long and fail it (0 = none)
 };
 
 /// Stop requests: `stop` = finish the current job and lease no more; `abort` = give the
@@ -31,6 +33,8 @@ struct StopFlags {
 
 struct WorkerStats {
   int completed = 0, failed = 0, rejected = 0, given_back = 0;
+  int abandoned = 0;     ///< simulations stopped because the lease was gone
+  int refused_jobs = 0;  ///< jobs over this worker's limits, failed back unrun
   bool unauthenticated = false;
 };
 

@@ -8,6 +8,7 @@
 
 #include "core/common/rng.hpp"
 #include "core/io/vtk.hpp"
+#include "core/lab/run_cancelled.hpp"
 #include "core/particles/insertion.hpp"
 #include "core/sim/step.hpp"
 #include "core/sim/time_step.hpp"
@@ -119,9 +120,11 @@ sim::HealthLimits die_limits(const sim::World& world, double die_radius, double 
 
 long run_checked(sim::World& world, long steps, const sim::HealthLimits& limits,
                  const std::function<bool(sim::World&)>& each, int check_every) {
+  constexpr long kPollEvery = 64;  // steps between progress polls (a stop request is heard)
   for (long s = 0; s < steps; ++s) {
     sim::step(world);
     if ((s + 1) % check_every == 0) sim::check_health(world, limits);
+    if ((s + 1) % kPollEvery == 0) poll_progress();
     if (each && !each(world)) {
       sim::check_health(world, limits);
       return s + 1;

@@ -7,11 +7,43 @@
 #include "core/lab/hopper.hpp"
 #include "core/lab/packing.hpp"
 #include "core/lab/rotating_drum.hpp"
+#include "core/lab/run_cancelled.hpp"
 #include "core/lab/shear_cell.hpp"
 #include "core/lab/tensile.hpp"
 #include "core/lab/wall_friction.hpp"
 
 namespace demcal::lab {
+
+namespace {
+
+/// The progress callback of the lab test running on this thread and its last fraction.
+struct ProgressHook {
+  const std::function<void(double)>* report = nullptr;
+  double last = 0.0;
+};
+thread_local ProgressHook current_progress;
+
+/// Installs a run's callback for poll_progress() and restores the previous one (a test run
+/// inside another, as a study does) when the run ends or unwinds.
+class ProgressScope {
+ public:
+  explicit ProgressScope(const std::function<void(double)>* report) : saved_(current_progress) {
+    current_progress = {report, 0.0};
+  }
+  ~ProgressScope() { current_progress = saved_; }
+  ProgressScope(const ProgressScope&) = delete;
+  ProgressScope& operator=(const ProgressScope&) = delete;
+
+ private:
+  ProgressHook saved_;
+};
+
+}  // namespace
+
+void poll_progress() {
+  if (current_progress.report && *current_progress.report)
+    (*current_progress.report)(current_progress.last);
+}
 
 LabRunner find_lab_runner(const std::string& name) {
   if (name == "packing") return run_packing;
@@ -40,7 +72,14 @@ LabOutput run_lab_test(const std::string& name, const MaterialModel& material,
   const LabTestInfo& info = find_lab_info(name);
   validate_settings(info, settings, "settings");
   const auto started = std::chrono::steady_clock::now();
-  LabOutput out = find_lab_runner(name)(material, settings, options);
+  RunOptions run = options;
+  if (options.progress)
+    run.progress = [&options](double fraction) {
+      current_progress.last = fraction;
+      options.progress(fraction);
+    };
+  const ProgressScope scope(&options.progress);
+  LabOutput out = find_lab_runner(name)(material, settings, run);
   out.cost.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   for (const auto& m : info.metrics)

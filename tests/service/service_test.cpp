@@ -2,6 +2,7 @@
 // a worker SIGKILLed mid-job, workers racing, the coordinator SIGKILLed and restarted, a late
 // Complete from an expired lease, invalid specs, missing or wrong tokens, and the CLI end to
 // end. Leases and heartbeats are short (flags); every wait is bounded.
+#include <grpcpp/generic/generic_stub.h>
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -25,6 +26,9 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kToken = "test-token-123";
+/// Particles of a packing job that runs for minutes on one thread (cancelled or stopped long
+/// before it would end).
+constexpr int kLongJobParticles = 20000;
 
 /// A packing campaign of 2^2 runs (+ centre points) at `particles` particles; by default its
 /// calibration verifies one round only.
@@ -70,15 +74,27 @@ class Service : public ::testing::Test {
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   /// Starts (or restarts on the same port and file) the coordinator.
-  void start_server(double lease = 1.5, double heartbeat = 0.3, int port = 0) {
+  void start_server(double lease = 1.5, double heartbeat = 0.3, int port = 0,
+                    const std::vector<std::string>& extra = {}) {
     const std::string port_file = path("port");
     fs::remove(port_file);
-    server_ = std::make_unique<Process>(
-        std::vector<std::string>{DEMCAL_SERVER_BIN, "--listen", "127.0.0.1:" + std::to_string(port),
-                                 "--db", path("c.db"), "--token", kToken, "--lease",
-                                 std::to_string(lease), "--heartbeat", std::to_string(heartbeat),
-                                 "--reaper-interval", "0.1", "--port-file", port_file},
-        path("server.log"));
+    std::vector<std::string> argv{DEMCAL_SERVER_BIN,
+                                  "--listen",
+                                  "127.0.0.1:" + std::to_string(port),
+                                  "--db",
+                                  path("c.db"),
+                                  "--token",
+                                  kToken,
+                                  "--lease",
+                                  std::to_string(lease),
+                                  "--heartbeat",
+                                  std::to_string(heartbeat),
+                                  "--reaper-interval",
+                                  "0.1",
+                                  "--port-file",
+                                  port_file};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    server_ = std::make_unique<Process>(argv, path("server.log"));
     ASSERT_TRUE(wait_until([&] { return fs::exists(port_file); }, 20)) << server_->log();
     std::ifstream(port_file) >> port_;
     channel_.address = "127.0.0.1:" + std::to_string(port_);
@@ -87,12 +103,36 @@ class Service : public ::testing::Test {
     workers_stub_ = v1::WorkerService::NewStub(proto::make_channel(channel_));
   }
 
-  Process& start_worker(const std::string& id, const std::string& token = kToken) {
-    workers_.push_back(std::make_unique<Process>(
-        std::vector<std::string>{DEMCAL_WORKER_BIN, "--coordinator", channel_.address, "--token",
-                                 token, "--threads", "1", "--id", id, "--max-backoff", "0.5"},
-        path(id + ".log")));
+  Process& start_worker(const std::string& id, const std::string& token = kToken,
+                        const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> argv{DEMCAL_WORKER_BIN,
+                                  "--coordinator",
+                                  channel_.address,
+                                  "--token",
+                                  token,
+                                  "--threads",
+                                  "1",
+                                  "--id",
+                                  id,
+                                  "--max-backoff",
+                                  "0.5"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    workers_.push_back(std::make_unique<Process>(argv, path(id + ".log")));
     return *workers_.back();
+  }
+
+  /// The id of a job in state `state`, polled for at most `seconds` (0 if none appeared).
+  std::int64_t wait_for_job(std::int64_t campaign, const std::string& state, double seconds) {
+    std::int64_t found = 0;
+    wait_until(
+        [&] {
+          const auto now = results(campaign);
+          for (const auto& j : now.jobs())
+            if (j.state() == state) found = j.job_id();
+          return found != 0;
+        },
+        seconds);
+    return found;
   }
 
   std::unique_ptr<grpc::ClientContext> ctx(double seconds = 30) {
@@ -176,6 +216,109 @@ TEST_F(Service, MissingOrWrongTokenIsUnauthenticated) {
   EXPECT_EQ(w.wait_exit(20), 2) << w.log();
 }
 
+TEST_F(Service, AWorkerTokenCannotSubmitOrCancelAndAClientTokenCannotLeaseOrComplete) {
+  std::ofstream(path("worker.token")) << "worker-secret\n";
+  std::ofstream(path("client.token")) << "client-secret\n";
+  start_server(
+      /*lease=*/30, /*heartbeat=*/5, 0,
+      {"--worker-token-file", path("worker.token"), "--client-token-file", path("client.token")});
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());  // the operator's token opens both
+  auto as = [&](const std::string& token) {
+    proto::ChannelOptions o = channel_;
+    o.token = token;
+    return o;
+  };
+  const auto worker = as("worker-secret"), client = as("client-secret");
+  auto campaigns_as = [&](const proto::ChannelOptions& o) {
+    return v1::CampaignService::NewStub(proto::make_channel(o));
+  };
+  auto workers_as = [&](const proto::ChannelOptions& o) {
+    return v1::WorkerService::NewStub(proto::make_channel(o));
+  };
+  // The worker token: the worker service only.
+  v1::SubmitRequest sreq;
+  *sreq.mutable_spec() = cli::parse_campaign_spec(tiny_spec(30), "spec.yaml").spec;
+  v1::SubmitReply sr;
+  auto st = campaigns_as(worker)->Submit(proto::make_context(worker, 10).get(), sreq, &sr);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::PERMISSION_DENIED) << st.error_message();
+  v1::CancelRequest cancel;
+  cancel.set_id(id);
+  v1::Campaign c;
+  EXPECT_EQ(
+      campaigns_as(worker)->Cancel(proto::make_context(worker, 10).get(), cancel, &c).error_code(),
+      grpc::StatusCode::PERMISSION_DENIED);
+  v1::LeaseRequest lr;
+  lr.set_worker("w");
+  v1::LeaseReply lease;
+  ASSERT_TRUE(workers_as(worker)->Lease(proto::make_context(worker, 10).get(), lr, &lease).ok());
+  ASSERT_TRUE(lease.has_job());
+  // The client token: the campaign service only.
+  v1::LeaseReply other;
+  EXPECT_EQ(
+      workers_as(client)->Lease(proto::make_context(client, 10).get(), lr, &other).error_code(),
+      grpc::StatusCode::PERMISSION_DENIED);
+  v1::CompleteRequest done;
+  done.set_job_id(lease.job().job_id());
+  done.set_attempt(lease.job().attempt());
+  done.set_worker("w");
+  (*done.mutable_metrics())["solid_fraction"] = 0.5;
+  (*done.mutable_metrics())["coordination_number"] = 4.0;
+  v1::CompleteReply cr;
+  EXPECT_EQ(
+      workers_as(client)->Complete(proto::make_context(client, 10).get(), done, &cr).error_code(),
+      grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_TRUE(workers_as(worker)->Complete(proto::make_context(worker, 10).get(), done, &cr).ok());
+  v1::ListReply list;
+  EXPECT_TRUE(campaigns_as(client)->List(proto::make_context(client, 10).get(), {}, &list).ok());
+  EXPECT_EQ(campaigns_as(as("nope"))
+                ->List(proto::make_context(as("nope"), 10).get(), {}, &list)
+                .error_code(),
+            grpc::StatusCode::UNAUTHENTICATED);
+  // The CLI reads its token from a file (not the command line); a missing file is an error.
+  Process cli({DEMCAL_CLI_BIN, "list", "--coordinator", channel_.address, "--token-file",
+               path("client.token")},
+              path("list.log"));
+  EXPECT_EQ(cli.wait_exit(30), 0) << cli.log();
+  EXPECT_NE(cli.log().find("tiny"), std::string::npos) << cli.log();
+  Process missing({DEMCAL_CLI_BIN, "list", "--coordinator", channel_.address, "--token-file",
+                   path("missing.token")},
+                  path("missing.log"));
+  EXPECT_EQ(missing.wait_exit(30), 2) << missing.log();
+  EXPECT_NE(missing.log().find(path("missing.token")), std::string::npos) << missing.log();
+}
+
+/// The status of one call to a method by name, with an empty message (for services the test
+/// has no stub of, such as reflection).
+grpc::Status call_by_name(const proto::ChannelOptions& o, const std::string& method) {
+  grpc::GenericStub stub(proto::make_channel(o));
+  grpc::CompletionQueue cq;
+  auto context = proto::make_context(o, 10);
+  grpc::ByteBuffer request, response;
+  grpc::Slice empty("");
+  request = grpc::ByteBuffer(&empty, 1);
+  auto call = stub.PrepareUnaryCall(context.get(), method, request, &cq);
+  call->StartCall();
+  grpc::Status status;
+  call->Finish(&response, &status, reinterpret_cast<void*>(1));
+  void* tag = nullptr;
+  bool ok = false;
+  cq.Next(&tag, &ok);
+  cq.Shutdown();
+  while (cq.Next(&tag, &ok)) {
+  }
+  return status;
+}
+
+TEST_F(Service, ReflectionIsServedOnlyWhenAskedFor) {
+  const std::string method = "/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo";
+  start_server();
+  EXPECT_EQ(call_by_name(channel_, method).error_code(), grpc::StatusCode::UNIMPLEMENTED);
+  server_.reset();
+  start_server(1.5, 0.3, 0, {"--reflection"});
+  EXPECT_NE(call_by_name(channel_, method).error_code(), grpc::StatusCode::UNIMPLEMENTED);
+}
+
 TEST_F(Service, AMissingOrEmptyTokenFileStopsServerAndWorkerInsteadOfTurningAuthOff) {
   std::ofstream(path("empty.token")) << "\n";
   for (const std::string& file : {path("missing.token"), path("empty.token")}) {
@@ -232,6 +375,12 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
       {tiny_spec(30, 0, "", "calibration: {model: quadratic}\n"), "spec.calibration.model"},
       {tiny_spec(30, 0, "", "calibration: {surrogate: kriging}\n"), "spec.calibration.surrogate"},
       {tiny_spec(30, 0, "", "calibration: {batch: -1}\n"), "spec.calibration.batch"},
+      {[] {
+         auto s = tiny_spec(30);
+         s.replace(s.find("  - test: packing\n"), 18, "  - test: packing\n    threads: 100000\n");
+         return s;
+       }(),
+       "spec.tests[0].threads"},
   };
   for (const auto& c : cases) {
     const auto s = submit(c.yaml);
@@ -239,16 +388,30 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
     EXPECT_NE(s.error_message().find(c.field), std::string::npos)
         << c.field << " not in: " << s.error_message();
   }
-  // A NaN the YAML reader would refuse, sent straight over gRPC, is refused by the coordinator.
-  {
+  // A NaN or an infinity the YAML reader would refuse, sent straight over gRPC, is refused by
+  // the coordinator, naming the field.
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<std::pair<std::function<void(v1::CampaignSpec&)>, std::string>> numbers = {
+      {[](v1::CampaignSpec& s) { s.mutable_measurements(0)->set_uncertainty(std::nan("")); },
+       "spec.measurements[0].uncertainty"},
+      {[&](v1::CampaignSpec& s) { s.mutable_measurements(0)->set_weight(inf); },
+       "spec.measurements[0].weight"},
+      {[&](v1::CampaignSpec& s) { s.mutable_factors(0)->set_low(-inf); }, "spec.factors[0].low"},
+      {[&](v1::CampaignSpec& s) { s.mutable_factors(1)->set_high(std::nan("")); },
+       "spec.factors[1].high"},
+      {[&](v1::CampaignSpec& s) {
+         (*s.mutable_tests(0)->mutable_settings())["particles"] = std::nan("");
+       },
+       "spec.tests[0].settings.particles"},
+  };
+  for (const auto& [spoil, field] : numbers) {
     v1::SubmitRequest req;
     *req.mutable_spec() = cli::parse_campaign_spec(tiny_spec(30), "spec.yaml").spec;
-    req.mutable_spec()->mutable_measurements(0)->set_uncertainty(std::nan(""));
+    spoil(*req.mutable_spec());
     v1::SubmitReply reply;
     const auto s = campaigns_->Submit(ctx().get(), req, &reply);
-    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-    EXPECT_NE(s.error_message().find("spec.measurements[0].uncertainty"), std::string::npos)
-        << s.error_message();
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << field;
+    EXPECT_NE(s.error_message().find(field), std::string::npos) << s.error_message();
   }
   // Mistakes the JSON parser catches name the field and the YAML line before anything is sent.
   std::string typo = tiny_spec(30);
@@ -316,9 +479,25 @@ TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
     const auto st = workers_stub_->Complete(ctx().get(), *bad, &cr);
     EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << st.error_message();
   }
+  // Only the lease's holder may report it; another worker is denied and changes nothing.
+  v1::CompleteRequest intruder = good;
+  intruder.set_worker("intruder");
+  EXPECT_EQ(workers_stub_->Complete(ctx().get(), intruder, &cr).error_code(),
+            grpc::StatusCode::PERMISSION_DENIED);
+  v1::FailRequest intruder_fail;
+  intruder_fail.set_job_id(job);
+  intruder_fail.set_attempt(2);
+  intruder_fail.set_worker("intruder");
+  v1::FailReply fr;
+  EXPECT_EQ(workers_stub_->Fail(ctx().get(), intruder_fail, &fr).error_code(),
+            grpc::StatusCode::PERMISSION_DENIED);
   EXPECT_TRUE(workers_stub_->Complete(ctx().get(), good, &cr).ok());
-  EXPECT_EQ(workers_stub_->Complete(ctx().get(), good, &cr).error_code(),
-            grpc::StatusCode::FAILED_PRECONDITION);  // once only
+  // A retry of the stored result (its answer lost on the way) succeeds; another result does not.
+  EXPECT_TRUE(workers_stub_->Complete(ctx().get(), good, &cr).ok());
+  v1::CompleteRequest other = good;
+  (*other.mutable_metrics())["solid_fraction"] = 0.59;
+  EXPECT_EQ(workers_stub_->Complete(ctx().get(), other, &cr).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
   EXPECT_EQ(stored_results().at(job), 1);
   const auto after = results(id);
   for (const auto& j : after.jobs())
@@ -328,6 +507,152 @@ TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
       EXPECT_EQ(j.worker(), "fast");
       EXPECT_DOUBLE_EQ(j.metrics().at("solid_fraction"), 0.58);
     }
+}
+
+TEST_F(Service, AResultFinishedWhileTheCoordinatorWasDownLongerThanTheLeaseIsAccepted) {
+  // With one attempt per job, a lease expired by the coordinator's own downtime would fail the
+  // job although its simulation succeeded, and a second attempt would run it again.
+  const std::vector<std::string> one_attempt{"--max-attempts", "1"};
+  start_server(/*lease=*/2, /*heartbeat=*/0.3, 0, one_attempt);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(400), &id).ok());  // 4 jobs of ~1 s
+  start_worker("w");
+  ASSERT_NE(wait_for_job(id, "leased", 30), 0);
+  const int port = port_;
+  server_->signal(SIGTERM);
+  ASSERT_EQ(server_->wait_exit(20), 0) << server_->log();
+  std::this_thread::sleep_for(std::chrono::milliseconds(3500));  // down longer than the lease
+  start_server(2, 0.3, port, one_attempt);
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 120)) << workers_[0]->log();
+  const auto r = results(id);
+  const auto stored = stored_results();
+  ASSERT_EQ(r.jobs_size(), 4);
+  for (const auto& j : r.jobs()) {
+    EXPECT_EQ(j.state(), "done") << j.error();
+    EXPECT_EQ(j.attempt(), 1) << "job " << j.job_id() << " ran again";
+    EXPECT_EQ(stored.count(j.job_id()), 1u);
+  }
+  EXPECT_EQ(workers_[0]->log().find("refused the report"), std::string::npos) << workers_[0]->log();
+}
+
+TEST_F(Service, CancellingACampaignStopsTheWorkersSimulationAndFreesTheWorker) {
+  start_server(/*lease=*/30, /*heartbeat=*/0.3);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(kLongJobParticles), &id).ok());  // jobs of minutes
+  auto& worker = start_worker("w");
+  ASSERT_NE(wait_for_job(id, "leased", 30), 0);
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // well into the simulation
+  v1::CancelRequest cancel;
+  cancel.set_id(id);
+  v1::Campaign c;
+  ASSERT_TRUE(campaigns_->Cancel(ctx().get(), cancel, &c).ok());
+  ASSERT_TRUE(
+      wait_until([&] { return worker.log().find("simulation stopped") != std::string::npos; }, 60))
+      << worker.log();
+  // The worker is free again: it runs the next campaign's jobs.
+  std::int64_t next = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &next).ok());
+  ASSERT_TRUE(wait_until([&] { return campaign_done(next); }, 90)) << worker.log();
+  const auto next_results = results(next);
+  for (const auto& j : next_results.jobs()) EXPECT_EQ(j.state(), "done") << j.error();
+  EXPECT_EQ(stored_results().size(), 4u) << "the cancelled job reported nothing";
+}
+
+TEST_F(Service, AJobOverTheWorkersLimitsFailsWithTheLimitNamed) {
+  start_server(/*lease=*/30, /*heartbeat=*/0.3, 0, {"--max-attempts", "1"});
+  // More particles than --max-particles: refused unrun.
+  std::int64_t big = 0;
+  ASSERT_TRUE(submit(tiny_spec(400), &big).ok());
+  auto& small = start_worker("small", kToken, {"--max-particles", "300"});
+  ASSERT_TRUE(wait_until([&] { return campaign_done(big); }, 60)) << small.log();
+  const auto refused = results(big);
+  for (const auto& j : refused.jobs()) {
+    EXPECT_EQ(j.state(), "failed");
+    EXPECT_NE(j.error().find("400 particles, more than this worker's --max-particles 300"),
+              std::string::npos)
+        << j.error();
+  }
+  small.signal(SIGKILL);
+  small.wait_exit(10);
+  // Longer than --max-job-seconds: the simulation is stopped and the job failed.
+  std::int64_t slow = 0;
+  ASSERT_TRUE(submit(tiny_spec(kLongJobParticles), &slow).ok());
+  auto& hasty = start_worker("hasty", kToken, {"--max-job-seconds", "2"});
+  ASSERT_NE(wait_for_job(slow, "failed", 90), 0) << hasty.log();
+  bool named = false;
+  const auto stopped = results(slow);
+  for (const auto& j : stopped.jobs())
+    named |= j.error().find("--max-job-seconds 2") != std::string::npos;
+  EXPECT_TRUE(named) << hasty.log();
+}
+
+TEST_F(Service, ASpecAskingForMoreThreadsThanTheWorkerHasRunsOnTheWorkersThreads) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::string spec = tiny_spec(30);
+  spec.replace(spec.find("  - test: packing\n"), 18, "  - test: packing\n    threads: 16\n");
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(spec, &id).ok());
+  auto& worker = start_worker("w");  // --threads 1
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 90)) << worker.log();
+  EXPECT_NE(worker.log().find("on 1 thread(s)"), std::string::npos) << worker.log();
+  EXPECT_EQ(worker.log().find("on 16 thread(s)"), std::string::npos) << worker.log();
+}
+
+TEST_F(Service, DiagnoseOrVerifyOnACancelledCampaignIsRefusedAndQueuesNothing) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  v1::CancelRequest cancel;
+  cancel.set_id(id);
+  v1::Campaign c;
+  ASSERT_TRUE(campaigns_->Cancel(ctx().get(), cancel, &c).ok());
+  // Cancelling again is refused: only a running campaign can be cancelled.
+  EXPECT_EQ(campaigns_->Cancel(ctx().get(), cancel, &c).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  v1::DiagnoseRequest diagnose;
+  diagnose.set_id(id);
+  v1::DiagnoseReply dr;
+  const auto ds = campaigns_->Diagnose(ctx().get(), diagnose, &dr);
+  EXPECT_EQ(ds.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_NE(ds.error_message().find("cancelled"), std::string::npos) << ds.error_message();
+  v1::CalibrateRequest verify;
+  verify.set_id(id);
+  verify.set_verify(true);
+  v1::CalibrateReply cr;
+  EXPECT_EQ(campaigns_->Calibrate(ctx().get(), verify, &cr).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  const auto r = results(id);
+  EXPECT_EQ(r.jobs_size(), 4);
+  for (const auto& j : r.jobs()) EXPECT_EQ(j.state(), "cancelled");
+}
+
+TEST_F(Service, OutOfRangeNumbersInRequestsAreInvalidArgumentNamingTheField) {
+  start_server(/*lease=*/30, /*heartbeat=*/5, 0, {"--max-starts", "64"});
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  for (const int starts : {-1, 65, 1 << 30}) {
+    v1::CalibrateRequest req;
+    req.set_id(id);
+    req.set_starts(starts);
+    v1::CalibrateReply reply;
+    const auto st = campaigns_->Calibrate(ctx().get(), req, &reply);
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << starts;
+    EXPECT_NE(st.error_message().find("starts: must lie in [0, 64]"), std::string::npos)
+        << st.error_message();
+  }
+  for (const double interval : {1e-9, -1.0, 61.0, std::nan(""), 1e300}) {
+    v1::WatchRequest req;
+    req.set_id(id);
+    req.set_interval_seconds(interval);
+    auto context = ctx();
+    auto reader = campaigns_->Watch(context.get(), req);
+    v1::Progress p;
+    while (reader->Read(&p)) {
+    }
+    const auto st = reader->Finish();
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << interval;
+    EXPECT_NE(st.error_message().find("interval_seconds"), std::string::npos) << st.error_message();
+  }
 }
 
 TEST_F(Service, WorkersRacingNeverShareAJob) {
@@ -442,6 +767,9 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
       {DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--workers", "2", "--threads", "1"},
       path("run.log"));
   ASSERT_EQ(run.wait_exit(150), 0) << run.log();
+  // The new work directory (it holds the database) is its owner's alone.
+  EXPECT_EQ(fs::status(path("work")).permissions() & (fs::perms::group_all | fs::perms::others_all),
+            fs::perms::none);
   const std::string out = run.log();
   EXPECT_NE(out.find("resolution full factorial"), std::string::npos) << out;
   EXPECT_NE(out.find("== packing.solid_fraction (5 of 5 runs) =="), std::string::npos) << out;
@@ -584,6 +912,41 @@ TEST_F(Service, CentrePointsDifferCurvatureIsTestedAndTheCalibrationRoundsAreSho
       cli_json(dir_, "diagnose", {"diagnose", ids, "--no-wait", "--format", "json"}, channel_);
   EXPECT_TRUE(diagnosis.is_object() && !diagnosis.empty()) << diagnosis.dump();
   EXPECT_GT(results(id).jobs_size(), jobs_before) << "the diagnosis proper queues its runs";
+}
+
+TEST_F(Service, AnExportLargerThanAGrpcMessageArrivesWhole) {
+  // Synthetic results through the real worker protocol, no physics: each with a cost block of
+  // 5,000 long-named phases (about 1.5 MB of JSON), so that the export exceeds gRPC's 4 MB.
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());  // 4 jobs
+  for (int k = 0; k < 4; ++k) {
+    v1::LeaseRequest lr;
+    lr.set_worker("fake");
+    v1::LeaseReply lease;
+    ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
+    ASSERT_TRUE(lease.has_job());
+    v1::CompleteRequest c;
+    c.set_job_id(lease.job().job_id());
+    c.set_attempt(lease.job().attempt());
+    c.set_worker("fake");
+    (*c.mutable_metrics())["solid_fraction"] = 0.55 + 0.01 * k;
+    (*c.mutable_metrics())["coordination_number"] = 4.0;
+    for (int p = 0; p < 5000; ++p) {
+      auto* phase = c.mutable_cost()->add_phases();
+      phase->set_name("phase " + std::to_string(p) + std::string(200, '.'));
+      phase->set_steps(p);
+    }
+    v1::CompleteReply cr;
+    const auto st = workers_stub_->Complete(ctx().get(), c, &cr);
+    ASSERT_TRUE(st.ok()) << st.error_message();
+  }
+  ASSERT_TRUE(campaign_done(id));
+  const auto exported =
+      cli_json(dir_, "export", {"export", std::to_string(id), "--format", "json"}, channel_);
+  EXPECT_GT(fs::file_size(path("export.json")), 4u << 20);
+  ASSERT_EQ(exported.at("jobs").size(), 4u);
+  for (const auto& j : exported.at("jobs")) EXPECT_EQ(j.at("cost").at("phases").size(), 5000u);
 }
 
 TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {

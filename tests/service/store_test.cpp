@@ -1,5 +1,6 @@
 // The coordinator's store on :memory: and on a real file: migrations, WAL, the lease state
-// machine, exactly-once results, the retry cap, give-back and cancellation.
+// machine, exactly-once results, the retry cap, give-back and cancellation. Lease times are
+// seconds of a fake monotonic clock passed in as `now`.
 #include "server/store.hpp"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,10 @@
 namespace demcal::server {
 namespace {
 
+constexpr auto kOk = LeaseAnswer::kOk;
+constexpr auto kStale = LeaseAnswer::kStale;
+constexpr auto kNotHolder = LeaseAnswer::kNotHolder;
+
 std::vector<NewJob> jobs(int n) {
   std::vector<NewJob> out;
   for (int i = 0; i < n; ++i) out.push_back({i + 1, n - i, "packing", "design", "{}"});
@@ -21,12 +26,15 @@ TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
   const auto path = std::filesystem::temp_directory_path() /
                     ("demcal_store_" + std::to_string(::getpid()) + ".db");
   std::filesystem::remove(path);
+  std::int64_t leased = 0;
   {
     Store s(path.string());
     EXPECT_EQ(s.journal_mode(), "wal");
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     s.create_campaign("c", "{}", "{}", jobs(3), 0.0);
-    ASSERT_TRUE(s.lease("w", 1.0));
+    const auto job = s.lease("w", 1.0);
+    ASSERT_TRUE(job);
+    leased = job->id;
     // Specs and results are the owner's alone: the file and its write-ahead log are 0600.
     namespace fs = std::filesystem;
     const auto others = fs::perms::group_all | fs::perms::others_all;
@@ -36,12 +44,20 @@ TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
     }
   }
   {
-    Store s(path.string());  // migrations are not re-run; the lease survived
+    // Migrations are not re-run; the lease survived, with a whole lease from the reopening (at
+    // 1000 s of the monotonic clock) however long the coordinator was down: the worker that
+    // ran on meanwhile reports in time, and the reaper finds nothing expired.
+    Store s(path.string(), {10.0, 1}, /*opened=*/1000.0);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto c = s.counts(1);
     EXPECT_EQ(c.leased, 1);
     EXPECT_EQ(c.queued, 2);
+    ASSERT_TRUE(s.lease_deadline(leased));
+    EXPECT_EQ(*s.lease_deadline(leased), 1010.0);
+    EXPECT_EQ(s.reap(1009.0), 0);
+    EXPECT_EQ(s.complete(leased, 1, "w", "{}", 1.0, 1009.5), LeaseAnswer::kOk);
+    EXPECT_EQ(s.job(leased)->state, "done");
   }
   std::filesystem::remove(path);
   std::filesystem::remove(path.string() + "-wal");
@@ -55,15 +71,15 @@ TEST(Store, LeasesInRunOrderAndStoresAResultExactlyOnce) {
   ASSERT_TRUE(a);
   EXPECT_EQ(a->run_order, 1);  // std_order 2 runs first
   EXPECT_EQ(a->attempt, 1);
-  EXPECT_TRUE(s.complete(a->id, 1, "w1", R"({"x":1})", 0.5, 2.0));
-  EXPECT_FALSE(s.complete(a->id, 1, "w1", R"({"x":2})", 0.5, 2.1));  // a repeat is refused
+  EXPECT_EQ(s.complete(a->id, 1, "w1", R"({"x":1})", 0.5, 2.0), kOk);
+  EXPECT_EQ(s.complete(a->id, 1, "w1", R"({"x":2})", 0.5, 2.1), kStale);  // a repeat is refused
   EXPECT_EQ(s.result_count(a->id), 1);
   EXPECT_EQ(*s.job(a->id)->metrics_json, R"({"x":1})");
   EXPECT_EQ(s.campaign(id)->state, "running");
   const auto b = s.lease("w2", 3.0);
   ASSERT_TRUE(b);
   EXPECT_FALSE(s.lease("w3", 3.0));  // nothing left
-  EXPECT_TRUE(s.complete(b->id, 1, "w2", "{}", 0.5, 4.0));
+  EXPECT_EQ(s.complete(b->id, 1, "w2", "{}", 0.5, 4.0), kOk);
   EXPECT_EQ(s.campaign(id)->state, "done");
 }
 
@@ -74,13 +90,13 @@ TEST(Store, KeepsTheFlagsAndTheCostOfAResult) {
   ASSERT_TRUE(a);
   const std::string flags = R"({"x":"phase 'load 1' did not reach stress 150 Pa"})";
   const std::string cost = R"({"steps":"12","phases":[{"name":"settle","reached":true}]})";
-  EXPECT_TRUE(s.complete(a->id, 1, "w1", R"({"x":1})", 0.5, 2.0, flags, cost));
+  EXPECT_EQ(s.complete(a->id, 1, "w1", R"({"x":1})", 0.5, 2.0, flags, cost), kOk);
   EXPECT_EQ(s.job(a->id)->flags_json, flags);
   EXPECT_EQ(s.job(a->id)->cost_json, cost);
   // A result stored without them reads as empty objects.
   const auto b = s.lease("w2", 3.0);
   ASSERT_TRUE(b);
-  EXPECT_TRUE(s.complete(b->id, 1, "w2", "{}", 0.5, 4.0));
+  EXPECT_EQ(s.complete(b->id, 1, "w2", "{}", 0.5, 4.0), kOk);
   EXPECT_EQ(s.job(b->id)->flags_json, "{}");
   EXPECT_EQ(s.job(b->id)->cost_json, "{}");
 }
@@ -89,25 +105,118 @@ TEST(Store, LateCompleteOfAnExpiredLeaseIsRefusedAndTheNewLeaseWins) {
   Store s(":memory:", {10.0, 3});
   s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
   const auto a = s.lease("w1", 0.0);
-  EXPECT_TRUE(s.heartbeat(a->id, 1, 5.0));  // deadline now 15
+  EXPECT_EQ(s.heartbeat(a->id, 1, "w1", 5.0), kOk);  // deadline now 15
   EXPECT_EQ(s.reap(14.0), 0);
   EXPECT_EQ(s.reap(16.0), 1);  // expired: back to the queue
-  EXPECT_FALSE(s.complete(a->id, 1, "w1", "{}", 1.0, 16.5));
-  EXPECT_FALSE(s.heartbeat(a->id, 1, 16.5));
+  EXPECT_EQ(s.complete(a->id, 1, "w1", "{}", 1.0, 16.5), kStale);
+  EXPECT_EQ(s.heartbeat(a->id, 1, "w1", 16.5), kStale);
   const auto b = s.lease("w2", 17.0);
   ASSERT_TRUE(b);
   EXPECT_EQ(b->id, a->id);
   EXPECT_EQ(b->attempt, 2);
-  EXPECT_FALSE(s.complete(a->id, 1, "w1", "{}", 1.0, 18.0));  // stale attempt number
-  EXPECT_TRUE(s.complete(b->id, 2, "w2", "{}", 1.0, 18.0));
+  EXPECT_EQ(s.complete(a->id, 1, "w1", "{}", 1.0, 18.0), kStale);  // stale attempt number
+  EXPECT_EQ(s.complete(b->id, 2, "w2", "{}", 1.0, 18.0), kOk);
   EXPECT_EQ(s.result_count(a->id), 1);
+}
+
+TEST(Store, ARetriedCompleteOfTheStoredResultSucceedsAndStoresItOnce) {
+  // The coordinator stored the result but its answer was lost: the worker's retry is a success,
+  // not a refusal that would make it log a lost result.
+  Store s(":memory:", {10.0, 3});
+  s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  const auto a = s.lease("w1", 0.0);
+  EXPECT_EQ(s.complete(a->id, 1, "w1", R"({"x":1})", 0.5, 1.0), kOk);
+  EXPECT_EQ(s.complete(a->id, 1, "w1", R"({"x":1})", 0.5, 30.0), kOk);  // after the deadline too
+  EXPECT_EQ(s.result_count(a->id), 1);
+  // Another result, another attempt or another worker is no retry of it.
+  EXPECT_EQ(s.complete(a->id, 1, "w1", R"({"x":1})", 0.6, 2.0), kStale);
+  EXPECT_EQ(s.complete(a->id, 2, "w1", R"({"x":1})", 0.5, 2.0), kStale);
+  EXPECT_EQ(s.complete(a->id, 1, "w2", R"({"x":1})", 0.5, 2.0), kStale);
+  EXPECT_EQ(*s.job(a->id)->metrics_json, R"({"x":1})");
+}
+
+TEST(Store, OnlyTheLeaseHolderMayHeartbeatCompleteOrFailIt) {
+  Store s(":memory:", {10.0, 3});
+  s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  const auto a = s.lease("w1", 0.0);
+  EXPECT_EQ(s.heartbeat(a->id, 1, "intruder", 1.0), kNotHolder);
+  EXPECT_EQ(s.complete(a->id, 1, "intruder", "{}", 0.5, 1.0), kNotHolder);
+  EXPECT_EQ(s.fail(a->id, 1, "intruder", "no", false, false, 1.0), kNotHolder);
+  EXPECT_EQ(s.fail(a->id, 1, "intruder", "no", true, true, 1.0), kNotHolder);
+  EXPECT_EQ(s.job(a->id)->state, "leased");
+  EXPECT_EQ(s.result_count(a->id), 0);
+  EXPECT_EQ(s.complete(a->id, 1, "w1", "{}", 0.5, 2.0), kOk);
+}
+
+TEST(Store, ACampaignOfManyBatchesIsInsertedWholeInRunOrder) {
+  Store s(":memory:");
+  const int n = 3 * static_cast<int>(Store::kInsertBatch) + 5;
+  const auto id = s.create_campaign("big", "{}", "{}", jobs(n), 0.0);
+  EXPECT_EQ(s.counts(id).queued, n);
+  ASSERT_EQ(s.campaigns().size(), 1u);
+  EXPECT_EQ(s.lease("w", 0.0)->run_order, 1);
+}
+
+TEST(Store, ACampaignWhoseJobsWereNotAllInsertedIsDroppedOnOpening) {
+  // A coordinator stopped between two batches of a submission it never answered.
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("demcal_store_partial_" + std::to_string(::getpid()) + ".db");
+  std::filesystem::remove(path);
+  {
+    Store s(path.string());
+    s.create_campaign("whole", "{}", "{}", jobs(2), 0.0);
+  }
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db,
+                         "INSERT INTO campaigns (name, state, spec_json, design_json, created, "
+                         "ready) VALUES ('partial', 'running', '{}', '{}', 0, 0);"
+                         "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, "
+                         "payload, state) VALUES (2, 1, 1, 'packing', 'design', '{}', 'queued');",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(db);
+  {
+    Store s(path.string());
+    ASSERT_EQ(s.campaigns().size(), 1u);
+    EXPECT_EQ(s.campaigns()[0].name, "whole");
+    EXPECT_FALSE(s.campaign(2));
+    EXPECT_EQ(s.counts(2).total(), 0);
+  }
+  std::filesystem::remove(path);
+  std::filesystem::remove(path.string() + "-wal");
+  std::filesystem::remove(path.string() + "-shm");
+}
+
+TEST(Store, TimeTheLockIsHeldByOneLongWriteIsAddedToEveryLeaseDeadline) {
+  // A write holding the store's lock for 100 s (a stalled disk; here the lock-hold clock jumps
+  // while the write holds it): the workers whose heartbeats waited behind it keep their leases.
+  double t = 0.0;
+  int reads_until_jump = 0;
+  StoreLimits limits{10.0, 3};
+  limits.clock = [&] {
+    if (reads_until_jump > 0 && --reads_until_jump == 0) t += 100.0;
+    return t;
+  };
+  Store s(":memory:", limits);
+  s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  const auto a = s.lease("w", 0.0);
+  ASSERT_EQ(*s.lease_deadline(a->id), 10.0);
+  reads_until_jump = 2;  // the second reading is the end of the next hold: held 100 s
+  s.create_campaign("d", "{}", "{}", jobs(1), 0.0);
+  EXPECT_EQ(*s.lease_deadline(a->id), 110.0);
+  EXPECT_EQ(s.reap(105.0), 0);
+  EXPECT_EQ(s.heartbeat(a->id, 1, "w", 105.0), kOk);
+  // A short hold adds nothing.
+  s.create_campaign("e", "{}", "{}", jobs(1), 0.0);
+  EXPECT_EQ(*s.lease_deadline(a->id), 115.0);
 }
 
 TEST(Store, ExpiredBeforeTheReaperRunsIsAlsoRefused) {
   Store s(":memory:", {10.0, 3});
   s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
   const auto a = s.lease("w1", 0.0);
-  EXPECT_FALSE(s.complete(a->id, 1, "w1", "{}", 1.0, 10.5));
+  EXPECT_EQ(s.complete(a->id, 1, "w1", "{}", 1.0, 10.5), kStale);
   EXPECT_EQ(s.result_count(a->id), 0);
 }
 
@@ -115,10 +224,10 @@ TEST(Store, RetryCapFailsTheJobAndGiveBackDoesNotCount) {
   Store s(":memory:", {10.0, 2});
   const auto id = s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
   auto a = s.lease("w", 0.0);
-  EXPECT_TRUE(s.fail(a->id, 1, "stopping", true, true, 1.0));  // given back
+  EXPECT_EQ(s.fail(a->id, 1, "w", "stopping", true, true, 1.0), kOk);  // given back
   a = s.lease("w", 2.0);
   EXPECT_EQ(a->attempt, 2);
-  EXPECT_TRUE(s.fail(a->id, 2, "io error", true, false, 3.0));  // counted: 1 of 2
+  EXPECT_EQ(s.fail(a->id, 2, "w", "io error", true, false, 3.0), kOk);  // counted: 1 of 2
   EXPECT_EQ(s.job(a->id)->state, "queued");
   a = s.lease("w", 4.0);
   EXPECT_EQ(s.reap(20.0), 1);  // counted: 2 of 2 -> failed
@@ -131,7 +240,7 @@ TEST(Store, SimulationFailureFailsAtOnce) {
   Store s(":memory:");
   s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
   const auto a = s.lease("w", 0.0);
-  EXPECT_TRUE(s.fail(a->id, 1, "simulation failed (not finite)", false, false, 1.0));
+  EXPECT_EQ(s.fail(a->id, 1, "w", "simulation failed (not finite)", false, false, 1.0), kOk);
   EXPECT_EQ(s.job(a->id)->state, "failed");
   EXPECT_FALSE(s.lease("w", 2.0));
 }
@@ -141,15 +250,16 @@ TEST(Store, CancelStopsLeasingAndRefusesResults) {
   const auto id = s.create_campaign("c", "{}", "{}", jobs(3), 0.0);
   const auto a = s.lease("w", 0.0);
   EXPECT_TRUE(s.cancel(id, 1.0));
+  EXPECT_FALSE(s.cancel(id, 1.5));  // only a running campaign is cancelled
   EXPECT_FALSE(s.cancel(999, 1.0));
   EXPECT_FALSE(s.lease("w", 2.0));
-  EXPECT_FALSE(s.complete(a->id, 1, "w", "{}", 1.0, 2.0));
+  EXPECT_EQ(s.complete(a->id, 1, "w", "{}", 1.0, 2.0), kStale);
   EXPECT_EQ(s.counts(id).cancelled, 3);
   EXPECT_EQ(s.campaign(id)->state, "cancelled");
   // A done campaign is not cancelled: it stays done with its results.
   const auto done = s.create_campaign("d", "{}", "{}", jobs(1), 3.0);
   const auto b = s.lease("w", 3.0);
-  ASSERT_TRUE(s.complete(b->id, 1, "w", "{}", 1.0, 4.0));
+  ASSERT_EQ(s.complete(b->id, 1, "w", "{}", 1.0, 4.0), kOk);
   EXPECT_FALSE(s.cancel(done, 5.0));
   EXPECT_EQ(s.campaign(done)->state, "done");
   EXPECT_EQ(s.counts(done).done, 1);
@@ -244,7 +354,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 4);
+    EXPECT_EQ(Store::latest_schema_version(), 5);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
@@ -278,7 +388,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());  // reopening does not migrate again
-    EXPECT_EQ(s.schema_version(), 4);
+    EXPECT_EQ(s.schema_version(), Store::latest_schema_version());  // 5: campaigns.ready
     EXPECT_EQ(s.jobs(1).size(), 2u);
     // Version 4 admits the calibration's stage designs and stores rounds and stages with them.
     const auto round_jobs = s.add_calibration_round(1, {1, 1, R"({"natural":[0.3]})", 300.0},
