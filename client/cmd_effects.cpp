@@ -115,16 +115,10 @@ void add_analysis_commands(CLI::App& app) {
     if (o->format == "liggghts") {
       content = liggghts_export(*campaign_stub(o->channel), o->channel, o->id);
     } else {
-      v1::ExportRequest req;
-      req.set_id(o->id);
-      req.set_format(o->format == "table" ? "json" : o->format);
-      // The document arrives in pieces (it may exceed a gRPC message); nothing is written unless
-      // all of it arrived.
-      const auto context = proto::make_context(o->channel, 600);
-      auto reader = campaign_stub(o->channel)->Export(context.get(), req);
-      v1::ExportReply piece;
-      while (reader->Read(&piece)) content += piece.content();
-      check(reader->Finish(), "export");
+      // Nothing is written unless the whole document arrived.
+      check(read_export(*campaign_stub(o->channel), o->channel, o->id,
+                        o->format == "table" ? "json" : o->format, content),
+            "export");
     }
     if (o->out.empty()) {
       std::cout << content;

@@ -83,6 +83,20 @@ std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const proto::ChannelOpt
   return v1::CampaignService::NewStub(proto::make_channel(o));
 }
 
+grpc::Status read_export(v1::CampaignService::StubInterface& stub,
+                         const proto::ChannelOptions& options, std::int64_t id,
+                         const std::string& format, std::string& content) {
+  v1::ExportRequest req;
+  req.set_id(id);
+  req.set_format(format);
+  const auto context = proto::make_context(options, 600);
+  auto reader = stub.Export(context.get(), req);
+  content.clear();
+  v1::ExportReply piece;
+  while (reader->Read(&piece)) content += piece.content();
+  return reader->Finish();
+}
+
 void check(const grpc::Status& s, const std::string& what) {
   if (s.ok()) return;
   if (s.error_code() == grpc::StatusCode::INVALID_ARGUMENT) throw InputError("", s.error_message());

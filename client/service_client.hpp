@@ -2,6 +2,7 @@
 // What the service subcommands share: connection flags, status -> error mapping, and the
 // printing of design summaries, progress, effect tables and calibrations.
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <memory>
 #include <ostream>
 #include <string>
@@ -19,6 +20,12 @@ std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const proto::ChannelOpt
 /// Throws for a failed call: InputError for INVALID_ARGUMENT (the message names the field),
 /// std::runtime_error "<what>: <CODE>: <message>" otherwise.
 void check(const grpc::Status& status, const std::string& what);
+
+/// The campaign's Export document in `format` (json or csv), read whole from its stream (it may
+/// exceed one gRPC message). Returns the stream's status; `content` is complete only when it is OK.
+grpc::Status read_export(v1::CampaignService::StubInterface& stub,
+                         const proto::ChannelOptions& options, std::int64_t id,
+                         const std::string& format, std::string& content);
 
 void print_design_summary(std::ostream& out, const v1::DesignSummary& d);
 std::string progress_line(const v1::Progress& p, int width = 30);

@@ -56,13 +56,9 @@ json read_design(v1::CampaignService::StubInterface& stub, const proto::ChannelO
 /// The Export reply's content is itself the JSON document `demcal export --format json` prints.
 json read_export(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
                  std::int64_t id) {
-  v1::ExportRequest req;
-  req.set_id(id);
-  req.set_format("json");
-  v1::ExportReply exported;
-  required([&] { return stub.Export(proto::make_context(ch, 120).get(), req, &exported); },
-           "export");
-  return json::parse(exported.content());
+  std::string content;
+  required([&] { return cli::read_export(stub, ch, id, "json", content); }, "export");
+  return json::parse(content);
 }
 
 /// The request `demcal effects ID --format json` sends: model 2fi, alpha 0.05 (the defaults).

@@ -39,8 +39,9 @@ namespace demcal::lab {
 MohrResult mohr_evaluation(double k, double c, double s_pre, double t_pre) {
   MohrResult m;
   const double phi = std::atan(k), sn = std::sin(phi), cs = std::cos(phi);
-  // Unconfined yield strength: the circle through the origin touching the locus.
-  m.sigma_c = 2.0 * c * (1.0 + sn) / cs;
+  // Unconfined yield strength: the circle through the origin touching the locus; a locus without
+  // cohesion (intercept <= 0, within noise of a cohesionless material) has none.
+  m.sigma_c = std::max(0.0, 2.0 * c * (1.0 + sn) / cs);
   // Consolidation circle: centre s, radius rho = s sin(phi) + c cos(phi) (touches the locus)
   // and through the pre-shear point: (s_pre - s)^2 + t_pre^2 = rho^2, a quadratic in s.
   // A circle touching the locus lies below it, so a pre-shear point above the locus has none
@@ -55,7 +56,7 @@ MohrResult mohr_evaluation(double k, double c, double s_pre, double t_pre) {
   if (rho <= 0.0 || s <= 0.0) return m;
   m.consistent = true;
   m.sigma_1 = s + rho;
-  m.ffc = m.sigma_c > 0.0 ? m.sigma_1 / m.sigma_c : std::numeric_limits<double>::infinity();
+  m.ffc = m.sigma_c > 0.0 ? std::min(kFfcCap, m.sigma_1 / m.sigma_c) : kFfcCap;
   m.phi_e = std::asin(std::min(1.0, rho / s)) * 180.0 / M_PI;
   return m;
 }

@@ -63,6 +63,18 @@ TEST(LabShearCell, MohrEvaluationOfAConsistentAndAnInconsistentLocus) {
   EXPECT_FALSE(mohr_evaluation(k, c, 3.0, k * 3.0 + c + 0.1).consistent);
 }
 
+TEST(LabShearCell, MohrEvaluationOfALocusWithoutCohesionIsFreeFlowingAndFinite) {
+  // tau = 0.5 sigma - 0.05 (a cohesionless bed's fitted intercept scatters about 0): no circle
+  // through the origin touches it, so sigma_c = 0 and ffc is reported as its cap.
+  const double k = 0.5, c = -0.05;
+  const MohrResult m = mohr_evaluation(k, c, 3.0, 0.5 * 3.0 - 0.3);
+  ASSERT_TRUE(m.consistent);
+  EXPECT_EQ(m.sigma_c, 0.0);
+  EXPECT_EQ(m.ffc, kFfcCap);
+  EXPECT_TRUE(std::isfinite(m.sigma_1) && m.sigma_1 > 3.0);
+  EXPECT_TRUE(std::isfinite(m.phi_e) && m.phi_e > 0.0);
+}
+
 TEST(LabShearCell, PreShearStressAndSlopeRiseWithFrictionAndYieldStressWithSigmaX) {
   const auto low = mean_metrics(powder(0.1, 1e-20));
   const auto high = mean_metrics(powder(0.7, 1e-20));
