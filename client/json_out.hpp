@@ -22,6 +22,7 @@ inline nlohmann::json to_json(const lab::RunCost& c) {
                       {"wall_seconds", p.wall_seconds},
                       {"reached", p.reached}});
   return {{"time_step_s", c.time_step},
+          {"critical_time_step_s", c.critical_time_step},
           {"time_step_limit", c.time_step_limit},
           {"particles", c.particles},
           {"steps", c.steps},

@@ -17,6 +17,7 @@ double RunCost::particle_steps_per_second() const {
 void RunCost::close(const sim::World& world) {
   time_step = world.dt;
   const sim::TimeStepLimit limit = sim::critical_time_step(world);
+  critical_time_step = limit.critical;
   char text[384];
   if (world.adaptive_safety > 0.0) {
     const sim::TimeStepLimit reached = sim::reached_time_step(world);

@@ -23,13 +23,14 @@ struct PhaseCost {
 };
 
 struct RunCost {
-  double time_step = 0.0;         ///< (s, simulated)
-  std::string time_step_limit;    ///< which bound sets it, and the safety factor
-  std::size_t particles = 0;      ///< particles (clump members counted) at the end
-  std::int64_t steps = 0;         ///< all steps of the run
-  double simulated_time = 0.0;    ///< (s)
-  double wall_seconds = 0.0;      ///< the whole run, building the bed included
-  std::vector<PhaseCost> phases;  ///< in the order they ran
+  double time_step = 0.0;           ///< (s, simulated) at the end of the run
+  double critical_time_step = 0.0;  ///< the bound at the laws' largest stiffness (s)
+  std::string time_step_limit;      ///< which bound sets it, and the safety factor
+  std::size_t particles = 0;        ///< particles (clump members counted) at the end
+  std::int64_t steps = 0;           ///< all steps of the run
+  double simulated_time = 0.0;      ///< (s)
+  double wall_seconds = 0.0;        ///< the whole run, building the bed included
+  std::vector<PhaseCost> phases;    ///< in the order they ran
 
   double particle_steps_per_second() const;
   /// Fills the time step, its limit and the particle count from the world a test ran on, and the

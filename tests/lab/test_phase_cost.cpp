@@ -8,6 +8,7 @@
 
 #include "core/io/yaml_node.hpp"
 #include "core/lab/lab_spec.hpp"
+#include "core/sim/time_step.hpp"
 #include "lab_test_util.hpp"
 
 namespace demcal::lab {
@@ -36,7 +37,14 @@ TEST(PhaseCost, EveryPhaseOfAConfinedCompressionIsRecorded) {
   EXPECT_EQ(names, (std::vector<std::string>{"fill", "settle", "load 1", "unload 1", "load 2",
                                              "final unload"}));
   EXPECT_EQ(c.steps, steps);
-  EXPECT_NEAR(c.simulated_time, static_cast<double>(steps) * c.time_step, 1e-9 * c.simulated_time);
+  // The step follows the stiffness the contacts reached: between the safety (0.2, the default)
+  // and the stability cap (0.7) times the bound at the laws' largest stiffness, at every step.
+  ASSERT_GT(c.critical_time_step, 0.0);
+  const double crit_steps = static_cast<double>(steps) * c.critical_time_step;
+  EXPECT_GE(c.simulated_time, (1.0 - 1e-9) * 0.2 * crit_steps);
+  EXPECT_LE(c.simulated_time, (1.0 + 1e-9) * sim::kStableFraction * crit_steps);
+  EXPECT_GE(c.time_step, (1.0 - 1e-9) * 0.2 * c.critical_time_step);
+  EXPECT_LE(c.time_step, (1.0 + 1e-9) * sim::kStableFraction * c.critical_time_step);
   EXPECT_GT(c.wall_seconds, 0.0);
   EXPECT_GT(c.particle_steps_per_second(), 0.0);
   EXPECT_TRUE(out.flags.empty());

@@ -48,17 +48,23 @@ TEST(SimWalls, SettledBedFloorCarriesTheWeightAndMovingLidMovesVt) {
   w.dt = sim::recommended_time_step(w, 0.2);
 
   const double weight = w.particles.total_mass() * kG;
-  constexpr int kSettle = 14000, kAverage = 1000;
-  sim::run(w, kSettle);
+  const double ref_energy = w.particles.mass[0] * kG * 0.001;  // m g r of one sphere
+  // Settle until a block of kAverage steps stays at rest (the bed's last rattles end at a step
+  // that depends on the rounding of the build, e.g. FMA in a native build), at most kMaxBlocks.
+  constexpr int kAverage = 1000, kMaxBlocks = 60;
   Vec3 floor_force{}, cylinder_force{};
   double max_ke = 0.0;
-  for (int s = 0; s < kAverage; ++s) {
-    sim::step(w);
-    floor_force += w.walls[0].force / kAverage;
-    cylinder_force += w.walls[1].force / kAverage;
-    max_ke = std::max(max_ke, w.particles.kinetic_energy());
+  for (int block = 0; block < kMaxBlocks; ++block) {
+    floor_force = cylinder_force = {};
+    max_ke = 0.0;
+    for (int s = 0; s < kAverage; ++s) {
+      sim::step(w);
+      floor_force += w.walls[0].force / kAverage;
+      cylinder_force += w.walls[1].force / kAverage;
+      max_ke = std::max(max_ke, w.particles.kinetic_energy());
+    }
+    if (block >= 14 && max_ke < 1e-2 * ref_energy) break;
   }
-  const double ref_energy = w.particles.mass[0] * kG * 0.001;  // m g r of one sphere
   std::printf(
       "bed of 300: weight %.6e N, floor force z %.6e N (rel. error %.2e), cylinder axial "
       "%.3e N, max KE %.3e J (m g r = %.3e J), %ld steps of %.3e s\n",
@@ -85,7 +91,7 @@ TEST(SimWalls, SettledBedFloorCarriesTheWeightAndMovingLidMovesVt) {
   EXPECT_NEAR(w.walls[2].displacement.x, expected.x, 1e-12);
   EXPECT_NEAR(w.walls[2].displacement.y, expected.y, 1e-12);
   EXPECT_NEAR(w.walls[2].displacement.z, expected.z, 1e-12);
-  EXPECT_NEAR(t, (kSettle + kAverage) * w.dt, 1e-12);
+  EXPECT_NEAR(t, static_cast<double>(w.step_count) * w.dt, 1e-12);
   const auto& lid = std::get<walls::Plane>(w.walls[2].shape);
   EXPECT_NEAR(lid.point.z, 0.06 + expected.z, 1e-12);
   EXPECT_NEAR(w.walls[2].pivot.z, 0.06 + expected.z, 1e-12);
