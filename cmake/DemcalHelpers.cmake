@@ -8,9 +8,16 @@ if(DEMCAL_NATIVE AND NOT DEMCAL_SANITIZE)
   # -march=native enables on this hardware.
   target_compile_options(demcal_warnings INTERFACE -march=native -Wno-maybe-uninitialized)
 endif()
-if(DEMCAL_SANITIZE)
+if(DEMCAL_SANITIZE OR DEMCAL_FUZZ)
   target_compile_options(demcal_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer)
   target_link_options(demcal_warnings INTERFACE -fsanitize=address,undefined)
+endif()
+if(DEMCAL_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "DEMCAL_FUZZ needs clang (libFuzzer): configure with -DCMAKE_CXX_COMPILER=clang++")
+  endif()
+  # Coverage instrumentation for every library the harnesses link; the harnesses add the driver.
+  target_compile_options(demcal_warnings INTERFACE -fsanitize=fuzzer-no-link)
 endif()
 
 # demcal_add_library(NAME core_contact SOURCES a.cpp b.cpp DEPS demcal::core_common)

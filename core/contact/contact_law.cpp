@@ -32,21 +32,23 @@ std::vector<std::string> names_of() {
   return out;
 }
 
+/// Appends model M's parameter table to `out` if `model` names it. (A function of its own, not a
+/// lambda inside the fold below: clang 14's front end crashes on that nesting.)
+template <class M>
+void append_params_if_named(const std::string& model, std::vector<ParamDoc>& out, bool& found) {
+  if (model != M::kName) return;
+  found = true;
+  for (const auto& p : M::table())
+    out.push_back(
+        {std::string(p.name), std::string(p.unit), std::string(p.doc), p.lo, p.hi, p.fallback});
+}
+
 template <class Variant>
 std::vector<ParamDoc> params_of(const std::string& model) {
   std::vector<ParamDoc> out;
   bool found = false;
   [&]<std::size_t... Is>(std::index_sequence<Is...>) {
-    (
-        [&] {
-          using M = std::variant_alternative_t<Is, Variant>;
-          if (model != M::kName) return;
-          found = true;
-          for (const auto& p : M::table())
-            out.push_back({std::string(p.name), std::string(p.unit), std::string(p.doc), p.lo, p.hi,
-                           p.fallback});
-        }(),
-        ...);
+    (append_params_if_named<std::variant_alternative_t<Is, Variant>>(model, out, found), ...);
   }
   (std::make_index_sequence<std::variant_size_v<Variant>>{});
   if (!found) throw InputError("model", "unknown model '" + model + "'");

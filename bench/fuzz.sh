@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# libFuzzer with AddressSanitizer and UndefinedBehaviorSanitizer on the readers of untrusted input
+# in the core: the STL reader (io::read_stl) and the YAML scene parser (io::read_scene). Builds
+# the harnesses of tests/fuzz with clang in BUILD_DIR (-DDEMCAL_FUZZ=ON: the core and the
+# harnesses only), replays the regression inputs, runs each harness for RUNS executions from the
+# seed corpus in tests/fuzz/corpus (a run stops at its first finding, which libFuzzer writes to a
+# crash-/leak-/timeout-/oom- file), and prints per harness: executions, crashes (crash-*, leak-*),
+# timeouts and out-of-memory inputs. Exit status 1 if any harness crashed.
+#   bench/fuzz.sh [BUILD_DIR] [RUNS]     e.g. bench/fuzz.sh build-fuzz 1000000
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=${1:-$root/build-fuzz}
+RUNS=${2:-1000000}
+"$root/scripts/setup" > /dev/null
+cmake -S "$root" -B "$BUILD" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DDEMCAL_FUZZ=ON -DDEMCAL_BUILD_TESTS=OFF -DDEMCAL_BUILD_BENCH=OFF > /dev/null
+ninja -C "$BUILD" fuzz_stl_reader fuzz_scene_yaml > /dev/null
+status=0
+printf "%-18s %10s %8s %9s %5s\n" harness executions crashes timeouts ooms
+for h in stl_reader scene_yaml; do
+  corpus_dir=${h%%_*}; [ "$h" = scene_yaml ] && corpus_dir=scene
+  out="$BUILD/fuzz-$h"; rm -rf "$out"; mkdir -p "$out/corpus"
+  cp "$root/tests/fuzz/corpus/$corpus_dir"/* "$out/corpus/"
+  regressions="$root/tests/fuzz/regressions/$h"
+  if [ -d "$regressions" ] && ls "$regressions"/* > /dev/null 2>&1; then
+    (cd "$out" && "$BUILD/tests/fuzz/fuzz_$h" "$regressions"/* > replay.log 2>&1) ||
+      { echo "$h: a regression input fails again ($out/replay.log)"; status=1; }
+  fi
+  (cd "$out" && "$BUILD/tests/fuzz/fuzz_$h" -runs="$RUNS" -timeout=10 -rss_limit_mb=4096 \
+     -max_len=65536 -print_final_stats=1 corpus \
+     > run.log 2>&1) || true
+  execs=$(grep -o "stat::number_of_executed_units: *[0-9]*" "$out/run.log" | tail -1 | grep -o "[0-9]*$" ||
+          grep -o "#[0-9]*" "$out/run.log" | tail -1 | tr -d '#')
+  crashes=$(ls "$out"/crash-* "$out"/leak-* 2> /dev/null | wc -l)
+  timeouts=$(ls "$out"/timeout-* 2> /dev/null | wc -l)
+  ooms=$(ls "$out"/oom-* 2> /dev/null | wc -l)
+  printf "%-18s %10s %8s %9s %5s\n" "$h" "${execs:-?}" "$crashes" "$timeouts" "$ooms"
+  [ "$crashes" -eq 0 ] || status=1
+done
+exit $status
