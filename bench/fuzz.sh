@@ -22,7 +22,7 @@ for h in stl_reader scene_yaml; do
   out="$BUILD/fuzz-$h"; rm -rf "$out"; mkdir -p "$out/corpus"
   cp "$root/tests/fuzz/corpus/$corpus_dir"/* "$out/corpus/"
   regressions="$root/tests/fuzz/regressions/$h"
-  if [ -d "$regressions" ] && ls "$regressions"/* > /dev/null 2>&1; then
+  if [ -n "$(find "$regressions" -type f 2> /dev/null)" ]; then
     (cd "$out" && "$BUILD/tests/fuzz/fuzz_$h" "$regressions"/* > replay.log 2>&1) ||
       { echo "$h: a regression input fails again ($out/replay.log)"; status=1; }
   fi
@@ -31,9 +31,10 @@ for h in stl_reader scene_yaml; do
      > run.log 2>&1) || true
   execs=$(grep -o "stat::number_of_executed_units: *[0-9]*" "$out/run.log" | tail -1 | grep -o "[0-9]*$" ||
           grep -o "#[0-9]*" "$out/run.log" | tail -1 | tr -d '#')
-  crashes=$(ls "$out"/crash-* "$out"/leak-* 2> /dev/null | wc -l)
-  timeouts=$(ls "$out"/timeout-* 2> /dev/null | wc -l)
-  ooms=$(ls "$out"/oom-* 2> /dev/null | wc -l)
+  found() { find "$out" -maxdepth 1 -name "$1-*" | wc -l; }
+  crashes=$(($(found crash) + $(found leak)))
+  timeouts=$(found timeout)
+  ooms=$(found oom)
   printf "%-18s %10s %8s %9s %5s\n" "$h" "${execs:-?}" "$crashes" "$timeouts" "$ooms"
   [ "$crashes" -eq 0 ] || status=1
 done

@@ -89,7 +89,10 @@ walls::Mesh read_stl(const std::string& path, double scale) {
   if (!f) throw InputError(path, "cannot open STL file");
   std::ostringstream ss;
   ss << f.rdbuf();
-  const std::string data = ss.str();
+  return parse_stl(ss.str(), path, scale);
+}
+
+walls::Mesh parse_stl(const std::string& data, const std::string& path, double scale) {
   // Binary files may also start with "solid": trust the facet count when it matches the size.
   if (data.size() >= 84) {
     std::uint32_t count = 0;

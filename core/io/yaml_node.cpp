@@ -66,7 +66,11 @@ std::vector<YamlNode> YamlNode::items() const {
 std::vector<std::string> YamlNode::keys() const {
   if (!node_.IsMap()) fail("expected a map");
   std::vector<std::string> out;
-  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  for (const auto& kv : node_) {
+    // A key that is itself a list or a map ("{[a, b]: 1}") names no field.
+    if (!kv.first.IsScalar()) fail("a key must be a name, not a list or a map");
+    out.push_back(kv.first.Scalar());
+  }
   return out;
 }
 

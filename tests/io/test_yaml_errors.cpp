@@ -130,6 +130,16 @@ TEST(IoYamlErrors, SceneParameterOutOfRange) {
   expect_contains(density, "density");
 }
 
+TEST(IoYamlErrors, AKeyThatIsAListIsAnInputErrorNotACrash) {
+  // Found by bench/fuzz.sh (tests/fuzz/regressions/scene_yaml): a flow list as a map key escaped
+  // as yaml-cpp's bad conversion and terminated the reader.
+  const std::string msg =
+      scene_error(with_line(kScene, 8, "  tangential: {model: history, mu_s: 0.5, [x]: 1}"));
+  expect_contains(msg, "spec.yaml:8");
+  expect_contains(msg, "contact_law.tangential");
+  expect_contains(msg, "a key must be a name");
+}
+
 TEST(IoYamlErrors, SceneWrongType) {
   const std::string radius =
       scene_error(with_line(kScene, 13, "    - {radius: small, position: [0, 0, 0.002]}"));
