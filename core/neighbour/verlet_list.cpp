@@ -118,17 +118,31 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
   row_start.assign(n + 1, 0);
 
   const MinimumImage image(domain);
+  const bool any_periodic = grid.periodic[0] || grid.periodic[1] || grid.periodic[2];
   auto for_each_partner = [&](int i, auto&& visit) {
-    std::array<int, 27> cells;
-    const int nc =
-        grid.stencil(grid.coord(x[i], 0), grid.coord(x[i], 1), grid.coord(x[i], 2), cells);
-    for (int s = 0; s < nc; ++s)
-      for (int k = cell_start_[cells[s]]; k < cell_start_[cells[s] + 1]; ++k) {
+    // The candidates of one cell's items in cell_items_[begin, end).
+    auto scan = [&](int begin, int end) {
+      for (int k = begin; k < end; ++k) {
         const int j = cell_items_[k];
         if (j <= i || (body && body[i] >= 0 && body[i] == body[j])) continue;
         const double cut = radius[i] + radius[j] + reach;
         if (norm2(image(x[j] - x[i])) < cut * cut) visit(j);
       }
+    };
+    const int cx = grid.coord(x[i], 0), cy = grid.coord(x[i], 1), cz = grid.coord(x[i], 2);
+    if (!any_periodic) {
+      // The stencil is a box clipped to the grid; along x its cells are consecutive, so the
+      // items of each of its (y, z) rows are one run of cell_items_. Rows are sorted below, so
+      // the order in which candidates are met does not matter.
+      const int x0 = std::max(cx - 1, 0), x1 = std::min(cx + 1, grid.n[0] - 1);
+      for (int cz2 = std::max(cz - 1, 0); cz2 <= std::min(cz + 1, grid.n[2] - 1); ++cz2)
+        for (int cy2 = std::max(cy - 1, 0); cy2 <= std::min(cy + 1, grid.n[1] - 1); ++cy2)
+          scan(cell_start_[grid.index(x0, cy2, cz2)], cell_start_[grid.index(x1, cy2, cz2) + 1]);
+      return;
+    }
+    std::array<int, 27> cells;
+    const int nc = grid.stencil(cx, cy, cz, cells);
+    for (int s = 0; s < nc; ++s) scan(cell_start_[cells[s]], cell_start_[cells[s] + 1]);
   };
 
   // One pass over the candidates: each thread lists the partners of its own rows, sorted, in a

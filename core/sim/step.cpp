@@ -25,7 +25,7 @@ bool kick_drift(World& w) {
   {
     const auto [lo, hi] = owned_range(n, omp_get_thread_num(), omp_get_num_threads());
     integrate::kick_drift(p, w.dt, lo, hi);
-    if (clumps) integrate::clump_kick_drift(p, w.domain, w.gravity, w.dt);
+    if (clumps) integrate::clump_kick_drift(p, w.clump_frames, w.domain, w.gravity, w.dt);
     for (int i = lo; i < hi; ++i) worst = std::max(worst, w.list.displacement2(i, p.x[i]));
   }
   return worst > half_skin * half_skin;
@@ -50,6 +50,7 @@ void step(World& w) {
   const double half = 0.5 * w.dt;
   auto& p = w.particles;
   const bool clumps = p.clumps.size() > 0;
+  if (clumps && w.clump_frames.q.size() != p.clumps.size()) w.clump_frames.reset(p);
 
   // 1. Walls move with their prescribed or controlled velocities (nothing in them depends on
   //    the particles' drift).
@@ -67,7 +68,7 @@ void step(World& w) {
     integrate::kick(p, half, lo, hi);
     if (clumps) {
 #pragma omp barrier
-      integrate::clump_kick(p, w.gravity, half);
+      integrate::clump_kick(p, w.clump_frames, w.gravity, half);
     }
   });
 

@@ -111,6 +111,7 @@ void World::prepare() {
   pair_history.clear();
   list.build(particles.x, particles.radius, domain, interaction_range() + skin_, threads,
              pair_history, pair_stride_, clump_bodies());
+  clump_frames.reset(particles);
   wall_history.assign(walls.size(), {});
   for (std::size_t w = 0; w < walls.size(); ++w)
     wall_history[w].assign(particles.size() * wall_strides_[w], 0.0);

@@ -7,6 +7,7 @@
 
 #include "core/common/domain.hpp"
 #include "core/contact/contact_law.hpp"
+#include "core/integrate/rigid_body.hpp"
 #include "core/neighbour/verlet_list.hpp"
 #include "core/particles/particle_store.hpp"
 #include "core/walls/wall.hpp"
@@ -72,6 +73,8 @@ class World {
     Vec3 force, torque;
   };
   std::vector<std::vector<DeferredForce>> deferred;  ///< per thread
+  /// The clumps' rotations, arms and wrenches one half step hands to the next (reset by prepare).
+  integrate::ClumpFrames clump_frames;
   int pair_stride() const { return pair_stride_; }
   int wall_stride(std::size_t wall) const { return wall_strides_[wall]; }
   double effective_skin() const { return skin_; }
