@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # libFuzzer with AddressSanitizer and UndefinedBehaviorSanitizer on the readers of untrusted input
-# in the core: the STL reader (io::read_stl) and the YAML scene parser (io::read_scene). Builds
+# in the core: the STL reader (io::read_stl), the CSV table reader of `analyze` (io::read_csv)
+# and the YAML scene parser (io::read_scene); HARNESSES="..." picks some. Builds
 # the harnesses of tests/fuzz with clang in BUILD_DIR (-DDEMCAL_FUZZ=ON: the core and the
 # harnesses only), replays the regression inputs, runs each harness for RUNS executions from the
 # seed corpus in tests/fuzz/corpus (a run stops at its first finding, which libFuzzer writes to a
@@ -14,11 +15,11 @@ RUNS=${2:-1000000}
 "$root/scripts/setup" > /dev/null
 cmake -S "$root" -B "$BUILD" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DDEMCAL_FUZZ=ON -DDEMCAL_BUILD_TESTS=OFF -DDEMCAL_BUILD_BENCH=OFF > /dev/null
-ninja -C "$BUILD" fuzz_stl_reader fuzz_scene_yaml > /dev/null
+ninja -C "$BUILD" fuzz_stl_reader fuzz_scene_yaml fuzz_csv_reader > /dev/null
 status=0
 printf "%-18s %10s %8s %9s %5s\n" harness executions crashes timeouts ooms
-for h in stl_reader scene_yaml; do
-  corpus_dir=${h%%_*}; [ "$h" = scene_yaml ] && corpus_dir=scene
+for h in ${HARNESSES:-stl_reader csv_reader scene_yaml}; do
+  corpus_dir=${h%%_*}
   out="$BUILD/fuzz-$h"; rm -rf "$out"; mkdir -p "$out/corpus"
   cp "$root/tests/fuzz/corpus/$corpus_dir"/* "$out/corpus/"
   regressions="$root/tests/fuzz/regressions/$h"

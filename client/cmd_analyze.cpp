@@ -19,6 +19,7 @@
 #include "client/commands.hpp"
 #include "core/common/error.hpp"
 #include "core/doe/analysis.hpp"
+#include "core/io/csv.hpp"
 
 namespace demcal::cli {
 namespace {
@@ -30,58 +31,6 @@ struct AnalyzeOptions {
   double alpha = 0.05;
   std::string format = "table";
 };
-
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
-};
-
-std::vector<std::string> split_csv_line(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  bool quoted = false;
-  for (const char c : line) {
-    if (c == '"') {
-      quoted = !quoted;
-    } else if (c == ',' && !quoted) {
-      cells.push_back(cell);
-      cell.clear();
-    } else if (c != '\r') {
-      cell += c;
-    }
-  }
-  cells.push_back(cell);
-  for (auto& s : cells) {
-    const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
-    s = b == std::string::npos ? "" : s.substr(b, e - b + 1);
-  }
-  return cells;
-}
-
-Table read_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open file");
-  Table t;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty() || line[0] == '#') continue;
-    auto cells = split_csv_line(line);
-    if (t.header.empty()) {
-      t.header = cells;
-      continue;
-    }
-    if (cells.size() != t.header.size()) {
-      throw InputError(
-          path + ":" + std::to_string(line_no),
-          std::to_string(cells.size()) + " cells, header has " + std::to_string(t.header.size()));
-    }
-    t.rows.push_back(cells);
-  }
-  if (t.rows.empty()) throw InputError(path, "no data rows");
-  return t;
-}
 
 bool is_missing(const std::string& s) {
   std::string l = s;
@@ -134,7 +83,7 @@ std::string fmt(double v, int precision = 5) {
 }
 
 void run_analyze(const AnalyzeOptions& opt) {
-  const Table t = read_csv(opt.design);
+  const io::CsvTable t = io::read_csv(opt.design);
   const auto rc = std::find(t.header.begin(), t.header.end(), opt.response);
   if (rc == t.header.end()) {
     throw InputError("--response", "no column '" + opt.response + "' in " + opt.design);

@@ -1,6 +1,7 @@
 #include "core/io/csv.hpp"
 
 #include <cstdio>
+#include <sstream>
 
 #include "core/common/error.hpp"
 
@@ -21,6 +22,60 @@ void CsvWriter::row(const std::vector<double>& values) {
     out_ << (k ? "," : "") << buf;
   }
   out_ << "\n";
+}
+
+std::vector<std::string> split_csv_line(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  bool quoted = false;
+  for (const char c : line) {
+    if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      cells.push_back(cell);
+      cell.clear();
+    } else if (c != '\r') {
+      cell += c;
+    }
+  }
+  cells.push_back(cell);
+  for (auto& s : cells) {
+    const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
+    s = b == std::string::npos ? "" : s.substr(b, e - b + 1);
+  }
+  return cells;
+}
+
+CsvTable parse_csv(const std::string& text, const std::string& name) {
+  std::istringstream in(text);
+  CsvTable t;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line[0] == '#') continue;
+    auto cells = split_csv_line(line);
+    if (t.header.empty()) {
+      t.header = cells;
+      continue;
+    }
+    if (cells.size() != t.header.size()) {
+      throw InputError(
+          name + ":" + std::to_string(line_no),
+          std::to_string(cells.size()) + " cells, header has " + std::to_string(t.header.size()));
+    }
+    t.rows.push_back(cells);
+  }
+  if (t.rows.empty()) throw InputError(name, "no data rows");
+  return t;
+}
+
+CsvTable read_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot open file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_csv(text.str(), path);
 }
 
 }  // namespace demcal::io
