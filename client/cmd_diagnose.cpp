@@ -116,23 +116,9 @@ void report(const v1::DiagnoseReply& reply, const std::string& format) {
 }
 
 void run(const DiagnoseOptions& o) {
-  if (std::filesystem::is_regular_file(o.campaign)) {
-    const SpecFile file = read_campaign_spec(o.campaign);
-    EmbeddedService service(work_directory(o.campaign, o.workdir), o.local, o.verbose);
-    const std::int64_t id = service.submit_or_resume(file, std::cerr);
-    watch_campaign(service.stub(), service.channel(), id, std::cerr);
-    report(drive(service.stub(), service.channel(), id, o), o.format);
-    return;
-  }
-  std::int64_t id = 0;
-  try {
-    id = std::stoll(o.campaign);
-  } catch (const std::exception&) {
-    throw CLI::ValidationError("campaign",
-                               "'" + o.campaign + "' is neither a spec file nor a campaign id");
-  }
-  auto stub = campaign_stub(o.channel);
-  report(drive(*stub, o.channel, id, o), o.format);
+  with_campaign(o.campaign, o.workdir, o.local, o.verbose, o.channel,
+                [&](v1::CampaignService::Stub& stub, const proto::ChannelOptions& channel,
+                    std::int64_t id) { report(drive(stub, channel, id, o), o.format); });
 }
 
 }  // namespace

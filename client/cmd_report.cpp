@@ -36,27 +36,13 @@ std::filesystem::path write_report(v1::CampaignService::Stub& stub,
   return html;
 }
 
-std::int64_t campaign_id(const std::string& text) {
-  try {
-    return std::stoll(text);
-  } catch (const std::exception&) {
-    throw CLI::ValidationError("campaign",
-                               "'" + text + "' is neither a spec file nor a campaign id");
-  }
-}
-
 void run(const ReportOptions& o) {
-  std::filesystem::path html;
-  if (std::filesystem::is_regular_file(o.campaign)) {
-    const SpecFile file = read_campaign_spec(o.campaign);
-    EmbeddedService service(work_directory(o.campaign, o.workdir), o.local, o.verbose);
-    const std::int64_t id = service.submit_or_resume(file, std::cerr);
-    watch_campaign(service.stub(), service.channel(), id, std::cerr);
-    html = write_report(service.stub(), service.channel(), id, o);
-  } else {
-    html = write_report(*campaign_stub(o.channel), o.channel, campaign_id(o.campaign), o);
-  }
-  std::cout << std::filesystem::absolute(html).string() << "\n";
+  with_campaign(
+      o.campaign, o.workdir, o.local, o.verbose, o.channel,
+      [&](v1::CampaignService::Stub& stub, const proto::ChannelOptions& channel, std::int64_t id) {
+        const auto html = write_report(stub, channel, id, o);
+        std::cout << std::filesystem::absolute(html).string() << "\n";
+      });
 }
 
 }  // namespace

@@ -25,6 +25,27 @@ std::filesystem::path work_directory(const std::string& spec, const std::string&
                          : std::filesystem::path(workdir);
 }
 
+void with_campaign(const std::string& campaign, const std::string& workdir,
+                   const LocalWorkers& local, bool verbose, const proto::ChannelOptions& channel,
+                   const CampaignAction& act) {
+  if (std::filesystem::is_regular_file(campaign)) {
+    const SpecFile file = read_campaign_spec(campaign);
+    EmbeddedService service(work_directory(campaign, workdir), local, verbose);
+    const std::int64_t id = service.submit_or_resume(file, std::cerr);
+    watch_campaign(service.stub(), service.channel(), id, std::cerr);
+    act(service.stub(), service.channel(), id);
+    return;
+  }
+  std::int64_t id = 0;
+  try {
+    id = std::stoll(campaign);
+  } catch (const std::exception&) {
+    throw CLI::ValidationError("campaign",
+                               "'" + campaign + "' is neither a spec file nor a campaign id");
+  }
+  act(*campaign_stub(channel), channel, id);
+}
+
 void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
   cmd.add_option("--workers", local.workers, "embedded: local workers (jobs run side by side)")
       ->check(CLI::Range(1, 64))

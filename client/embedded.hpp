@@ -3,7 +3,9 @@
 // token) and local workers in this process, talking real gRPC. Used by `demcal run` and
 // `demcal diagnose SPEC`.
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -59,5 +61,16 @@ class EmbeddedService {
 
 /// demcal-work/<spec stem> unless a directory is given.
 std::filesystem::path work_directory(const std::string& spec, const std::string& workdir);
+
+/// What a command does with a campaign once it is reached: its stub, channel and id.
+using CampaignAction = std::function<void(v1::CampaignService::Stub& stub,
+                                          const proto::ChannelOptions& channel, std::int64_t id)>;
+
+/// Reaches the campaign a command names and runs `act` on it: a spec YAML file on the embedded
+/// default (submitted or resumed in `workdir`, watched until its jobs end), otherwise a campaign
+/// id on the coordinator of `channel`. CLI::ValidationError for text that is neither.
+void with_campaign(const std::string& campaign, const std::string& workdir,
+                   const LocalWorkers& local, bool verbose, const proto::ChannelOptions& channel,
+                   const CampaignAction& act);
 
 }  // namespace demcal::cli

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "core/common/error.hpp"
+#include "core/io/read_file.hpp"
 
 namespace demcal::io {
 
@@ -71,11 +72,7 @@ CsvTable parse_csv(const std::string& text, const std::string& name) {
 }
 
 CsvTable read_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_csv(text.str(), path);
+  return parse_csv(read_file(path), path);
 }
 
 }  // namespace demcal::io

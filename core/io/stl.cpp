@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "core/common/error.hpp"
+#include "core/io/read_file.hpp"
 
 namespace demcal::io {
 namespace {
@@ -85,11 +86,7 @@ walls::Mesh read_binary(const std::string& data, const std::string& path, double
 }  // namespace
 
 walls::Mesh read_stl(const std::string& path, double scale) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(path, "cannot open STL file");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return parse_stl(ss.str(), path, scale);
+  return parse_stl(read_file(path, "STL file"), path, scale);
 }
 
 walls::Mesh parse_stl(const std::string& data, const std::string& path, double scale) {

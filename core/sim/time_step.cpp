@@ -49,34 +49,47 @@ double contact_mass(const particles::ParticleStore& p, std::size_t i) {
   return 1.0 / (1.0 / body_mass + a2 * largest);
 }
 
-/// Tightens `limit` by a law's bound for every particle. `overlap` < 0: the law's largest
-/// stiffness; otherwise the stiffness of a contact whose overlap has reached `overlap`.
-void tighten(TimeStepLimit& limit, const contact::ContactLaw& law, const std::string& which,
+/// Both bounds of a world, found in one pass over its laws and particles.
+struct Bounds {
+  TimeStepLimit law_max{std::numeric_limits<double>::infinity(), "no contacts"};
+  TimeStepLimit reached{std::numeric_limits<double>::infinity(), "no contacts"};
+};
+
+void lower(TimeStepLimit& limit, double t, bool hertz, const std::string& which) {
+  if (t < limit.critical) {
+    limit.critical = t;
+    limit.basis = (hertz ? "Rayleigh time of " : "sqrt(m/k) of ") + which;
+  }
+}
+
+/// Tightens both bounds by a law's for every particle: at the law's largest stiffness, and at the
+/// stiffness of a contact whose overlap has reached `overlap` (< 0: the largest stiffness too).
+void tighten(Bounds& bounds, const contact::ContactLaw& law, const std::string& which,
              const World& world, double overlap) {
   const auto& p = world.particles;
   const bool hertz = std::holds_alternative<contact::normal::Hertz>(law.normal);
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double r = p.radius[i];
     const double m = contact_mass(p, i);
-    double t;
+    double t_max, t_reached;
     if (hertz) {
       // The Rayleigh time pi r sqrt(rho / G) / (0.163 nu + 0.8766) is a bound in sqrt(m / r)
       // (rho = m / (4/3 pi r^3)); with m the mass the contact moves, it keeps for a member sphere
       // (whose radius sets the Hertz stiffness) the margin it has for a lone sphere.
       const auto& model = std::get<contact::normal::Hertz>(law.normal);
       const double density = m / (4.0 / 3.0 * M_PI * r * r * r);
-      t = integrate::rayleigh_time(r, density, model.youngs_modulus, model.poisson_ratio);
+      t_max = t_reached =
+          integrate::rayleigh_time(r, density, model.youngs_modulus, model.poisson_ratio);
     } else {
       // r_eff = 2 r covers equal spheres and sphere-wall contacts alike (and gives the larger
       // stiffness of the two: k1 grows with r_eff, k2*(delta) - k1 does not depend on it).
-      const double k =
-          overlap < 0.0 ? law.max_stiffness(2.0 * r) : law.reached_stiffness(2.0 * r, overlap);
-      t = integrate::spring_time(m, k);
+      t_max = integrate::spring_time(m, law.max_stiffness(2.0 * r));
+      t_reached = overlap < 0.0
+                      ? t_max
+                      : integrate::spring_time(m, law.reached_stiffness(2.0 * r, overlap));
     }
-    if (t < limit.critical) {
-      limit.critical = t;
-      limit.basis = (hertz ? "Rayleigh time of " : "sqrt(m/k) of ") + which;
-    }
+    lower(bounds.law_max, t_max, hertz, which);
+    lower(bounds.reached, t_reached, hertz, which);
   }
 }
 
@@ -90,46 +103,46 @@ double deepest_overlap(const std::vector<double>& history, int slot_stride) {
   return deepest;
 }
 
-/// The overlap a law's bound is taken at: -1 (its largest stiffness) for the law maximum or a
-/// law whose stiffness does not follow the overlap; else kOverlapHeadroom times the deepest
-/// overlap reached, so a contact may press that much deeper before the next re-tuning.
+/// The overlap a law's reached bound is taken at: -1 (its largest stiffness) for a law whose
+/// stiffness does not follow the overlap; else kOverlapHeadroom times the deepest overlap reached
+/// (0 without history yet), so a contact may press that much deeper before the next re-tuning.
 constexpr double kOverlapHeadroom = 2.0;
-double bound_overlap(const contact::ContactLaw& law, bool reached,
-                     const std::vector<double>& history, int slot_stride) {
-  if (!reached || !law.keeps_reached_overlap()) return -1.0;
-  return kOverlapHeadroom * deepest_overlap(history, slot_stride);
+double bound_overlap(const contact::ContactLaw& law, const std::vector<double>* history,
+                     int slot_stride) {
+  if (!law.keeps_reached_overlap()) return -1.0;
+  return history ? kOverlapHeadroom * deepest_overlap(*history, slot_stride) : 0.0;
 }
 
-TimeStepLimit limit_over_laws(const World& world, bool reached) {
-  TimeStepLimit limit{std::numeric_limits<double>::infinity(), "no contacts"};
+Bounds bounds_over_laws(const World& world) {
+  Bounds bounds;
   for (int a = 0; a < world.materials(); ++a)
     for (int b = a; b < world.materials(); ++b) {
       const auto& law = world.pair_law(a, b);
-      tighten(limit, law, "particle-particle law " + std::to_string(a) + "-" + std::to_string(b),
-              world, bound_overlap(law, reached, world.pair_history, world.pair_stride()));
+      tighten(bounds, law, "particle-particle law " + std::to_string(a) + "-" + std::to_string(b),
+              world, bound_overlap(law, &world.pair_history, world.pair_stride()));
     }
   for (std::size_t w = 0; w < world.walls.size(); ++w) {
     const auto& wall = world.walls[w];
-    const bool has_history = reached && w < world.wall_history.size();
+    const bool has_history = w < world.wall_history.size();
     for (int a = 0; a < world.materials(); ++a) {
       const auto& law = world.wall_law(wall.material, a);
-      tighten(limit, law, "wall '" + wall.name + "' law", world,
-              has_history ? bound_overlap(law, reached, world.wall_history[w],
-                                          world.wall_stride(w) / walls::contact_slots(wall.shape))
-                          : bound_overlap(law, reached, {}, 0));
+      tighten(
+          bounds, law, "wall '" + wall.name + "' law", world,
+          bound_overlap(law, has_history ? &world.wall_history[w] : nullptr,
+                        has_history ? world.wall_stride(w) / walls::contact_slots(wall.shape) : 0));
     }
   }
-  return limit;
+  return bounds;
 }
 
 }  // namespace
 
 TimeStepLimit critical_time_step(const World& world) {
-  return limit_over_laws(world, false);
+  return bounds_over_laws(world).law_max;
 }
 
 TimeStepLimit reached_time_step(const World& world) {
-  return limit_over_laws(world, true);
+  return bounds_over_laws(world).reached;
 }
 
 double recommended_time_step(const World& world, double safety) {
@@ -137,8 +150,8 @@ double recommended_time_step(const World& world, double safety) {
 }
 
 double adapted_time_step(const World& world, double safety) {
-  return std::min(safety * reached_time_step(world).critical,
-                  kStableFraction * critical_time_step(world).critical);
+  const Bounds bounds = bounds_over_laws(world);
+  return std::min(safety * bounds.reached.critical, kStableFraction * bounds.law_max.critical);
 }
 
 void check_time_step(const World& world) {

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +13,7 @@
 #include <string>
 
 #include "client/liggghts_fragment.hpp"
+#include "tests/common/command.hpp"
 #include "tests/contact/contact_test_util.hpp"
 
 namespace demcal {
@@ -22,16 +22,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr double kRadius = 0.001, kDensity = 2500.0, kSpeed = 0.5;
-
-std::string run_command(const std::string& cmd) {
-  std::array<char, 4096> buf;
-  std::string out;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return out;
-  while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  pclose(pipe);
-  return out;
-}
 
 v1::ContactSlot slot(const std::string& model, std::map<std::string, double> params) {
   v1::ContactSlot s;
@@ -98,8 +88,9 @@ double liggghts_restitution(const v1::Material& m, const std::string& name, std:
   std::ofstream(dir / "material.liggghts") << fragment.text;
   std::ofstream(dir / "in.collision") << collision_script("material.liggghts");
   // LIGGGHTS loses its messages when stdout is not a terminal: run it under script(1).
-  log = run_command("cd '" + dir.string() +
-                    "' && script -qc 'liggghts -in in.collision' /dev/null 2>&1");
+  log = test::run_command("cd '" + dir.string() +
+                          "' && script -qc 'liggghts -in in.collision' /dev/null 2>&1")
+            .out;
   fs::remove_all(dir);
   std::smatch match;
   if (!std::regex_search(log, match, std::regex("RESULT e_measured=([-+0-9.eE]+)"))) return NAN;
@@ -125,7 +116,7 @@ end_time: 8.0e-4
 class LiggghtsExport : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_FALSE(run_command("command -v liggghts").empty())
+    ASSERT_FALSE(test::run_command("command -v liggghts").out.empty())
         << "LIGGGHTS is not installed: scripts/setup installs Debian's liggghts package";
   }
 };

@@ -6,7 +6,6 @@
 // carries every console message; no driver beyond the browser itself is needed.
 #include <gtest/gtest.h>
 #include <httplib.h>
-#include <sys/wait.h>
 
 #include <array>
 #include <cmath>
@@ -22,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/common/command.hpp"
 #include "tests/service/process.hpp"
 
 namespace {
@@ -32,19 +32,11 @@ using nlohmann::json;
 
 const std::string kToken = "report-test-token";
 
-struct Output {
-  int exit_code;
-  std::string out;
-};
+using Output = demcal::test::CommandResult;
 
 /// Runs a command; standard output (and error, when `merge`) returned.
 Output run(const std::string& cmd, bool merge = true) {
-  FILE* pipe = popen((cmd + (merge ? " 2>&1" : " 2>/dev/null")).c_str(), "r");
-  std::string out;
-  std::array<char, 65536> buf;
-  while (std::size_t n = fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+  return demcal::test::run_command(cmd + (merge ? " 2>&1" : " 2>/dev/null"));
 }
 
 std::string read_text(const fs::path& p) {

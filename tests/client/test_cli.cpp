@@ -1,6 +1,5 @@
 // The `demcal` command line, run as a user runs it: real processes, real files, JSON parsed back.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <array>
@@ -14,24 +13,18 @@
 #include <string>
 
 #include "core/common/rng.hpp"
+#include "tests/common/command.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int exit_code;
-  std::string out;
-};
+using Result = demcal::test::CommandResult;
 
+/// The CLI with `args`, standard error merged into the output.
 Result demcal(const std::string& args) {
-  const std::string cmd = std::string(DEMCAL_BINARY_DIR) + "/client/demcal " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+  return demcal::test::run_command(std::string(DEMCAL_BINARY_DIR) + "/client/demcal " + args +
+                                   " 2>&1");
 }
 
 std::string source(const std::string& rel) {

@@ -3,7 +3,6 @@
 // agree to 1e-6 relative.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,22 +10,13 @@
 #include <regex>
 #include <sstream>
 
+#include "tests/common/command.hpp"
 #include "tests/contact/contact_test_util.hpp"
 
 namespace demcal {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string run_command(const std::string& cmd) {
-  std::array<char, 4096> buf;
-  std::string out;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return out;
-  while (fgets(buf.data(), buf.size(), pipe)) out += buf.data();
-  pclose(pipe);
-  return out;
-}
 
 fs::path peer_dir() {
   return fs::path(DEMCAL_SOURCE_DIR) / "tests" / "data" / "liggghts";
@@ -40,8 +30,9 @@ std::string run_liggghts(const std::string& script, const std::string& vars, fs:
   fs::copy_file(peer_dir() / script, scratch / "run" / script,
                 fs::copy_options::overwrite_existing);
   // LIGGGHTS loses its messages when stdout is not a terminal: run it under script(1).
-  return run_command("cd '" + (scratch / "run").string() + "' && script -qc 'liggghts -in " +
-                     script + " " + vars + "' /dev/null 2>&1");
+  return test::run_command("cd '" + (scratch / "run").string() + "' && script -qc 'liggghts -in " +
+                           script + " " + vars + "' /dev/null 2>&1")
+      .out;
 }
 
 double result_field(const std::string& log, const std::string& key) {
@@ -53,7 +44,7 @@ double result_field(const std::string& log, const std::string& key) {
 class PeerLiggghts : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_FALSE(run_command("command -v liggghts").empty())
+    ASSERT_FALSE(test::run_command("command -v liggghts").out.empty())
         << "LIGGGHTS is not installed: scripts/setup installs Debian's liggghts package";
     ASSERT_TRUE(fs::exists(peer_dir())) << peer_dir();
   }

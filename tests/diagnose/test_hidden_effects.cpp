@@ -28,6 +28,7 @@
 #include <string>
 
 #include "core/common/rng.hpp"
+#include "tests/common/command.hpp"
 
 namespace {
 
@@ -107,12 +108,9 @@ std::string material_yaml(const Truth& t, bool truth) {
 
 /// Runs a demcal command and parses its standard output as JSON.
 nlohmann::json run_json(const std::string& cmd) {
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  EXPECT_EQ(pclose(p), 0) << cmd;
-  return nlohmann::json::parse(out);
+  const test::CommandResult r = test::run_command(cmd);
+  EXPECT_EQ(r.exit_code, 0) << cmd;
+  return nlohmann::json::parse(r.out);
 }
 
 /// The measured data: the truth simulated in the packing test (its own lab seed).
