@@ -49,6 +49,7 @@ void add_analysis_commands(CLI::App& app) {
     std::string calibrate_model;  ///< empty: the spec's calibration.model
     double alpha = 0.05;
     bool verify = false, wait = false;
+    bool series = false;  ///< export: each finished job's curves too (json)
     std::string out;
   };
   auto o = std::make_shared<Options>();
@@ -110,6 +111,9 @@ void add_analysis_commands(CLI::App& app) {
   exp->add_option("--format", o->format, "csv, json or liggghts")
       ->check(CLI::IsMember({"csv", "json", "liggghts"}));
   exp->add_option("-o,--output", o->out, "file (default: standard output)");
+  exp->add_flag("--series", o->series,
+                "json: each finished job's curves (stress-strain, yield points, drum surface, "
+                "mass-time; docs/lab-tests.md) under jobs[].series");
   exp->callback([o] {
     std::string content;
     if (o->format == "liggghts") {
@@ -117,7 +121,7 @@ void add_analysis_commands(CLI::App& app) {
     } else {
       // Nothing is written unless the whole document arrived.
       check(read_export(*campaign_stub(o->channel), o->channel, o->id,
-                        o->format == "table" ? "json" : o->format, content),
+                        o->format == "table" ? "json" : o->format, content, o->series),
             "export");
     }
     if (o->out.empty()) {

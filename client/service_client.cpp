@@ -85,10 +85,11 @@ std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const proto::ChannelOpt
 
 grpc::Status read_export(v1::CampaignService::StubInterface& stub,
                          const proto::ChannelOptions& options, std::int64_t id,
-                         const std::string& format, std::string& content) {
+                         const std::string& format, std::string& content, bool series) {
   v1::ExportRequest req;
   req.set_id(id);
   req.set_format(format);
+  req.set_series(series);
   const auto context = proto::make_context(options, 600);
   auto reader = stub.Export(context.get(), req);
   content.clear();

@@ -21,11 +21,12 @@ std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const proto::ChannelOpt
 /// std::runtime_error "<what>: <CODE>: <message>" otherwise.
 void check(const grpc::Status& status, const std::string& what);
 
-/// The campaign's Export document in `format` (json or csv), read whole from its stream (it may
-/// exceed one gRPC message). Returns the stream's status; `content` is complete only when it is OK.
+/// The campaign's Export document in `format` (json or csv; with `series` the jobs' curves too),
+/// read whole from its stream (it may exceed one gRPC message). Returns the stream's status;
+/// `content` is complete only when it is OK.
 grpc::Status read_export(v1::CampaignService::StubInterface& stub,
                          const proto::ChannelOptions& options, std::int64_t id,
-                         const std::string& format, std::string& content);
+                         const std::string& format, std::string& content, bool series = false);
 
 void print_design_summary(std::ostream& out, const v1::DesignSummary& d);
 std::string progress_line(const v1::Progress& p, int width = 30);

@@ -504,10 +504,27 @@ v1::MetricEffects effects_message(const std::string& response, const doe::Respon
   return m;
 }
 
+std::string series_json(const google::protobuf::RepeatedPtrField<v1::Series>& series) {
+  if (series.empty()) return {};
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& s : series) {
+    const std::size_t width = static_cast<std::size_t>(s.columns_size());
+    nlohmann::json rows = nlohmann::json::array();
+    for (std::size_t at = 0; width > 0 && at < static_cast<std::size_t>(s.values_size());
+         at += width)
+      rows.push_back(std::vector<double>(s.values().begin() + static_cast<int>(at),
+                                         s.values().begin() + static_cast<int>(at + width)));
+    out[s.name()] = {{"columns", std::vector<std::string>(s.columns().begin(), s.columns().end())},
+                     {"rows", std::move(rows)}};
+  }
+  return out.dump();
+}
+
 std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
                             const std::vector<JobRow>& jobs,
                             const std::vector<v1::CalibrationRound>& rounds,
-                            const std::string& format) {
+                            const std::string& format,
+                            const std::map<std::int64_t, std::string>* series) {
   const Eigen::MatrixXd y = response_matrix(plan, jobs);
   const auto& d = plan.design;
   if (format == "csv") {
@@ -547,6 +564,11 @@ std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
       o["metrics"] = nlohmann::json::parse(*job.metrics_json);
       o["flags"] = nlohmann::json::parse(job.flags_json);
       o["cost"] = nlohmann::json::parse(job.cost_json);
+    }
+    if (series) {
+      const auto it = series->find(job.id);
+      o["series"] =
+          it == series->end() ? nlohmann::json::object() : nlohmann::json::parse(it->second);
     }
     j["jobs"].push_back(o);
   }

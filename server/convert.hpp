@@ -52,9 +52,14 @@ void from_json(const std::string& json, google::protobuf::Message& message);
 /// The whole campaign (spec, design, runs, results) as JSON, or as a CSV of the design in
 /// natural units plus one column per response (readable by `demcal analyze`).
 /// The JSON form also holds the calibration rounds.
+/// With `series` (job id -> series JSON, JSON form only) each finished job carries its curves.
 std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
                             const std::vector<JobRow>& jobs,
                             const std::vector<v1::CalibrationRound>& rounds,
-                            const std::string& format);
+                            const std::string& format,
+                            const std::map<std::int64_t, std::string>* series = nullptr);
+
+/// A result's curves as stored: {name: {"columns": [...], "rows": [[...], ...]}}; "" for none.
+std::string series_json(const google::protobuf::RepeatedPtrField<v1::Series>& series);
 
 }  // namespace demcal::server

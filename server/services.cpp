@@ -2,9 +2,12 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <thread>
 
 #include "core/common/error.hpp"
@@ -297,10 +300,15 @@ grpc::Status CampaignServiceImpl::Export(grpc::ServerContext* ctx, const v1::Exp
   const std::string format = req->format().empty() ? "json" : req->format();
   if (format != "json" && format != "csv")
     return {grpc::StatusCode::INVALID_ARGUMENT, "format: expected csv or json"};
+  if (req->series() && format != "json")
+    return {grpc::StatusCode::INVALID_ARGUMENT, "series: only with format json"};
   std::string content;
   try {
+    const auto series =
+        req->series() ? store_.series(row->id) : std::map<std::int64_t, std::string>{};
     content = export_campaign(*row, plan_from_json(row->design_json), store_.jobs(row->id),
-                              calibration_rounds(store_, *row), format);
+                              calibration_rounds(store_, *row), format,
+                              req->series() ? &series : nullptr);
   } catch (const std::exception& e) {
     return internal(e);
   }
@@ -345,6 +353,39 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* ctx, const v1::He
 
 namespace {
 
+/// A name of a series or column: 1-64 characters of [a-z0-9_] (any case).
+bool series_name_ok(const std::string& name) {
+  return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  });
+}
+
+/// The curves of a result: at most 32 series, each with a distinct valid name, 1-16 valid
+/// columns and at most 2,000 full rows of finite values.
+std::string series_error(const google::protobuf::RepeatedPtrField<v1::Series>& series) {
+  constexpr int kMaxSeries = 32, kMaxColumns = 16, kMaxRows = 2000;
+  if (series.size() > kMaxSeries) return "series: more than 32";
+  std::set<std::string> names;
+  for (int i = 0; i < series.size(); ++i) {
+    const auto& s = series[i];
+    const std::string where = "series[" + std::to_string(i) + "]";
+    if (!series_name_ok(s.name())) return where + ".name: 1-64 characters of [A-Za-z0-9_]";
+    if (!names.insert(s.name()).second) return where + ".name: " + s.name() + " given twice";
+    if (s.columns_size() < 1 || s.columns_size() > kMaxColumns)
+      return where + ".columns: 1 to 16 expected";
+    for (const auto& c : s.columns())
+      if (!series_name_ok(c)) return where + ".columns: 1-64 characters of [A-Za-z0-9_] each";
+    if (s.values_size() % s.columns_size() != 0)
+      return where + ".values: not a whole number of rows of " + std::to_string(s.columns_size());
+    if (s.values_size() / s.columns_size() > kMaxRows)
+      return where + ".values: more than 2000 rows";
+    for (int k = 0; k < s.values_size(); ++k)
+      if (!std::isfinite(s.values(k)))
+        return where + ".values[" + std::to_string(k) + "]: must be finite";
+  }
+  return {};
+}
+
 /// Checks a result before it is stored: every metric value finite and the metrics bounded in
 /// number and name length, the wall time finite and >= 0; a flag names a reported metric; texts
 /// and the phase list of the cost block bounded, its numbers finite and not negative. Empty when
@@ -364,6 +405,7 @@ std::string result_error(const v1::CompleteRequest& req) {
       return "flags." + metric + ": flags a metric the result does not report";
     if (reason.size() > kMaxText) return "flags." + metric + ": longer than 2000 characters";
   }
+  if (std::string e = series_error(req.series()); !e.empty()) return e;
   const auto& c = req.cost();
   auto bad = [](double v) { return !std::isfinite(v) || v < 0.0; };
   if (bad(c.time_step()) || bad(c.simulated_time()) || bad(c.wall_seconds()) ||
@@ -391,9 +433,10 @@ grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::Com
   std::map<std::string, double> metrics(req->metrics().begin(), req->metrics().end());
   const nlohmann::json flags(
       std::map<std::string, std::string>(req->flags().begin(), req->flags().end()));
-  if (const auto answer = store_.complete(req->job_id(), req->attempt(), req->worker(),
-                                          metrics_to_json(metrics), req->wall_seconds(),
-                                          steady_seconds(), flags.dump(), to_json(req->cost()));
+  if (const auto answer =
+          store_.complete(req->job_id(), req->attempt(), req->worker(), metrics_to_json(metrics),
+                          req->wall_seconds(), steady_seconds(), flags.dump(), to_json(req->cost()),
+                          series_json(req->series()));
       answer != LeaseAnswer::kOk) {
     spdlog::warn("job {}: result of attempt {} from {} rejected", req->job_id(), req->attempt(),
                  req->worker());

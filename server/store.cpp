@@ -133,6 +133,13 @@ const std::vector<const char*>& migrations() {
       R"sql(
       ALTER TABLE campaigns ADD COLUMN ready INTEGER NOT NULL DEFAULT 1;
       )sql",
+      // 6: a result's curves (stress-strain, yield points, drum surface, ...), apart from the
+      // results so that reading metrics never reads them.
+      R"sql(
+      CREATE TABLE result_series (
+        job_id INTEGER PRIMARY KEY REFERENCES results(job_id),
+        series_json TEXT NOT NULL);
+      )sql",
   };
   return m;
 }
@@ -472,6 +479,17 @@ std::vector<JobRow> Store::jobs(std::int64_t campaign_id) {
   return out;
 }
 
+std::map<std::int64_t, std::string> Store::series(std::int64_t campaign_id) {
+  Guard lock(*this);
+  Statement s(db_,
+              "SELECT c.job_id, c.series_json FROM result_series c JOIN jobs j ON j.id = c.job_id "
+              "WHERE j.campaign_id = ?");
+  s.bind(1, campaign_id);
+  std::map<std::int64_t, std::string> out;
+  while (s.step()) out.emplace(s.i64(0), s.text(1));
+  return out;
+}
+
 std::optional<JobRow> Store::job(std::int64_t job_id) {
   Guard lock(*this);
   Statement s(db_, (std::string(kJobColumns) + " WHERE j.id = ?").c_str());
@@ -621,7 +639,8 @@ LeaseAnswer Store::heartbeat(std::int64_t job_id, int attempt, const std::string
 
 LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string& worker,
                             const std::string& metrics_json, double wall_seconds, double now,
-                            const std::string& flags_json, const std::string& cost_json) {
+                            const std::string& flags_json, const std::string& cost_json,
+                            const std::string& series_json) {
   Guard lock(*this);
   Transaction tx(*this);
   if (already_stored(job_id, attempt, worker, metrics_json, wall_seconds)) return LeaseAnswer::kOk;
@@ -635,6 +654,10 @@ LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string&
               "flags_json, cost_json) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
   r.bind(1, job_id).bind(2, attempt).bind(3, worker).bind(4, metrics_json);
   r.bind(5, wall_seconds).bind(6, stored).bind(7, flags_json).bind(8, cost_json).step();
+  if (!series_json.empty()) {
+    Statement c(db_, "INSERT INTO result_series (job_id, series_json) VALUES (?, ?)");
+    c.bind(1, job_id).bind(2, series_json).step();
+  }
   finish_campaigns(stored);
   tx.commit();
   deadlines_.erase(job_id);

@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -159,9 +160,13 @@ class Store {
   LeaseAnswer heartbeat(std::int64_t job_id, int attempt, const std::string& worker, double now);
   /// Stores the result of the current, unexpired lease held by `worker` exactly once; a retry
   /// with the result already stored for that lease (same metrics and wall time) is kOk too.
+  /// `series_json` (the run's curves; empty: none) goes to its own table in the same transaction.
   LeaseAnswer complete(std::int64_t job_id, int attempt, const std::string& worker,
                        const std::string& metrics_json, double wall_seconds, double now,
-                       const std::string& flags_json = "{}", const std::string& cost_json = "{}");
+                       const std::string& flags_json = "{}", const std::string& cost_json = "{}",
+                       const std::string& series_json = "");
+  /// The stored curves of the campaign's finished jobs: job id -> series JSON.
+  std::map<std::int64_t, std::string> series(std::int64_t campaign_id);
   /// See the state machine above; only the current lease's holder may fail it.
   LeaseAnswer fail(std::int64_t job_id, int attempt, const std::string& worker,
                    const std::string& reason, bool retryable, bool give_back, double now);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <future>
 #include <mutex>
@@ -34,6 +35,7 @@ struct Outcome {
   bool ok = false;
   std::map<std::string, double> metrics;
   std::map<std::string, std::string> flags;
+  std::vector<v1::Series> series;
   v1::RunCost cost;
   std::string reason;
   bool retryable = false;
@@ -66,6 +68,25 @@ std::string refusal(const v1::JobSpec& job, double max_particles) {
   return "job asks for " + std::to_string(std::llround(it->second)) +
          " particles, more than this worker's --max-particles " +
          std::to_string(std::llround(max_particles));
+}
+
+/// Rows a curve keeps in a result: enough to draw it, far below the coordinator's limit.
+constexpr std::size_t kSeriesRows = 500;
+
+/// A curve as a result carries it: thinned, and without rows that hold a value that is not
+/// finite (a point that cannot be drawn; the coordinator refuses such numbers).
+v1::Series to_proto(const std::string& name, const lab::Series& full) {
+  lab::Series drawable{full.columns, {}};
+  for (const auto& row : full.rows)
+    if (std::all_of(row.begin(), row.end(), [](double v) { return std::isfinite(v); }))
+      drawable.rows.push_back(row);
+  const lab::Series s = lab::thinned(drawable, kSeriesRows);
+  v1::Series out;
+  out.set_name(name);
+  for (const auto& c : s.columns) out.add_columns(c);
+  for (const auto& row : s.rows)
+    for (double v : row) out.add_values(v);
+  return out;
 }
 
 v1::RunCost to_proto(const lab::RunCost& c) {
@@ -112,6 +133,7 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
     o.metrics = out.metrics;
     o.flags = out.flags;
     o.cost = to_proto(out.cost);
+    for (const auto& [name, series] : out.series) o.series.push_back(to_proto(name, series));
   } catch (const lab::RunCancelled& e) {
     o.cancelled = true;
     o.reason = e.what();
@@ -305,6 +327,7 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
         for (const auto& [k, v] : out.metrics) (*c.mutable_metrics())[k] = v;
         for (const auto& [k, v] : out.flags) (*c.mutable_flags())[k] = v;
         *c.mutable_cost() = out.cost;
+        for (const auto& s : out.series) *c.add_series() = s;
         v1::CompleteReply cr;
         s = stub->Complete(proto::make_context(opt.channel, 10).get(), c, &cr);
       } else {

@@ -53,11 +53,12 @@ json read_design(v1::CampaignService::StubInterface& stub, const proto::ChannelO
   return as_json(design);
 }
 
-/// The Export reply's content is itself the JSON document `demcal export --format json` prints.
+/// The Export reply's content is itself the JSON document `demcal export --format json --series`
+/// prints.
 json read_export(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
                  std::int64_t id) {
   std::string content;
-  required([&] { return cli::read_export(stub, ch, id, "json", content); }, "export");
+  required([&] { return cli::read_export(stub, ch, id, "json", content, true); }, "export");
   return json::parse(content);
 }
 

@@ -57,6 +57,23 @@ LabRunner find_lab_runner(const std::string& name) {
   throw InputError("test", "lab test '" + name + "' is catalogued but has no runner");
 }
 
+Series thinned(const Series& series, std::size_t max_rows) {
+  const std::size_t n = series.rows.size();
+  if (n <= max_rows) return series;
+  Series out{series.columns, {}};
+  if (max_rows == 0) return out;
+  out.rows.reserve(max_rows);
+  if (max_rows == 1) {
+    out.rows.push_back(series.rows.back());
+    return out;
+  }
+  // Row k of the result is row round(k (n - 1) / (max_rows - 1)): strictly increasing because
+  // n > max_rows, so no row is taken twice.
+  for (std::size_t k = 0; k < max_rows; ++k)
+    out.rows.push_back(series.rows[(k * (n - 1) + (max_rows - 1) / 2) / (max_rows - 1)]);
+  return out;
+}
+
 void LabOutput::add_phase(const PhaseCost& phase, const std::vector<std::string>& depending) {
   cost.phases.push_back(phase);
   if (phase.reached) return;

@@ -19,6 +19,10 @@ struct Series {
   std::vector<std::vector<double>> rows;
 };
 
+/// At most `max_rows` rows of `series`, evenly spread over it, the first and the last kept (what
+/// a worker sends with its result; `demcal lab run` writes the full series).
+Series thinned(const Series& series, std::size_t max_rows);
+
 struct LabOutput {
   std::map<std::string, double> metrics;  ///< by the names of the catalogue
   std::map<std::string, Series> series;

@@ -97,27 +97,29 @@ double DrumImage::occupied_percent() const {
   return drum ? 100.0 * occupied / drum : 0.0;
 }
 
-double DrumImage::surface_angle() const {
-  // The free surface: in each column, the top black pixel that has black below it (a lone
-  // particle in flight is not the surface).
-  std::vector<double> xs, ys;
+std::vector<std::pair<double, double>> DrumImage::surface() const {
+  std::vector<std::pair<double, double>> points;
   for (int i = 0; i < n; ++i)
     for (int j = n - 1; j >= 2; --j)
       if (at(i, j) && at(i, j - 1) && at(i, j - 2)) {
-        xs.push_back(-radius + (i + 0.5) * pixel);
-        ys.push_back(-radius + (j + 0.5) * pixel);
+        points.emplace_back(-radius + (i + 0.5) * pixel, -radius + (j + 0.5) * pixel);
         break;
       }
-  if (xs.size() < 4) return 0.0;
+  return points;
+}
+
+double DrumImage::surface_angle() const {
+  const auto points = surface();
+  if (points.size() < 4) return 0.0;
   // The surface spans the chord between the two points where it meets the wall; fit its middle
   // half, away from the toe and the shoulder.
-  const double lo = xs.front(), hi = xs.back();
+  const double lo = points.front().first, hi = points.back().first;
   const double a = lo + 0.25 * (hi - lo), b = lo + 0.75 * (hi - lo);
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   int m = 0;
-  for (std::size_t k = 0; k < xs.size(); ++k)
-    if (xs[k] >= a && xs[k] <= b) {
-      sx += xs[k], sy += ys[k], sxx += xs[k] * xs[k], sxy += xs[k] * ys[k];
+  for (const auto& [x, y] : points)
+    if (x >= a && x <= b) {
+      sx += x, sy += y, sxx += x * x, sxy += x * y;
       ++m;
     }
   if (m < 3 || m * sxx - sx * sx <= 0.0) return 0.0;
@@ -186,10 +188,13 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   run_for(std::min(60.0 * M_PI / 180.0 / w_angle, 3.0), {});
   double angle_sum = 0.0;
   int angle_n = 0;
+  Series profile{{"x_m", "y_m"}, {}};  // the free surface of the last image
   run_for(s.angle_time, [&] {
     const DrumImage img = image();
     const double a = img.surface_angle();
     angle_series.rows.push_back({w.time, a, img.occupied_percent()});
+    profile.rows.clear();
+    for (const auto& [x, y] : img.surface()) profile.rows.push_back({x, y});
     if (angle_series.rows.size() * 2 > static_cast<std::size_t>(s.angle_time / frame)) {
       angle_sum += a;
       ++angle_n;
@@ -233,6 +238,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   out.metrics["drum_diameter_ratio"] = bed.diameter_ratio;
   out.metrics["particles"] = static_cast<double>(w.particles.units());
   out.series["angle"] = std::move(angle_series);
+  out.series["surface_profile"] = std::move(profile);
   out.series["area_method"] = std::move(area);
   out.cost.close(w);
   return out;

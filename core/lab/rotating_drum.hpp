@@ -3,6 +3,8 @@
 // area method (occupied cross-sectional area, eq. 20) at 4, 40, 80, 105 and 116 rpm, in a drum
 // given in real units whose particle count follows from its size, its fill and the sizes.
 #include <array>
+#include <utility>
+#include <vector>
 
 #include "core/lab/lab_test.hpp"
 #include "core/particles/size_distribution.hpp"
@@ -91,8 +93,11 @@ struct DrumImage {
   bool at(int i, int j) const { return black[static_cast<std::size_t>(j) * n + i] != 0; }
   /// Occupied cross-sectional area in % of the drum's (seed 001 eq. 20).
   double occupied_percent() const;
-  /// Angle (deg) of a straight line fitted to the free surface (the top black pixel of each
-  /// column) over the middle half of the surface's horizontal extent; gravity along -y.
+  /// The free surface (x, y) from wall to wall: per column the top black pixel with black below
+  /// it (a lone particle in flight is not the surface); gravity along -y.
+  std::vector<std::pair<double, double>> surface() const;
+  /// Angle (deg) of a straight line fitted to the free surface over the middle half of its
+  /// horizontal extent.
   double surface_angle() const;
 };
 DrumImage project_drum(const std::vector<Vec3>& x, const std::vector<double>& radius,

@@ -55,6 +55,8 @@ MohrResult mohr_evaluation(double k, double c, double s_pre, double t_pre) {
   const double rho = s * sn + c * cs;
   if (rho <= 0.0 || s <= 0.0) return m;
   m.consistent = true;
+  m.centre_1 = s;
+  m.radius_1 = rho;
   m.sigma_1 = s + rho;
   m.ffc = m.sigma_c > 0.0 ? std::min(kFfcCap, m.sigma_1 / m.sigma_c) : kFfcCap;
   m.phi_e = std::asin(std::min(1.0, rho / s)) * 180.0 / M_PI;
@@ -62,6 +64,15 @@ MohrResult mohr_evaluation(double k, double c, double s_pre, double t_pre) {
 }
 
 namespace {
+
+/// The circles of seed 000 Fig. 23 as (centre, radius) in kPa: the unconfined yield circle
+/// through the origin (when the locus has cohesion) and the consolidation circle.
+Series mohr_circles(const MohrResult& m) {
+  Series circles{{"circle", "centre_kpa", "radius_kpa"}, {}};
+  if (m.sigma_c > 0.0) circles.rows.push_back({0.0, 0.5 * m.sigma_c, 0.5 * m.sigma_c});
+  if (m.consistent) circles.rows.push_back({1.0, m.centre_1, m.radius_1});
+  return circles;
+}
 
 enum Wall : std::size_t { kFloor = 0, kVessel = 1, kHead = 2 };
 
@@ -269,6 +280,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
         "effective_friction_angle are 0 (undefined)");
   out.series["pre_shear"] = std::move(pre);
   out.series["yield_points"] = std::move(points);
+  out.series["mohr_circles"] = mohr_circles(mohr);
   out.cost.close(w);
   return out;
 }

@@ -61,6 +61,8 @@ struct MohrResult {
   double sigma_1 = 0.0;     ///< major consolidation stress
   double ffc = 0.0;         ///< sigma_1 / sigma_c, at most kFfcCap (kFfcCap when sigma_c = 0)
   double phi_e = 0.0;       ///< effective angle of internal friction (deg)
+  /// The consolidation circle (centre, radius), touching the locus; 0, 0 when not consistent.
+  double centre_1 = 0.0, radius_1 = 0.0;
 };
 MohrResult mohr_evaluation(double slope, double intercept, double sigma_pre, double tau_pre);
 

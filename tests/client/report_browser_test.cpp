@@ -206,11 +206,9 @@ class ReportBrowser : public ::testing::Test {
         (dir_ / "server.log").string());
     grpc_ = "127.0.0.1:" + std::to_string(read_port(dir_ / "port"));
     http_port_ = read_port(dir_ / "http_port");
-    const Output sub = cli("submit " + source("examples/packing_demo_campaign.yaml"));
-    ASSERT_EQ(sub.exit_code, 0) << sub.out;
-    std::smatch m;
-    ASSERT_TRUE(std::regex_search(sub.out, m, std::regex("campaign (\\d+) submitted"))) << sub.out;
-    id_ = std::stoll(m[1].str());
+    id_ = submit("examples/packing_demo_campaign.yaml");
+    // Queued behind the packing campaign (the oldest campaign's jobs are leased first).
+    curves_id_ = submit("tests/data/report/curves_campaign.yaml");
     for (int w = 1; w <= 2; ++w)
       workers_.push_back(std::make_unique<Process>(
           std::vector<std::string>{DEMCAL_WORKER_BIN, "--coordinator", grpc_, "--token", kToken,
@@ -230,6 +228,32 @@ class ReportBrowser : public ::testing::Test {
 
   static std::string source(const std::string& rel) {
     return std::string(DEMCAL_SOURCE_DIR) + "/" + rel;
+  }
+  /// Submits a spec of the source tree; its campaign id (0 after a failed assertion).
+  static std::int64_t submit(const std::string& spec) {
+    const Output sub = cli("submit " + source(spec));
+    EXPECT_EQ(sub.exit_code, 0) << sub.out;
+    std::smatch m;
+    if (!std::regex_search(sub.out, m, std::regex("campaign (\\d+) submitted"))) {
+      ADD_FAILURE() << sub.out;
+      return 0;
+    }
+    return std::stoll(m[1].str());
+  }
+  /// Waits until the campaign is no longer running; its status as JSON.
+  static json wait_finished(std::int64_t id, int seconds) {
+    json status;
+    demcal::test::wait_until(
+        [&] {
+          const Output o = cli("status " + std::to_string(id) + " --format json", false);
+          if (o.exit_code != 0) return false;
+          status = json::parse(o.out);
+          if (status["state"] != "RUNNING") return true;
+          std::this_thread::sleep_for(std::chrono::milliseconds(500));
+          return false;
+        },
+        seconds);
+    return status;
   }
   static Output cli(const std::string& args, bool merge = true) {
     return run(
@@ -269,6 +293,7 @@ class ReportBrowser : public ::testing::Test {
   static inline std::string grpc_;
   static inline int http_port_ = 0;
   static inline std::int64_t id_ = 0;
+  static inline std::int64_t curves_id_ = 0;  ///< every lab test that draws curves
   static inline json effects_;
   static inline std::set<long long> seen_done_;
 };
@@ -286,10 +311,88 @@ TEST_F(ReportBrowser, StaticReportDrawsEveryPlotWithTheNumbersOfTheCli) {
   // the verified errors, the calibration rounds, the packing test's metrics.
   expect_every_plot_drawn(page, effects_, 2 * 6 + 2 + 2 + 1);
   expect_effects_in_page(page.dom, effects_);
-  EXPECT_NE(page.dom.find("Curves not shown"), std::string::npos)
-      << "the report says where series are not stored";
+  EXPECT_EQ(page.dom.find("data-plot=\"curve:"), std::string::npos)
+      << "packing has no curves to draw";
   screenshot(url, dir_ / "report.png");
   EXPECT_GT(fs::file_size(dir_ / "report.png"), 50'000u);
+}
+
+/// The rows of one series of an exported job (empty when the job has no such series).
+std::size_t series_rows(const json& job, const std::string& name) {
+  const auto& series = job.at("series");
+  return series.contains(name) ? series[name]["rows"].size() : 0;
+}
+
+// Every lab test that has curves, run by the workers: the curves travel with the result, the
+// export carries them, and the report draws each one from them (one line per job, one symbol
+// per stored point).
+TEST_F(ReportBrowser, LabTestCurvesAreDrawnFromTheStoredSeries) {
+  const json status = wait_finished(curves_id_, 240);
+  ASSERT_EQ(status["state"], "DONE") << status.dump(1);
+  const Output exp = cli("export " + std::to_string(curves_id_) + " --format json --series", false);
+  ASSERT_EQ(exp.exit_code, 0) << exp.out;
+  std::map<std::string, std::vector<json>> jobs;  // per test, its finished jobs
+  const json exported = json::parse(exp.out);
+  for (const auto& job : exported.at("jobs")) {
+    ASSERT_EQ(job["state"], "done") << job.dump(1);
+    jobs[job["test"].get<std::string>()].push_back(job);
+  }
+  ASSERT_EQ(jobs.size(), 6u);
+  for (const auto& [test, list] : jobs) {
+    ASSERT_EQ(list.size(), 2u) << test;
+    for (const auto& job : list) {
+      for (const auto& [name, series] : job["series"].items()) {
+        EXPECT_LE(series["rows"].size(), 500u) << test << " " << name << " thinned";
+        for (const auto& row : series["rows"])
+          EXPECT_EQ(row.size(), series["columns"].size()) << test << " " << name;
+      }
+    }
+  }
+  for (const auto& job : jobs["confined_compression"])
+    EXPECT_GE(series_rows(job, "stress_strain"), 20u) << "load and unload of one cycle";
+  int yield_points = 0, circles = 0, surface = 0;
+  for (const auto& job : jobs["shear_cell"]) {
+    std::size_t normal_stresses = 0;  // one yield_shear_stress_<sigma> metric each
+    for (const auto& [metric, value] : job["metrics"].items())
+      normal_stresses += metric.rfind("yield_shear_stress_", 0) == 0;
+    EXPECT_EQ(series_rows(job, "yield_points"), normal_stresses);
+    EXPECT_GE(series_rows(job, "mohr_circles"), 1u);
+    yield_points += int(series_rows(job, "yield_points"));
+    circles += int(series_rows(job, "mohr_circles"));
+  }
+  for (const auto& job : jobs["rotating_drum"]) {
+    EXPECT_GE(series_rows(job, "surface_profile"), 4u);
+    surface += int(series_rows(job, "surface_profile"));
+  }
+  for (const auto& job : jobs["hopper"]) EXPECT_GE(series_rows(job, "discharge"), 3u);
+
+  const fs::path out = dir_ / "curves";
+  const Output o = cli("report " + std::to_string(curves_id_) + " -o " + out.string());
+  ASSERT_EQ(o.exit_code, 0) << o.out;
+  const Page page =
+      open_in_chromium("file://" + fs::absolute(out / "report.html").string(), dir_, "curves");
+  EXPECT_TRUE(page.console.empty()) << page.console.front();
+  const std::size_t at = page.dom.find("id=\"demcal-status\"");
+  ASSERT_NE(at, std::string::npos);
+  const std::string tag = page.dom.substr(page.dom.rfind('<', at), 300);
+  EXPECT_EQ(attribute(tag, "data-plots-failed"), "0");
+  EXPECT_EQ(attribute(tag, "data-plots-rendered"), attribute(tag, "data-plots-expected"));
+  const auto marks = marks_per_plot(page.dom);
+  // One line per job in every curve plot; the drum adds its wall (two half circles), the
+  // shear cell one locus per job and its Mohr circles.
+  for (const std::string plot :
+       {"confined_compression:stress_strain", "tensile:tensile", "wall_friction:wall_shear",
+        "rotating_drum:angle", "hopper:discharge"}) {
+    const auto it = marks.find("curve:" + plot);
+    ASSERT_NE(it, marks.end()) << plot << " not drawn";
+    EXPECT_EQ(it->second.at("line"), 2) << plot;
+  }
+  const auto& drum = marks.at("curve:rotating_drum:surface_profile");
+  EXPECT_EQ(drum.at("line"), 2 + 2);
+  EXPECT_EQ(drum.at("symbol"), surface) << "one point per stored surface point";
+  const auto& locus = marks.at("curve:shear_cell:yield_locus");
+  EXPECT_EQ(locus.at("symbol"), yield_points);
+  EXPECT_EQ(locus.at("line"), 2 + circles);
 }
 
 TEST_F(ReportBrowser, LivePageFollowsTheCampaignAndDrawsTheSameReport) {

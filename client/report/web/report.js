@@ -479,24 +479,127 @@
     if ((r.conflicts || []).length) s.appendChild(el('ul', {}, r.conflicts.map((c) => el('li', {}, c.statement))));
   }
 
+  // The curves of each lab test (docs/lab-tests.md names the series, docs/report.md the figures):
+  // per plot the series, its x and y columns, the axis titles and the seed's figure it follows.
+  const CURVES = {
+    confined_compression: [{ series: 'stress_strain', x: 'strain', y: 'stress_kPa', xTitle: 'strain (h - h1) / h1', yTitle: 'piston stress (kPa)', title: 'stress-strain cycles', caption: 'Load-unload cycles of every finished job, strain as seed 000 Fig. 8.' }],
+    tensile: [{ series: 'tensile', x: 'strain', y: 'tensile_stress_kPa', xTitle: 'strain', yTitle: 'tensile stress (kPa)', title: 'tensile stress against strain', caption: 'The pull of every finished job (seed 000 §2.7.3).' }],
+    wall_friction: [{ series: 'wall_shear', x: 'normal_stress_kPa', y: 'shear_stress_kPa', xTitle: 'normal stress (kPa)', yTitle: 'wall shear stress (kPa)', title: 'wall yield locus', points: true, caption: 'Wall shear stress against normal stress (seed 000 Fig. 13); the slope is the wall friction.' }],
+    rotating_drum: [
+      { series: 'surface_profile', x: 'x_m', y: 'y_m', xTitle: 'x (m)', yTitle: 'y (m)', title: 'free surface in the drum', drum: true, points: true, caption: 'The free surface of the last image of the angle window (seed 001 §3.2.2) inside the drum wall.' },
+      { series: 'angle', x: 'time', y: 'angle_deg', xTitle: 'time (s)', yTitle: 'surface angle (deg)', title: 'dynamic angle over time', caption: 'The surface angle of every image; the metric is the mean of the second half.' },
+    ],
+    hopper: [{ series: 'discharge', x: 'time', y: 'discharged_mass', xTitle: 'time (s)', yTitle: 'discharged mass (kg)', title: 'hopper mass against time', caption: 'Discharged mass of every finished job; the rate is the slope between 15 % and 75 % of it.' }],
+  };
+
+  function jobLabel(job) {
+    return 'job ' + job.job_id + ' (' + job.kind + ' ' + job.std_order + ')';
+  }
+
+  // The rows of `series` as points {job, i, x, y}, or none when it lacks a column.
+  function curvePoints(job, series, x, y) {
+    const s = (job.series || {})[series];
+    if (!s) return [];
+    const ix = s.columns.indexOf(x), iy = s.columns.indexOf(y);
+    if (ix < 0 || iy < 0) return [];
+    return s.rows.map((r, i) => ({ job: jobLabel(job), i: i, x: r[ix], y: r[iy] }));
+  }
+
+  // Points of the upper half of a circle (sigma, tau) for a Mohr circle.
+  function circlePoints(job, circle, centre, radius) {
+    const out = [];
+    for (let k = 0; k <= 60; ++k) {
+      const t = (Math.PI * k) / 60;
+      out.push({ job: jobLabel(job), circle: circle, i: k, x: centre + radius * Math.cos(t), y: radius * Math.sin(t) });
+    }
+    return out;
+  }
+
+  // One line per job (and per circle), its points in row order; `axes` gives the axis titles.
+  function lineLayer(values, axes, points, strokeDash) {
+    return {
+      data: { values: values },
+      mark: { type: 'line', point: points ? { filled: true, size: 30 } : false, strokeDash: strokeDash },
+      encoding: {
+        x: { field: 'x', type: 'quantitative', scale: { zero: false }, title: axes.xTitle },
+        y: { field: 'y', type: 'quantitative', scale: { zero: false }, title: axes.yTitle },
+        color: { field: 'job', type: 'nominal', legend: { title: null } },
+        detail: { field: 'circle', type: 'nominal' },
+        order: { field: 'i', type: 'quantitative' },
+        tooltip: [{ field: 'job' }, { field: 'x', format: '.4g' }, { field: 'y', format: '.4g' }],
+      },
+    };
+  }
+
+  function curvePlot(parent, name, jobs, c) {
+    const values = jobs.flatMap((j) => curvePoints(j, c.series, c.x, c.y));
+    if (!values.length) return false;
+    const layers = [lineLayer(values, c, c.points)];
+    if (c.drum) {
+      // the drum wall: a circle of the job's drum_diameter about the axis
+      const wall = jobs.filter((j) => j.metrics && j.metrics.drum_diameter > 0).slice(0, 1)
+        .flatMap((j) => [...circlePoints(j, 'upper', 0, j.metrics.drum_diameter / 2), ...circlePoints(j, 'lower', 0, j.metrics.drum_diameter / 2).map((p) => Object.assign(p, { y: -p.y }))]);
+      if (wall.length) layers.push({ data: { values: wall }, mark: { type: 'line', color: '#999' }, encoding: { x: { field: 'x', type: 'quantitative' }, y: { field: 'y', type: 'quantitative' }, detail: { field: 'circle', type: 'nominal' }, order: { field: 'i', type: 'quantitative' } } });
+    }
+    plot(parent, name, {
+      title: c.title,
+      width: c.drum ? 300 : 420, height: c.drum ? 300 : 260,
+      layer: layers,
+    }, c.caption);
+    return true;
+  }
+
+  // Seed 000 Fig. 23: the measured yield points, the fitted locus and its Mohr circles per job.
+  function yieldLocusPlot(parent, name, jobs) {
+    const points = jobs.flatMap((j) => curvePoints(j, 'yield_points', 'sigma_measured_kpa', 'yield_shear_stress_kpa'));
+    if (!points.length) return false;
+    const loci = [], circles = [];
+    for (const j of jobs) {
+      const m = j.metrics || {};
+      const top = Math.max(...curvePoints(j, 'yield_points', 'sigma_measured_kpa', 'yield_shear_stress_kpa').map((p) => p.x), m.major_consolidation_stress || 0);
+      if (typeof m.yield_locus_slope === 'number' && isFinite(top))
+        for (const x of [0, top]) loci.push({ job: jobLabel(j), i: x, x: x, y: m.yield_locus_intercept + m.yield_locus_slope * x });
+      const s = (j.series || {}).mohr_circles;
+      if (s) for (const r of s.rows) circles.push(...circlePoints(j, String(r[0]), r[1], r[2]));
+    }
+    const axes = { xTitle: 'normal stress (kPa)', yTitle: 'shear stress (kPa)' };
+    const layers = [
+      { data: { values: points }, mark: { type: 'point', filled: true, size: 50 }, encoding: { x: { field: 'x', type: 'quantitative', title: axes.xTitle }, y: { field: 'y', type: 'quantitative', title: axes.yTitle }, color: { field: 'job', type: 'nominal', legend: { title: null } }, tooltip: [{ field: 'job' }, { field: 'x', format: '.4g' }, { field: 'y', format: '.4g' }] } },
+      lineLayer(loci, axes, false, [6, 3]),
+    ];
+    if (circles.length) layers.push(lineLayer(circles, axes, false));
+    plot(parent, name, {
+      title: 'yield locus and Mohr circles',
+      width: 420, height: 260,
+      layer: layers,
+    }, 'Yield points at the normal stresses of the test, the fitted locus (dashed) and the Mohr circles of the unconfined yield strength and of the consolidation (seed 000 Fig. 23).');
+    return true;
+  }
+
+  function labCurves(parent, t, name, jobs) {
+    let drawn = 0;
+    if (t.test === 'shear_cell') drawn += yieldLocusPlot(parent, 'curve:' + name + ':yield_locus', jobs);
+    for (const c of CURVES[t.test] || []) drawn += curvePlot(parent, 'curve:' + name + ':' + c.series, jobs, c);
+    if (!drawn && (CURVES[t.test] || t.test === 'shear_cell')) note(parent, 'No curves stored for the finished jobs of ' + name + '.');
+  }
+
   function labSection(root, data) {
-    const s = section(root, 'lab-tests', 'Lab tests', 'Per lab test instance its metrics over the runs (docs/lab-tests.md).');
+    const s = section(root, 'lab-tests', 'Lab tests', 'Per lab test instance its curves and its metrics over the runs (docs/lab-tests.md).');
     const tests = (data.campaign.spec && data.campaign.spec.tests) || [];
     for (const t of tests) {
       const name = t.name || t.test;
       const ts = el('div', { class: 'lab', 'data-test': name });
       s.appendChild(ts);
       ts.appendChild(el('h3', {}, name + ' (' + t.test + ')'));
-      note(ts, 'Curves not shown: the coordinator stores a job\'s metrics, not its time series (stress-strain cycles as seed 000 Fig. 8, yield locus with Mohr circles as Fig. 23, drum profile, hopper mass-time). `demcal lab run` with the same settings writes them as CSV.');
-      const values = [];
-      for (const job of data.export.jobs) {
-        if (job.test !== name || job.state !== 'done') continue;
-        for (const [metric, v] of Object.entries(job.metrics || {})) values.push({ metric: metric, value: v, run: job.std_order, kind: job.kind.split(':')[0] });
-      }
-      if (values.length === 0) {
+      const done = data.export.jobs.filter((job) => job.test === name && job.state === 'done');
+      if (done.length === 0) {
         note(ts, 'No finished job yet.');
         continue;
       }
+      labCurves(ts, t, name, done);
+      const values = [];
+      for (const job of done)
+        for (const [metric, v] of Object.entries(job.metrics || {})) values.push({ metric: metric, value: v, run: job.std_order, kind: job.kind.split(':')[0] });
       plot(ts, 'lab:' + name, {
         title: name + ': metrics of every finished job',
         data: { values: values },
