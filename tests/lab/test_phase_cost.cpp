@@ -18,6 +18,27 @@ Settings one_cycle(double particles) {
   return {{"particles", particles}, {"cycles", 1}, {"wall_stiffness_factor", 1}};
 }
 
+// What a worker sends of a curve: evenly spread rows, the first and the last kept, none twice.
+TEST(Series, ThinnedKeepsTheEndsAndSpreadsTheRows) {
+  Series full{{"i"}, {}};
+  for (int i = 0; i < 1001; ++i) full.rows.push_back({double(i)});
+  const Series t = thinned(full, 11);
+  ASSERT_EQ(t.rows.size(), 11u);
+  EXPECT_EQ(t.columns, full.columns);
+  for (std::size_t k = 0; k < t.rows.size(); ++k) EXPECT_EQ(t.rows[k][0], 100.0 * double(k));
+  const Series odd = thinned(full, 7);  // 1000 / 6 is not whole: rounded, increasing
+  ASSERT_EQ(odd.rows.size(), 7u);
+  EXPECT_EQ(odd.rows.front()[0], 0.0);
+  EXPECT_EQ(odd.rows.back()[0], 1000.0);
+  for (std::size_t k = 1; k < odd.rows.size(); ++k) {
+    EXPECT_NEAR(odd.rows[k][0], 1000.0 / 6.0 * double(k), 0.5 + 1e-9);
+    EXPECT_GT(odd.rows[k][0], odd.rows[k - 1][0]);
+  }
+  EXPECT_EQ(thinned(full, 2000).rows.size(), 1001u) << "a short series is kept whole";
+  EXPECT_EQ(thinned(full, 1).rows.at(0)[0], 1000.0);
+  EXPECT_TRUE(thinned(full, 0).rows.empty());
+}
+
 TEST(PhaseCost, EveryPhaseOfAConfinedCompressionIsRecorded) {
   const LabOutput out =
       run_lab_test("confined_compression", testing::soft_luding(), one_cycle(120), {});

@@ -57,6 +57,8 @@ TEST(LabShearCell, MohrEvaluationOfAConsistentAndAnInconsistentLocus) {
   EXPECT_NEAR((s_pre - s1) * (s_pre - s1) + t_pre * t_pre, r1 * r1, 1e-9);
   EXPECT_NEAR(s1 * std::sin(phi) + c * std::cos(phi), r1, 1e-9);
   EXPECT_GE(m.sigma_1, s + rho - 1e-9);  // the larger of the two circles
+  EXPECT_NEAR(m.centre_1, s1, 1e-9);     // the circle the report draws is that circle
+  EXPECT_NEAR(m.radius_1, r1, 1e-9);
   EXPECT_NEAR(m.sigma_c, 2.0 * c * (1.0 + std::sin(phi)) / std::cos(phi), 1e-12);
   EXPECT_NEAR(m.ffc, m.sigma_1 / m.sigma_c, 1e-12);
   // Fig. 23b: the pre-shear point above the locus.

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "client/service_client.hpp"
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
 #include "demcal/v1/campaign.grpc.pb.h"
@@ -507,6 +508,70 @@ TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
       EXPECT_EQ(j.worker(), "fast");
       EXPECT_DOUBLE_EQ(j.metrics().at("solid_fraction"), 0.58);
     }
+}
+
+// A result's curves: checked at the door (the field named, the lease kept), stored with the
+// result, and exported with it on request (json only).
+TEST_F(Service, AResultsCurvesAreCheckedStoredAndExported) {
+  start_server();
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  v1::LeaseRequest lr;
+  lr.set_worker("w");
+  v1::LeaseReply lease;
+  ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
+  ASSERT_TRUE(lease.has_job());
+  v1::CompleteRequest good;
+  good.set_job_id(lease.job().job_id());
+  good.set_attempt(lease.job().attempt());
+  good.set_worker("w");
+  (*good.mutable_metrics())["solid_fraction"] = 0.6;
+  auto* curve = good.add_series();
+  curve->set_name("stress_strain");
+  for (const char* c : {"strain", "stress_kPa"}) curve->add_columns(c);
+  for (double v : {0.0, 0.0, 0.01, 5.0, 0.02, 15.0}) curve->add_values(v);
+
+  const std::vector<std::pair<std::function<void(v1::Series&)>, std::string>> spoiled = {
+      {[](v1::Series& s) { s.set_values(3, std::nan("")); }, "series[0].values[3]"},
+      {[](v1::Series& s) { s.add_values(1.0); }, "series[0].values"},
+      {[](v1::Series& s) { s.set_name("a b"); }, "series[0].name"},
+      {[](v1::Series& s) { s.clear_columns(); }, "series[0].columns"},
+      {[](v1::Series& s) {
+         for (int r = 0; r < 2001; ++r) s.add_values(0.0), s.add_values(0.0);
+       },
+       "series[0].values"},
+  };
+  v1::CompleteReply cr;
+  for (const auto& [spoil, field] : spoiled) {
+    v1::CompleteRequest bad = good;
+    spoil(*bad.mutable_series(0));
+    const auto st = workers_stub_->Complete(ctx().get(), bad, &cr);
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << field;
+    EXPECT_NE(st.error_message().find(field), std::string::npos) << st.error_message();
+  }
+  v1::CompleteRequest twice = good;
+  *twice.add_series() = good.series(0);
+  EXPECT_EQ(workers_stub_->Complete(ctx().get(), twice, &cr).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  ASSERT_TRUE(workers_stub_->Complete(ctx().get(), good, &cr).ok()) << "the lease was kept";
+
+  std::string content;
+  ASSERT_TRUE(cli::read_export(*campaigns_, channel_, id, "json", content, true).ok());
+  bool found = false;
+  const auto exported = nlohmann::json::parse(content);
+  for (const auto& job : exported.at("jobs")) {
+    ASSERT_TRUE(job.contains("series"));
+    if (job["job_id"] != good.job_id()) continue;
+    found = true;
+    const auto& s = job["series"]["stress_strain"];
+    EXPECT_EQ(s["columns"], nlohmann::json({"strain", "stress_kPa"}));
+    EXPECT_EQ(s["rows"], nlohmann::json({{0.0, 0.0}, {0.01, 5.0}, {0.02, 15.0}}));
+  }
+  EXPECT_TRUE(found);
+  ASSERT_TRUE(cli::read_export(*campaigns_, channel_, id, "json", content).ok());
+  EXPECT_EQ(content.find("\"series\""), std::string::npos) << "curves only when asked for";
+  const auto csv = cli::read_export(*campaigns_, channel_, id, "csv", content, true);
+  EXPECT_EQ(csv.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 }
 
 TEST_F(Service, AResultFinishedWhileTheCoordinatorWasDownLongerThanTheLeaseIsAccepted) {

@@ -354,7 +354,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 5);
+    EXPECT_EQ(Store::latest_schema_version(), 6);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
@@ -374,6 +374,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
     EXPECT_DOUBLE_EQ(js[0].wall_seconds, 12.5);
     EXPECT_EQ(js[0].flags_json, "{}");  // a result from before flags and costs: none recorded
     EXPECT_EQ(js[0].cost_json, "{}");
+    EXPECT_TRUE(s.series(1).empty());  // a result from before curves: none stored
     EXPECT_EQ(s.result_count(1), 1);
 
     const auto ids = s.add_jobs(1, {{1, 1, "packing", "diagnose:shape", "{}"}});

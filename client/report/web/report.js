@@ -483,13 +483,13 @@
   // per plot the series, its x and y columns, the axis titles and the seed's figure it follows.
   const CURVES = {
     confined_compression: [{ series: 'stress_strain', x: 'strain', y: 'stress_kPa', xTitle: 'strain (h - h1) / h1', yTitle: 'piston stress (kPa)', title: 'stress-strain cycles', caption: 'Load-unload cycles of every finished job, strain as seed 000 Fig. 8.' }],
-    tensile: [{ series: 'tensile', x: 'strain', y: 'tensile_stress_kPa', xTitle: 'strain', yTitle: 'tensile stress (kPa)', title: 'tensile stress against strain', caption: 'The pull of every finished job (seed 000 §2.7.3).' }],
-    wall_friction: [{ series: 'wall_shear', x: 'normal_stress_kPa', y: 'shear_stress_kPa', xTitle: 'normal stress (kPa)', yTitle: 'wall shear stress (kPa)', title: 'wall yield locus', points: true, caption: 'Wall shear stress against normal stress (seed 000 Fig. 13); the slope is the wall friction.' }],
+    tensile: [{ series: 'tensile', x: 'strain', y: 'tensile_stress_kPa', xTitle: 'strain', yTitle: 'tensile stress (kPa)', title: 'tensile stress against strain', caption: 'The pull of every finished job (seed 000 Fig. 11, §2.7.3).' }],
+    wall_friction: [{ series: 'wall_shear', x: 'normal_stress_kPa', y: 'shear_stress_kPa', xTitle: 'normal stress (kPa)', yTitle: 'wall shear stress (kPa)', title: 'wall yield locus', points: true, caption: 'Wall shear stress against normal stress (seed 000 §2.7.5); the slope of the line through the origin is the wall friction.' }],
     rotating_drum: [
       { series: 'surface_profile', x: 'x_m', y: 'y_m', xTitle: 'x (m)', yTitle: 'y (m)', title: 'free surface in the drum', drum: true, points: true, caption: 'The free surface of the last image of the angle window (seed 001 §3.2.2) inside the drum wall.' },
       { series: 'angle', x: 'time', y: 'angle_deg', xTitle: 'time (s)', yTitle: 'surface angle (deg)', title: 'dynamic angle over time', caption: 'The surface angle of every image; the metric is the mean of the second half.' },
     ],
-    hopper: [{ series: 'discharge', x: 'time', y: 'discharged_mass', xTitle: 'time (s)', yTitle: 'discharged mass (kg)', title: 'hopper mass against time', caption: 'Discharged mass of every finished job; the rate is the slope between 15 % and 75 % of it.' }],
+    hopper: [{ series: 'discharge', x: 'time', y: 'discharged_mass', xTitle: 'time (s)', yTitle: 'discharged mass (kg)', title: 'hopper mass against time', caption: 'Discharged mass of every finished job (seed 000 §2.7.6); the rate is the slope between 15 % and 75 % of it.' }],
   };
 
   function jobLabel(job) {
