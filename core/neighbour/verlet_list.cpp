@@ -112,7 +112,10 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
     for (int i = 0; i < n; ++i) cell_items_[fill[cell_of[i]]++] = i;
   }
 
-  std::vector<int> old_start, old_nbr;
+  // The old rows and history go to buffers kept from the build before, whose memory is reused:
+  // a build allocates nothing once the list has reached its size.
+  std::vector<int>& old_start = old_start_;
+  std::vector<int>& old_nbr = old_nbr_;
   old_start.swap(row_start);
   old_nbr.swap(nbr);
   row_start.assign(n + 1, 0);
@@ -148,7 +151,7 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
   // One pass over the candidates: each thread lists the partners of its own rows, sorted, in a
   // buffer of its own; the buffers are then laid end to end in thread order (= row order).
   const bool carry = stride > 0 && old_start.size() == static_cast<std::size_t>(n + 1);
-  std::vector<double> new_history;
+  std::vector<double>& new_history = spare_history_;
   if (static_cast<int>(partners_.size()) < threads) partners_.resize(threads);
 #pragma omp parallel num_threads(threads)
   {

@@ -33,6 +33,8 @@ class VerletList {
  private:
   std::vector<Vec3> x_at_build_;
   std::vector<int> cell_start_, cell_items_;
+  std::vector<int> old_start_, old_nbr_;  ///< the rows of the build before last (memory reused)
+  std::vector<double> spare_history_;     ///< the history of the build before last (memory reused)
   std::vector<std::vector<int>> partners_;  ///< per thread: the partners of its rows, in a build
   std::size_t builds_ = 0;
 };
