@@ -37,6 +37,7 @@ diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan&
   p.shape_kind = m.shape().kind().empty() ? "sphere" : m.shape().kind();
   p.rolling_model =
       m.particle_law().rolling().model().empty() ? "none" : m.particle_law().rolling().model();
+  p.size_kind = m.sizes().has_monodisperse() ? "monodisperse" : "distribution";
   for (const auto& [path, value] : spec.fixed()) p.fixed[path] = value;
   const auto model = proto::to_material_model(m, "spec.material");
   for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
@@ -44,6 +45,7 @@ diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan&
   p.options.candidates.assign(o.candidates().begin(), o.candidates().end());
   p.options.aspect_ratio_max = or_default(o.aspect_ratio_max(), 3.0);
   p.options.rolling_max = or_default(o.rolling_max(), 0.3);
+  p.options.sigma_g_max = or_default(o.sigma_g_max(), 1.5);
   p.options.fixed_span = or_default(o.fixed_span(), 2.0);
   p.options.margin = or_default(o.margin(), 0.3);
   p.options.seed = seed ? seed : 1;
@@ -84,6 +86,12 @@ v1::Material switched(const v1::Material& base, const std::map<std::string, std:
       auto* slot = m.mutable_particle_law()->mutable_rolling();
       slot->set_model(value);
       (*slot->mutable_params())["mu_r"] = 0.0;
+    } else if (what == "sizes" && value == "lognormal" && m.sizes().has_monodisperse()) {
+      // One size becomes the median of a log-normal number distribution; the run sets sigma_g.
+      const double radius = m.sizes().monodisperse().radius();
+      auto* ln = m.mutable_sizes()->mutable_lognormal();
+      ln->set_median_radius(radius);
+      ln->set_sigma_g(diagnose::kSigmaGLow);
     } else {
       throw InputError("diagnose", "unknown model switch " + what);
     }

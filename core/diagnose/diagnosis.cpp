@@ -86,6 +86,21 @@ Plan new_factor_plan(const Problem& p, std::string id, std::string cause,
   return plan;
 }
 
+/// One size against a log-normal number distribution about it (seed 001 §3.1 describes its
+/// granules so): the one-size base runs are the limit sigma_g -> 1 of the log-normal with the
+/// radius as its median, just below the factor's low end 1.01 (sigma_g = 1 is no log-normal);
+/// the candidate's runs are at sigma_g_max and the middle.
+Plan size_distribution_plan(const Problem& p) {
+  const double low = kSigmaGLow;
+  if (!(p.options.sigma_g_max > low))
+    throw InputError("diagnose.sigma_g_max", "must be > " + std::to_string(low));
+  return new_factor_plan(
+      p, "size_distribution",
+      "a size distribution: a log-normal number distribution (width sigma_g) instead of one size",
+      {{"sizes", "lognormal"}},
+      {"sizes.sigma_g", doe::Factor{"sizes.sigma_g", low, p.options.sigma_g_max}}, 1.0);
+}
+
 std::vector<Plan> candidate_plans(const Problem& p) {
   std::vector<Plan> plans;
   const auto& o = p.options;
@@ -101,6 +116,8 @@ std::vector<Plan> candidate_plans(const Problem& p) {
         {{"particle_law.rolling", "cdt"}},
         {"particle_law.rolling.mu_r", doe::Factor{"particle_law.rolling.mu_r", 0.0, o.rolling_max}},
         0.0));
+  if (p.size_kind == "monodisperse" && !has_factor(p, "sizes.radius"))
+    plans.push_back(size_distribution_plan(p));
   for (const auto& [path, value] : p.fixed) {
     if (has_factor(p, path) || !(value > 0.0)) continue;
     double lo = value / o.fixed_span, hi = value * o.fixed_span;

@@ -11,6 +11,8 @@
 //   - candidate causes, each tested by simulation with a small augmented design:
 //       shape        rigid rods (shape.aspect_ratio) instead of spheres;
 //       rolling      a rolling-resistance model (CDT, mu_r) where the model has none;
+//       size_distribution  a log-normal size distribution (its width sigma_g) where the
+//                    material has one size;
 //       fixed:<p>    a parameter held fixed, varied over [v / span, v * span];
 //       curvature    non-linearity: axial runs, main effects and squares;
 //       interaction  a two-factor interaction aliased in the design: the fold-over;
@@ -34,6 +36,8 @@
 namespace demcal::diagnose {
 
 inline constexpr double kPending = std::numeric_limits<double>::quiet_NaN();
+/// size_distribution: the narrowest log-normal width it runs (sigma_g = 1 is one size).
+inline constexpr double kSigmaGLow = 1.01;
 
 struct Factor {
   std::string path;  ///< material parameter path
@@ -52,6 +56,7 @@ struct Options {
   std::vector<std::string> candidates;  ///< ids to test; empty = every applicable one
   double aspect_ratio_max = 3.0;        ///< shape: rods from 1 (a sphere) to this
   double rolling_max = 0.3;             ///< rolling: mu_r from 0 (none) to this
+  double sigma_g_max = 1.5;             ///< size_distribution: sigma_g from 1 (one size) to this
   double fixed_span = 2.0;              ///< fixed:<p>: from v / span to v * span
   double margin = 0.3;  ///< a named cause cuts the verified RMS error by at least this fraction
   int starts = 16;
@@ -74,9 +79,10 @@ struct Problem {
   std::vector<std::string> responses;
   Eigen::MatrixXd results;  ///< base design results, rows x responses, NaN = missing
   std::vector<Measurement> measurements;
-  std::string shape_kind = "sphere";    ///< the material's particle shape
-  std::string rolling_model = "none";   ///< its particle-particle rolling model
-  std::map<std::string, double> fixed;  ///< parameters held fixed (path -> value)
+  std::string shape_kind = "sphere";       ///< the material's particle shape
+  std::string rolling_model = "none";      ///< its particle-particle rolling model
+  std::string size_kind = "monodisperse";  ///< its size distribution: monodisperse | other
+  std::map<std::string, double> fixed;     ///< parameters held fixed (path -> value)
   std::map<std::string, std::pair<double, double>> valid;  ///< valid range of each path
   Options options;
 };
@@ -87,7 +93,7 @@ struct RunRequest {
   std::string group;  ///< "baseline", "<candidate>" or "<candidate>/verify"
   int row = 1;
   std::map<std::string, std::string>
-      switches;  ///< "shape" -> "rod", "particle_law.rolling" -> "cdt"
+      switches;  ///< "shape" -> "rod", "particle_law.rolling" -> "cdt", "sizes" -> "lognormal"
   std::map<std::string, double> parameters;
 };
 

@@ -30,6 +30,7 @@ const char* const kA = "particle_law.friction.mu_s";
 const char* const kB = "particle_law.restitution";
 const char* const kC = "wall.friction.mu_s";
 const char* const kMuR = "particle_law.rolling.mu_r";
+const char* const kSigmaG = "sizes.sigma_g";
 const char* const kSf = "packing.solid_fraction";
 const char* const kCn = "packing.coordination_number";
 const char* const kSlope = "shear.yield_slope";
@@ -165,6 +166,18 @@ Responses rolling_truth(const Parameters& p, const Switches& s) {
   const double mu_r = it != s.end() && it->second == "cdt" ? p.at(kMuR) : 0.0;
   const double l = a + 0.5 * b + 0.3 * c;
   return {{kSf, 0.60 - 0.02 * l - 0.25 * mu_r}, {kCn, 5.0 + 0.5 * l - 6.0 * mu_r}};
+}
+
+/// As the rolling truth, but what the base factors cannot reach is a width of sizes: a
+/// log-normal distribution (the switch; one size without it, sigma_g = 1) packs denser with
+/// fewer contacts per particle as it widens.
+constexpr double kTrueSigmaG = 1.3;
+Responses size_truth(const Parameters& p, const Switches& s) {
+  const auto [a, b, c] = coded_point(p);
+  const auto it = s.find("sizes");
+  const double width = it != s.end() && it->second == "lognormal" ? p.at(kSigmaG) - 1.0 : 0.0;
+  const double l = a + 0.5 * b + 0.3 * c;
+  return {{kSf, 0.60 - 0.02 * l + 0.1 * width}, {kCn, 5.0 + 0.5 * l - 3.0 * width}};
 }
 
 std::vector<Measurement> targets_at(const Responses& y, const std::vector<std::string>& which) {
@@ -305,6 +318,34 @@ TEST(Diagnosis, HiddenRollingResistanceIsNamedAndItsMuRRecovered) {
   EXPECT_FALSE(cn->reachable);
 }
 
+TEST(Diagnosis, HiddenSizeDistributionIsNamedAndItsWidthRecovered) {
+  const Simulator sim = size_truth;
+  auto truth_point = natural_point(-0.2, 0.4, -0.1);
+  truth_point[kSigmaG] = kTrueSigmaG;
+  const auto ms = targets_at(sim(truth_point, {{"sizes", "lognormal"}}), {kSf, kCn});
+  const Problem p = make_problem(sim, {kSf, kCn}, ms);
+  const Driven d = drive(p, sim);
+  const Report& r = d.step.report;
+  ASSERT_EQ(r.state, "done");
+  EXPECT_EQ(r.named_cause, "size_distribution") << r.conclusion;
+  const CandidateOutcome* c = candidate(r, "size_distribution");
+  ASSERT_NE(c, nullptr);
+  ASSERT_TRUE(c->proposed.count(kSigmaG));
+  EXPECT_NEAR(c->proposed.at(kSigmaG), kTrueSigmaG, 0.1 * (kTrueSigmaG - 1.0));
+  EXPECT_LT(c->verified_rms, 0.7 * r.baseline_verified_rms);
+}
+
+TEST(Diagnosis, SizeDistributionIsACandidateOnlyForOneSize) {
+  const Simulator sim = linear_truth;
+  const auto ms = targets_at(sim(natural_point(0.3, -0.4, 0.2), {}), {kSf, kCn});
+  Problem p = make_problem(sim, {kSf, kCn}, ms);
+  p.size_kind = "distribution";
+  for (const auto& r : diagnose::advance(p, {}).requests) EXPECT_NE(r.group, "size_distribution");
+  p.size_kind = "monodisperse";
+  p.options.sigma_g_max = 1.0;  // no wider than one size
+  EXPECT_THROW(diagnose::advance(p, {}), InputError);
+}
+
 // --- d) the runs advance() asks for first ---------------------------------------------------
 
 std::vector<RunRequest> of_group(const std::vector<RunRequest>& all, const std::string& group) {
@@ -360,6 +401,13 @@ TEST(Diagnosis, FirstCallRequestsTheBaselineAndEveryCandidatesDesign) {
   EXPECT_NEAR(rolling[0].parameters.at(kMuR), p.options.rolling_max, 1e-12);
   EXPECT_NEAR(rolling[4].parameters.at(kMuR), 0.5 * p.options.rolling_max, 1e-12);
 
+  // size_distribution: the same with one size switched to a log-normal at sigma_g_max.
+  const auto sizes = of_group(s.requests, "size_distribution");
+  ASSERT_EQ(sizes.size(), 5u);
+  EXPECT_EQ(sizes[0].switches, (Switches{{"sizes", "lognormal"}}));
+  EXPECT_NEAR(sizes[0].parameters.at(kSigmaG), p.options.sigma_g_max, 1e-12);
+  EXPECT_NEAR(sizes[4].parameters.at(kSigmaG), 0.5 * (kSigmaGLow + p.options.sigma_g_max), 1e-12);
+
   // interaction: the fold-over, minus each factorial row.
   const auto fold = of_group(s.requests, "interaction");
   ASSERT_EQ(fold.size(), 4u);
@@ -382,7 +430,7 @@ TEST(Diagnosis, FirstCallRequestsTheBaselineAndEveryCandidatesDesign) {
       expect_base_factors_at(axial[std::size_t(2 * f + side)], x[0], x[1], x[2]);
     }
 
-  EXPECT_EQ(s.requests.size(), 1u + 5u + 5u + 6u + 4u);
+  EXPECT_EQ(s.requests.size(), 1u + 5u + 5u + 5u + 6u + 4u);
 }
 
 // --- e) inputs that cannot be diagnosed -----------------------------------------------------

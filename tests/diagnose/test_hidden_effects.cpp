@@ -5,7 +5,10 @@
 //   shape        rigid rods of a random aspect ratio in [1.8, 2.8];
 //   rolling      spheres with CDT rolling resistance mu_r in [0.15, 0.3], outside the factor set;
 //   interaction  spheres inside the factor box, at a corner of (mu_s, A_H) where their
-//                interaction matters, confounded by the design with restitution (C = AB).
+//                interaction matters, confounded by the design with restitution (C = AB);
+//   size_distribution  spheres of a log-normal number distribution of sigma_g in [1.25, 1.45]
+//                about the campaign's one radius (drawn only when asked for: a second
+//                argument names the cause, so the seeds above keep their draws).
 // The shape and rolling truths are measured against one campaign (factors mu_s, wall mu_s,
 // restitution); the interaction needs a factor pair that interacts and that the two metrics
 // tell apart (friction lowers both, cohesion lowers the solid fraction but raises the
@@ -35,6 +38,7 @@ namespace {
 using namespace demcal;
 
 std::uint64_t g_seed = 1;
+std::string g_cause;  ///< a cause asked for by name; empty: drawn from the seed
 
 constexpr double kMargin = 0.3;           ///< the named cause cuts the verified RMS error by 30 %
 constexpr double kAspectTolerance = 0.5;  ///< recovered aspect ratio within +-0.5 of the truth
@@ -43,6 +47,7 @@ constexpr int kParticles = 300;
 struct Truth {
   std::string cause;  ///< the candidate id the diagnosis must name
   double mu_s = 0.3, hamaker = 0.0, restitution = 0.5, mu_r = 0.0, aspect_ratio = 1.0;
+  double sigma_g = 1.0;  ///< 1: one size
   bool rods = false, rolling = false;
 };
 
@@ -60,13 +65,18 @@ double at_corner(Rng& rng, double lo, double hi, bool log_scale) {
                    : 0.5 * (lo + hi) + 0.5 * c * (hi - lo);
 }
 
-Truth draw_truth(std::uint64_t seed) {
+Truth draw_truth(std::uint64_t seed, const std::string& cause) {
   Rng rng(seed);
   Truth t;
   const auto which = rng.below(3);
   t.mu_s = in_box(rng, 0.1, 0.6);
   t.restitution = in_box(rng, 0.2, 0.8);
-  if (which == 0) {
+  if (cause == "size_distribution") {
+    t.cause = cause;
+    t.sigma_g = rng.uniform(1.25, 1.45);
+  } else if (!cause.empty()) {
+    ADD_FAILURE() << "a cause asked for by name is size_distribution, not " << cause;
+  } else if (which == 0) {
     t.cause = "shape";
     t.rods = true;
     t.aspect_ratio = rng.uniform(1.8, 2.8);
@@ -101,7 +111,10 @@ std::string material_yaml(const Truth& t, bool truth) {
   y << "  wall_law:\n    normal: {model: hertz, youngs_modulus: 5.0e6, poisson_ratio: 0.3, "
        "restitution: 0.5}\n"
     << "    tangential: {model: history, mu_s: 0.3}\n"
-    << "  sizes: {monodisperse: {radius: 0.002}}\n  density: 2500\n";
+    << (truth && t.sigma_g > 1.0
+            ? "  sizes: {lognormal: {median_radius: 0.002, sigma_g: " + num(t.sigma_g) + "}}\n"
+            : std::string("  sizes: {monodisperse: {radius: 0.002}}\n"))
+    << "  density: 2500\n";
   if (truth && t.rods) y << "  shape: {kind: rod, aspect_ratio: " << num(t.aspect_ratio) << "}\n";
   return y.str();
 }
@@ -154,7 +167,7 @@ nlohmann::json diagnose(const std::filesystem::path& spec, const std::filesystem
 }
 
 TEST(HiddenEffects, DiagnosisNamesTheHiddenCause) {
-  const Truth truth = draw_truth(g_seed);
+  const Truth truth = draw_truth(g_seed, g_cause);
   const auto dir = std::filesystem::temp_directory_path() /
                    ("demcal-hidden-" + std::to_string(g_seed) + "-" + std::to_string(getpid()));
   std::filesystem::remove_all(dir);
@@ -164,7 +177,8 @@ TEST(HiddenEffects, DiagnosisNamesTheHiddenCause) {
   const auto report = diagnose(dir / "campaign.yaml", dir / "work");
   std::cout << "seed " << g_seed << ": hidden " << truth.cause << " (mu_s " << truth.mu_s
             << ", A_H " << truth.hamaker << ", restitution " << truth.restitution << ", mu_r "
-            << truth.mu_r << ", aspect ratio " << truth.aspect_ratio << ")\n"
+            << truth.mu_r << ", aspect ratio " << truth.aspect_ratio << ", sigma_g "
+            << truth.sigma_g << ")\n"
             << report.dump(2) << "\n";
 
   ASSERT_EQ(report["state"], "done");
@@ -190,5 +204,6 @@ int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   if (const char* s = std::getenv("DEMCAL_HIDDEN_SEED")) g_seed = std::stoull(s);
   if (argc > 1) g_seed = std::stoull(argv[1]);
+  if (argc > 2) g_cause = argv[2];
   return RUN_ALL_TESTS();
 }
