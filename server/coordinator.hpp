@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 
+#include "server/reflection.hpp"
 #include "server/services.hpp"
 #include "server/store.hpp"
 
@@ -21,7 +22,7 @@ struct CoordinatorOptions {
   std::string token;         ///< opens both services (all three empty: no auth, loopback only)
   std::string worker_token;  ///< opens only the WorkerService
   std::string client_token;  ///< opens only the CampaignService
-  bool reflection = false;   ///< serve gRPC server reflection
+  bool reflection = false;   ///< serve gRPC server reflection (behind the client token)
   double lease_seconds = 60.0;
   double heartbeat_seconds = 10.0;
   double reaper_seconds = 1.0;
@@ -57,6 +58,7 @@ class Coordinator {
   std::atomic<bool> stopping_{false};
   std::unique_ptr<CampaignServiceImpl> campaigns_;
   std::unique_ptr<WorkerServiceImpl> workers_;
+  std::unique_ptr<ReflectionService> reflection_;  ///< only with `reflection`
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
   std::mutex mutex_;

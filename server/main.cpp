@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
                  "the token of workers: Lease, Heartbeat, Complete, Fail only");
   app.add_option("--client-token-file", client_token_file,
                  "the token of clients: the campaign service only (submit, cancel, queries)");
-  app.add_flag("--reflection", o.reflection, "serve gRPC server reflection (off by default)");
+  app.add_flag("--reflection", o.reflection, "serve gRPC server reflection (off by default; needs the client token)");
   app.add_option("--lease", o.lease_seconds, "lease duration (s)")->capture_default_str();
   app.add_option("--heartbeat", o.heartbeat_seconds, "heartbeat interval asked of workers (s)")
       ->capture_default_str();
