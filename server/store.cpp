@@ -247,14 +247,53 @@ Store::Store(const std::string& path, StoreLimits limits, std::optional<double> 
     throw std::runtime_error("cannot open " + path + ": " + msg);
   }
   sqlite3_busy_timeout(db_, 10000);
-  exec("PRAGMA journal_mode=WAL");
-  require_wal(path);
-  exec("PRAGMA synchronous=FULL");
-  // Foreign keys are enforced from here on; migrations that rebuild a table run before.
-  migrate();
-  exec("PRAGMA foreign_keys=ON");
-  drop_unfinished_campaigns();
-  restore_leases(opened.value_or(steady_seconds()));
+  try {
+    // Checked before the first write (switching to WAL rewrites the header, migrations and the
+    // clean-up write tables): a damaged file is left exactly as it was found, for recovery.
+    require_intact(path);
+    exec("PRAGMA journal_mode=WAL");
+    require_wal(path);
+    exec("PRAGMA synchronous=FULL");
+    // Foreign keys are enforced from here on; migrations that rebuild a table run before.
+    migrate();
+    exec("PRAGMA foreign_keys=ON");
+    drop_unfinished_campaigns();
+    restore_leases(opened.value_or(steady_seconds()));
+  } catch (...) {
+    // Closing the last connection would otherwise copy the write-ahead log into the file.
+    sqlite3_db_config(db_, SQLITE_DBCONFIG_NO_CKPT_ON_CLOSE, 1, nullptr);
+    sqlite3_close(db_);
+    throw;
+  }
+}
+
+void Store::require_intact(const std::string& path) {
+  // quick_check reads every page and checks the b-trees' structure and the records' formats
+  // (not that indexes match their tables, which integrity_check adds at several times the
+  // cost); it answers one row "ok" or up to 100 rows each naming a problem
+  // (https://www.sqlite.org/pragma.html#pragma_quick_check). A file that is no database at all
+  // fails already at preparing it.
+  sqlite3_stmt* stmt = nullptr;
+  std::vector<std::string> problems;
+  int rc = sqlite3_prepare_v2(db_, "PRAGMA quick_check(10)", -1, &stmt, nullptr);
+  if (rc == SQLITE_OK) {
+    while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) {
+      const auto* row = sqlite3_column_text(stmt, 0);
+      std::string problem = row ? reinterpret_cast<const char*>(row) : "";
+      std::replace(problem.begin(), problem.end(), '\n', ' ');  // one log line
+      problems.push_back(std::move(problem));
+    }
+  }
+  if (rc != SQLITE_DONE) problems.emplace_back(sqlite3_errmsg(db_));
+  sqlite3_finalize(stmt);
+  if (problems.size() == 1 && problems.front() == "ok") return;
+  std::string what;
+  for (const auto& p : problems) what += (what.empty() ? "" : "; ") + p;
+  throw std::runtime_error(
+      "refusing to open " + (path.empty() ? std::string("the temporary database") : path) +
+      ": SQLite's quick_check finds it damaged (" + what +
+      "); the file is left unchanged: restore it from a backup, or try the sqlite3 shell's "
+      ".recover on a copy");
 }
 
 void Store::require_wal(const std::string& path) {

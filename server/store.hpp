@@ -186,6 +186,9 @@ class Store {
   double clock_now() const { return limits_.clock ? limits_.clock() : steady_seconds(); }
   /// Throws unless the file is in WAL mode (checked at opening).
   void require_wal(const std::string& path);
+  /// Throws, naming the file and the damage, unless PRAGMA quick_check finds the file sound
+  /// (checked at opening, before anything is written).
+  void require_intact(const std::string& path);
   std::string journal_mode_unlocked();
   /// Adds `seconds` to every lease deadline (the lock was held that long).
   void extend_deadlines(double seconds);
