@@ -24,9 +24,11 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
         "--worker-token-file and --client-token-file)");
   if (!(options_.grace_seconds >= 0.0 && options_.grace_seconds <= 3600.0))
     throw std::invalid_argument("--grace must lie in [0, 3600] s");
-  store_ = std::make_unique<Store>(
-      options_.db,
-      StoreLimits{options_.lease_seconds, options_.max_attempts, options_.grace_seconds});
+  store_ = std::make_unique<Store>(options_.db, StoreLimits{options_.lease_seconds,
+                                                            options_.max_attempts,
+                                                            options_.grace_seconds,
+                                                            {},
+                                                            options_.fsync_every_commit});
   if (options_.max_starts < 1 || options_.max_starts > 1000)
     throw std::invalid_argument("--max-starts must lie in [1, 1000]");
   if (!(options_.max_watch_interval >= kMinWatchInterval && options_.max_watch_interval <= 3600))

@@ -30,6 +30,9 @@ struct CoordinatorOptions {
   /// after start-up: workers that ran on while the coordinator was down reconnect and report.
   double grace_seconds = 30.0;
   int max_attempts = 3;
+  /// Sync the SQLite file at every commit (power-cut durability; store.hpp), not only at
+  /// checkpoints.
+  bool fsync_every_commit = false;
   int max_starts = 256;              ///< Calibrate `starts`, at most
   double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
   std::string tls_cert, tls_key;
