@@ -30,8 +30,8 @@ double now_seconds();
 
 /// What a Watch tick reads of a campaign, shared by every Watch stream of that campaign for
 /// kMinWatchInterval / 2: fifty clients watching at 0.1 s would otherwise read the store (and
-/// take its lock, counting every job) 500 times a second, a quarter of the coordinator's time in
-/// bench/coordinator.sh. Each stream still sees a read younger than half the shortest interval.
+/// take its lock, counting every job) 500 times a second, which cost a quarter of the throughput
+/// of bench/coordinator.sh. Each stream still sees a read younger than half the shortest interval.
 class WatchReads {
  public:
   struct Read {
