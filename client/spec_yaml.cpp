@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -16,6 +17,53 @@ namespace demcal::cli {
 namespace {
 
 using Json = nlohmann::ordered_json;
+
+/// The length of the well-formed UTF-8 sequence at text[at] (RFC 3629 section 4: no overlong
+/// forms, no surrogates, nothing above U+10FFFF), or 0 when it is not one.
+std::size_t utf8_sequence(const std::string& text, std::size_t at) {
+  const auto byte = [&](std::size_t i) {
+    return i < text.size() ? static_cast<unsigned char>(text[i]) : 0u;
+  };
+  const unsigned b0 = byte(at);
+  const auto tail = [&](std::size_t i, unsigned lo = 0x80, unsigned hi = 0xBF) {
+    return byte(at + i) >= lo && byte(at + i) <= hi;
+  };
+  if (b0 < 0x80) return 1;
+  if (b0 >= 0xC2 && b0 <= 0xDF) return tail(1) ? 2 : 0;
+  if (b0 >= 0xE0 && b0 <= 0xEF) {
+    const unsigned lo = b0 == 0xE0 ? 0xA0 : 0x80, hi = b0 == 0xED ? 0x9F : 0xBF;
+    return tail(1, lo, hi) && tail(2) ? 3 : 0;
+  }
+  if (b0 >= 0xF0 && b0 <= 0xF4) {
+    const unsigned lo = b0 == 0xF0 ? 0x90 : 0x80, hi = b0 == 0xF4 ? 0x8F : 0xBF;
+    return tail(1, lo, hi) && tail(2) && tail(3) ? 4 : 0;
+  }
+  return 0;
+}
+
+/// InputError "name:line: ..." at the first byte of `text` that is not UTF-8. A spec is UTF-8
+/// text (its strings become protobuf strings, which must be UTF-8); yaml-cpp passes other bytes
+/// through, and the JSON writer on the way to protobuf would stop at them with an exception of
+/// its own.
+void require_utf8(const std::string& text, const std::string& name) {
+  int line = 1;
+  std::size_t line_start = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t n = utf8_sequence(text, at);
+    if (n == 0) {
+      char byte[8];
+      std::snprintf(byte, sizeof byte, "0x%02X", static_cast<unsigned char>(text[at]));
+      throw InputError(name + ":" + std::to_string(line), std::string("not UTF-8 text: byte ") +
+                                                              byte + " at column " +
+                                                              std::to_string(at - line_start + 1));
+    }
+    if (text[at] == '\n') {
+      ++line;
+      line_start = at + 1;
+    }
+    at += n;
+  }
+}
 
 struct Place {
   std::string path;  ///< as the user wrote it
@@ -135,6 +183,7 @@ std::string SpecFile::locate(const std::string& message) const {
 }
 
 SpecFile parse_campaign_spec(const std::string& yaml, const std::string& name) {
+  require_utf8(yaml, name);
   YAML::Node root;
   try {
     root = YAML::Load(yaml);

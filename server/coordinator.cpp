@@ -1,27 +1,14 @@
 #include "server/coordinator.hpp"
 
-#include <dlfcn.h>
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
 #include <stdexcept>
 
 #include "server/auth.hpp"
+#include "server/reflection.hpp"
 
 namespace demcal::server {
-
-namespace {
-
-/// Loads gRPC's reflection library, whose static initializer registers the reflection plugin
-/// with every ServerBuilder made afterwards (there is no way to leave out a registered plugin,
-/// so the library is not linked).
-void load_reflection() {
-  if (!dlopen(DEMCAL_GRPC_REFLECTION_LIB, RTLD_NOW | RTLD_GLOBAL))
-    throw std::runtime_error(std::string("--reflection: cannot load ") +
-                             DEMCAL_GRPC_REFLECTION_LIB + ": " + dlerror());
-}
-
-}  // namespace
 
 Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(options)) {
   if (options_.lease_seconds <= 0 || options_.heartbeat_seconds <= 0 ||
@@ -37,9 +24,11 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
         "--worker-token-file and --client-token-file)");
   if (!(options_.grace_seconds >= 0.0 && options_.grace_seconds <= 3600.0))
     throw std::invalid_argument("--grace must lie in [0, 3600] s");
-  store_ = std::make_unique<Store>(
-      options_.db,
-      StoreLimits{options_.lease_seconds, options_.max_attempts, options_.grace_seconds});
+  store_ = std::make_unique<Store>(options_.db, StoreLimits{options_.lease_seconds,
+                                                            options_.max_attempts,
+                                                            options_.grace_seconds,
+                                                            {},
+                                                            options_.fsync_every_commit});
   if (options_.max_starts < 1 || options_.max_starts > 1000)
     throw std::invalid_argument("--max-starts must lie in [1, 1000]");
   if (!(options_.max_watch_interval >= kMinWatchInterval && options_.max_watch_interval <= 3600))
@@ -51,8 +40,14 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
   workers_ = std::make_unique<WorkerServiceImpl>(*store_, config);
 
   grpc::EnableDefaultHealthCheckService(true);
-  // Reflection describes every service and message to anyone who can connect: off unless asked.
-  if (options_.reflection) load_reflection();
+  // Reflection describes every service and message: off unless asked, and then behind the
+  // client token (reflection.hpp).
+  if (options_.reflection)
+    reflection_ = std::make_unique<ReflectionService>(
+        tokens,
+        std::vector<std::string>{v1::CampaignService::service_full_name(),
+                                 v1::WorkerService::service_full_name(), "grpc.health.v1.Health",
+                                 grpc::reflection::v1alpha::ServerReflection::service_full_name()});
   grpc::ServerBuilder builder;
   const auto creds =
       server_credentials(options_.listen, options_.tls_cert, options_.tls_key, options_.insecure);
@@ -62,6 +57,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
   builder.AddListeningPort(options_.listen, creds, &port_);
   builder.RegisterService(campaigns_.get());
   builder.RegisterService(workers_.get());
+  if (reflection_) builder.RegisterService(reflection_.get());
   server_ = builder.BuildAndStart();
   if (!server_ || port_ == 0) throw std::runtime_error("cannot listen on " + options_.listen);
   if (auto* health = server_->GetHealthCheckService()) health->SetServingStatus(true);

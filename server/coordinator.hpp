@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 
+#include "server/reflection.hpp"
 #include "server/services.hpp"
 #include "server/store.hpp"
 
@@ -21,7 +22,7 @@ struct CoordinatorOptions {
   std::string token;         ///< opens both services (all three empty: no auth, loopback only)
   std::string worker_token;  ///< opens only the WorkerService
   std::string client_token;  ///< opens only the CampaignService
-  bool reflection = false;   ///< serve gRPC server reflection
+  bool reflection = false;   ///< serve gRPC server reflection (behind the client token)
   double lease_seconds = 60.0;
   double heartbeat_seconds = 10.0;
   double reaper_seconds = 1.0;
@@ -29,6 +30,9 @@ struct CoordinatorOptions {
   /// after start-up: workers that ran on while the coordinator was down reconnect and report.
   double grace_seconds = 30.0;
   int max_attempts = 3;
+  /// Sync the SQLite file at every commit (power-cut durability; store.hpp), not only at
+  /// checkpoints.
+  bool fsync_every_commit = false;
   int max_starts = 256;              ///< Calibrate `starts`, at most
   double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
   std::string tls_cert, tls_key;
@@ -57,6 +61,7 @@ class Coordinator {
   std::atomic<bool> stopping_{false};
   std::unique_ptr<CampaignServiceImpl> campaigns_;
   std::unique_ptr<WorkerServiceImpl> workers_;
+  std::unique_ptr<ReflectionService> reflection_;  ///< only with `reflection`
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
   std::mutex mutex_;

@@ -37,7 +37,8 @@ int main(int argc, char** argv) {
                  "the token of workers: Lease, Heartbeat, Complete, Fail only");
   app.add_option("--client-token-file", client_token_file,
                  "the token of clients: the campaign service only (submit, cancel, queries)");
-  app.add_flag("--reflection", o.reflection, "serve gRPC server reflection (off by default)");
+  app.add_flag("--reflection", o.reflection,
+               "serve gRPC server reflection (off by default; needs the client token)");
   app.add_option("--lease", o.lease_seconds, "lease duration (s)")->capture_default_str();
   app.add_option("--heartbeat", o.heartbeat_seconds, "heartbeat interval asked of workers (s)")
       ->capture_default_str();
@@ -48,6 +49,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-attempts", o.max_attempts, "leases per job before it fails")
       ->capture_default_str();
+  app.add_flag("--fsync-every-commit", o.fsync_every_commit,
+               "sync the SQLite file at every commit: acknowledged results survive a power cut, "
+               "at an fsync per lease and per result (default: survive a crash of the process)");
   app.add_option("--max-starts", o.max_starts, "Calibrate starts a client may ask for, at most")
       ->capture_default_str();
   app.add_option("--max-watch-interval", o.max_watch_interval,

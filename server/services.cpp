@@ -87,6 +87,22 @@ doe::ModelKind model_kind(const std::string& text, const std::string& where) {
 
 }  // namespace
 
+WatchReads::Read WatchReads::read(std::int64_t campaign_id) {
+  // Readers of one campaign wait for the one read under way instead of each reading.
+  std::lock_guard lock(mutex_);
+  const double now = steady_seconds();
+  const auto it = entries_.find(campaign_id);
+  if (it != entries_.end() && now - it->second.at <= kMinWatchInterval / 2) return it->second.read;
+  Read r{store_.campaign(campaign_id), {}};
+  if (!r.row) {  // nothing kept for ids that name no campaign
+    if (it != entries_.end()) entries_.erase(it);
+    return r;
+  }
+  r.counts = store_.counts(campaign_id);
+  entries_[campaign_id] = {r, now};
+  return r;
+}
+
 grpc::Status CampaignServiceImpl::Submit(grpc::ServerContext* ctx, const v1::SubmitRequest* req,
                                          v1::SubmitReply* reply) {
   if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
@@ -158,10 +174,10 @@ grpc::Status CampaignServiceImpl::Watch(grpc::ServerContext* ctx, const v1::Watc
   std::string last;
   double last_sent = 0.0;
   while (!ctx->IsCancelled() && !stopping_) {
-    const auto row = store_.campaign(req->id());
+    const auto [row, counts] = watch_reads_.read(req->id());
     if (!row) return not_found(req->id());
     const double now = now_seconds();
-    const v1::Progress p = progress_message(*row, store_.counts(row->id), now);
+    const v1::Progress p = progress_message(*row, counts, now);
     v1::Progress key = p;
     key.clear_elapsed_seconds();
     key.clear_eta_seconds();

@@ -146,13 +146,32 @@ const std::vector<const char*>& migrations() {
 
 }  // namespace
 
+/// A prepared statement, taken from the store's cache of idle statements (SQLite's parsing and
+/// planning was 14 % of the coordinator's time in bench/coordinator.sh when every call prepared
+/// its statements anew) and given back, reset, when it goes out of scope. A statement whose SQL
+/// is already in use (a nested query) is prepared on its own and finalised after use.
 class Store::Statement {
  public:
-  Statement(sqlite3* db, const char* sql) : db_(db) {
-    if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK)
-      throw std::runtime_error(std::string("sqlite prepare: ") + sqlite3_errmsg(db) + " in " + sql);
+  Statement(Store& store, const std::string& sql) : store_(store), db_(store.db_), sql_(sql) {
+    const auto it = store_.idle_statements_.find(sql_);
+    if (it != store_.idle_statements_.end()) {
+      stmt_ = it->second;
+      store_.idle_statements_.erase(it);
+      return;
+    }
+    if (sqlite3_prepare_v3(db_, sql_.c_str(), -1, SQLITE_PREPARE_PERSISTENT, &stmt_, nullptr) !=
+        SQLITE_OK)
+      throw std::runtime_error(std::string("sqlite prepare: ") + sqlite3_errmsg(db_) + " in " +
+                               sql_);
   }
-  ~Statement() { sqlite3_finalize(stmt_); }
+  ~Statement() {
+    // Reset first: a statement left stepping holds its read transaction open.
+    sqlite3_reset(stmt_);
+    sqlite3_clear_bindings(stmt_);
+    if (!store_.idle_statements_.emplace(sql_, stmt_).second) sqlite3_finalize(stmt_);
+  }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
   Statement& bind(int i, std::int64_t v) {
     sqlite3_bind_int64(stmt_, i, v);
     return *this;
@@ -188,7 +207,9 @@ class Store::Statement {
   }
 
  private:
+  Store& store_;
   sqlite3* db_;
+  std::string sql_;
   sqlite3_stmt* stmt_ = nullptr;
 };
 
@@ -254,14 +275,60 @@ Store::Store(const std::string& path, StoreLimits limits, std::optional<double> 
     throw std::runtime_error("cannot open " + path + ": " + msg);
   }
   sqlite3_busy_timeout(db_, 10000);
-  exec("PRAGMA journal_mode=WAL");
-  require_wal(path);
-  exec("PRAGMA synchronous=FULL");
-  // Foreign keys are enforced from here on; migrations that rebuild a table run before.
-  migrate();
-  exec("PRAGMA foreign_keys=ON");
-  drop_unfinished_campaigns();
-  restore_leases(opened.value_or(steady_seconds()));
+  try {
+    // Checked before the first write (switching to WAL rewrites the header, migrations and the
+    // clean-up write tables): a damaged file is left exactly as it was found, for recovery.
+    require_intact(path);
+    exec("PRAGMA journal_mode=WAL");
+    require_wal(path);
+    exec(limits_.fsync_every_commit ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL");
+    // Foreign keys are enforced from here on; migrations that rebuild a table run before.
+    migrate();
+    exec("PRAGMA foreign_keys=ON");
+    drop_unfinished_campaigns();
+    restore_leases(opened.value_or(steady_seconds()));
+  } catch (...) {
+    // Closing the last connection would otherwise copy the write-ahead log into the file.
+    sqlite3_db_config(db_, SQLITE_DBCONFIG_NO_CKPT_ON_CLOSE, 1, nullptr);
+    close();
+    throw;
+  }
+}
+
+void Store::close() {
+  // sqlite3_close refuses (SQLITE_BUSY) while a prepared statement is left.
+  for (auto& [sql, stmt] : idle_statements_) sqlite3_finalize(stmt);
+  idle_statements_.clear();
+  sqlite3_close(db_);
+}
+
+void Store::require_intact(const std::string& path) {
+  // quick_check reads every page and checks the b-trees' structure and the records' formats
+  // (not that indexes match their tables, which integrity_check adds at several times the
+  // cost); it answers one row "ok" or up to 100 rows each naming a problem
+  // (https://www.sqlite.org/pragma.html#pragma_quick_check). A file that is no database at all
+  // fails already at preparing it.
+  sqlite3_stmt* stmt = nullptr;
+  std::vector<std::string> problems;
+  int rc = sqlite3_prepare_v2(db_, "PRAGMA quick_check(10)", -1, &stmt, nullptr);
+  if (rc == SQLITE_OK) {
+    while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) {
+      const auto* row = sqlite3_column_text(stmt, 0);
+      std::string problem = row ? reinterpret_cast<const char*>(row) : "";
+      std::replace(problem.begin(), problem.end(), '\n', ' ');  // one log line
+      problems.push_back(std::move(problem));
+    }
+  }
+  if (rc != SQLITE_DONE) problems.emplace_back(sqlite3_errmsg(db_));
+  sqlite3_finalize(stmt);
+  if (problems.size() == 1 && problems.front() == "ok") return;
+  std::string what;
+  for (const auto& p : problems) what += (what.empty() ? "" : "; ") + p;
+  throw std::runtime_error(
+      "refusing to open " + (path.empty() ? std::string("the temporary database") : path) +
+      ": SQLite's quick_check finds it damaged (" + what +
+      "); the file is left unchanged: restore it from a backup, or try the sqlite3 shell's "
+      ".recover on a copy");
 }
 
 void Store::require_wal(const std::string& path) {
@@ -277,7 +344,7 @@ void Store::require_wal(const std::string& path) {
 void Store::restore_leases(double opened) {
   // The deadlines of the previous run are gone with its clock: a worker still running a job
   // leased before a restart has a whole lease from the opening to report or heartbeat again.
-  Statement s(db_, "SELECT id FROM jobs WHERE state = 'leased'");
+  Statement s(*this, "SELECT id FROM jobs WHERE state = 'leased'");
   const double deadline = opened + std::max(limits_.lease_seconds, limits_.restart_grace_seconds);
   while (s.step()) deadlines_[s.i64(0)] = deadline;
 }
@@ -290,7 +357,7 @@ std::optional<double> Store::lease_deadline(std::int64_t job_id) {
 }
 
 Store::~Store() {
-  sqlite3_close(db_);
+  close();
 }
 
 void Store::exec(const char* sql) {
@@ -308,7 +375,7 @@ int Store::latest_schema_version() {
 
 int Store::schema_version() {
   Guard lock(*this);
-  Statement s(db_, "PRAGMA user_version");
+  Statement s(*this, "PRAGMA user_version");
   s.step();
   return s.i32(0);
 }
@@ -319,7 +386,7 @@ std::string Store::journal_mode() {
 }
 
 std::string Store::journal_mode_unlocked() {
-  Statement s(db_, "PRAGMA journal_mode");
+  Statement s(*this, "PRAGMA journal_mode");
   s.step();
   return s.text(0);
 }
@@ -336,7 +403,7 @@ void Store::migrate() {
     exec(migrations()[std::size_t(i)]);
     exec(("PRAGMA user_version=" + std::to_string(i + 1)).c_str());
   }
-  Statement fk(db_, "PRAGMA foreign_key_check");
+  Statement fk(*this, "PRAGMA foreign_key_check");
   if (fk.step()) throw std::runtime_error("schema migration broke a foreign key");
   tx.commit();
 }
@@ -348,7 +415,7 @@ std::int64_t Store::create_campaign(const std::string& name, const std::string& 
   {
     Guard lock(*this);
     Transaction tx(*this);
-    Statement c(db_,
+    Statement c(*this,
                 "INSERT INTO campaigns (name, state, spec_json, design_json, created, ready) "
                 "VALUES (?, 'running', ?, ?, ?, 0)");
     c.bind(1, name).bind(2, spec_json).bind(3, design_json).bind(4, now).step();
@@ -364,7 +431,7 @@ std::int64_t Store::create_campaign(const std::string& name, const std::string& 
   }
   Guard lock(*this);
   Transaction tx(*this);
-  Statement r(db_, "UPDATE campaigns SET ready = 1 WHERE id = ?");
+  Statement r(*this, "UPDATE campaigns SET ready = 1 WHERE id = ?");
   r.bind(1, id).step();
   tx.commit();
   return id;
@@ -374,7 +441,7 @@ std::vector<std::int64_t> Store::insert_job_rows(std::int64_t campaign_id,
                                                  const std::vector<NewJob>& jobs, std::size_t first,
                                                  std::size_t end) {
   std::vector<std::int64_t> ids;
-  Statement s(db_,
+  Statement s(*this,
               "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state) "
               "VALUES (?, ?, ?, ?, ?, ?, 'queued')");
   for (std::size_t i = first; i < end; ++i) {
@@ -404,7 +471,7 @@ constexpr const char* kCampaignColumns =
 
 std::optional<CampaignRow> Store::campaign(std::int64_t id) {
   Guard lock(*this);
-  Statement s(db_, (std::string(kCampaignColumns) + " AND id = ?").c_str());
+  Statement s(*this, (std::string(kCampaignColumns) + " AND id = ?").c_str());
   s.bind(1, id);
   if (!s.step()) return std::nullopt;
   return CampaignRow{s.i64(0), s.text(1), s.text(2), s.text(3), s.text(4), s.f64(5), s.f64(6)};
@@ -412,7 +479,7 @@ std::optional<CampaignRow> Store::campaign(std::int64_t id) {
 
 std::vector<CampaignRow> Store::campaigns() {
   Guard lock(*this);
-  Statement s(db_, (std::string(kCampaignColumns) + " ORDER BY id").c_str());
+  Statement s(*this, (std::string(kCampaignColumns) + " ORDER BY id").c_str());
   std::vector<CampaignRow> out;
   while (s.step())
     out.push_back({s.i64(0), s.text(1), s.text(2), s.text(3), s.text(4), s.f64(5), s.f64(6)});
@@ -421,7 +488,7 @@ std::vector<CampaignRow> Store::campaigns() {
 
 Counts Store::counts(std::int64_t campaign_id, const std::string& kind) {
   Guard lock(*this);
-  Statement s(db_,
+  Statement s(*this,
               "SELECT state, COUNT(*) FROM jobs WHERE campaign_id = ? AND (? = '' OR kind = ?) "
               "GROUP BY state");
   s.bind(1, campaign_id).bind(2, kind).bind(3, kind);
@@ -472,7 +539,7 @@ JobRow read_job(const S& s) {
 
 std::vector<JobRow> Store::jobs(std::int64_t campaign_id) {
   Guard lock(*this);
-  Statement s(db_, (std::string(kJobColumns) + " WHERE j.campaign_id = ? ORDER BY j.id").c_str());
+  Statement s(*this, (std::string(kJobColumns) + " WHERE j.campaign_id = ? ORDER BY j.id").c_str());
   s.bind(1, campaign_id);
   std::vector<JobRow> out;
   while (s.step()) out.push_back(read_job(s));
@@ -492,7 +559,7 @@ std::map<std::int64_t, std::string> Store::series(std::int64_t campaign_id) {
 
 std::optional<JobRow> Store::job(std::int64_t job_id) {
   Guard lock(*this);
-  Statement s(db_, (std::string(kJobColumns) + " WHERE j.id = ?").c_str());
+  Statement s(*this, (std::string(kJobColumns) + " WHERE j.id = ?").c_str());
   s.bind(1, job_id);
   if (!s.step()) return std::nullopt;
   return read_job(s);
@@ -503,12 +570,12 @@ bool Store::cancel(std::int64_t campaign_id, double now) {
   Transaction tx(*this);
   // Only a running campaign is cancelled. A done one stays done: its results are complete, and
   // a later verification or diagnosis reopens it (add_jobs) rather than finding it cancelled.
-  Statement c(db_,
+  Statement c(*this,
               "UPDATE campaigns SET state = 'cancelled', finished = ? WHERE id = ? AND state = "
               "'running'");
   c.bind(1, now).bind(2, campaign_id).step();
   if (sqlite3_changes(db_) == 0) return false;
-  Statement j(db_,
+  Statement j(*this,
               "UPDATE jobs SET state = 'cancelled', finished = ? "
               "WHERE campaign_id = ? AND state IN ('queued', 'leased')");
   j.bind(1, now).bind(2, campaign_id).step();
@@ -520,7 +587,8 @@ std::vector<std::int64_t> Store::insert_jobs(std::int64_t campaign_id,
                                              const std::vector<NewJob>& jobs) {
   auto ids = insert_job_rows(campaign_id, jobs, 0, jobs.size());
   Statement c(
-      db_, "UPDATE campaigns SET state = 'running', finished = 0 WHERE id = ? AND state = 'done'");
+      *this,
+      "UPDATE campaigns SET state = 'running', finished = 0 WHERE id = ? AND state = 'done'");
   c.bind(1, campaign_id).step();
   return ids;
 }
@@ -539,7 +607,7 @@ std::vector<std::int64_t> Store::add_calibration_round(std::int64_t campaign_id,
                                                        const std::vector<NewJob>& jobs) {
   Guard lock(*this);
   Transaction tx(*this);
-  Statement s(db_,
+  Statement s(*this,
               "INSERT INTO calibration_rounds (campaign_id, round, stage, proposal_json, created) "
               "VALUES (?, ?, ?, ?, ?)");
   s.bind(1, campaign_id).bind(2, round.round).bind(3, round.stage);
@@ -554,7 +622,7 @@ std::vector<std::int64_t> Store::add_calibration_stage(std::int64_t campaign_id,
                                                        const std::vector<NewJob>& jobs) {
   Guard lock(*this);
   Transaction tx(*this);
-  Statement s(db_,
+  Statement s(*this,
               "INSERT INTO calibration_stages (campaign_id, stage, box_json, created) "
               "VALUES (?, ?, ?, ?)");
   s.bind(1, campaign_id).bind(2, stage.stage).bind(3, stage.box_json).bind(4, stage.created);
@@ -566,7 +634,7 @@ std::vector<std::int64_t> Store::add_calibration_stage(std::int64_t campaign_id,
 
 std::vector<CalibrationRoundRow> Store::calibration_rounds(std::int64_t campaign_id) {
   Guard lock(*this);
-  Statement s(db_,
+  Statement s(*this,
               "SELECT round, stage, proposal_json, created FROM calibration_rounds "
               "WHERE campaign_id = ? ORDER BY round");
   s.bind(1, campaign_id);
@@ -577,7 +645,7 @@ std::vector<CalibrationRoundRow> Store::calibration_rounds(std::int64_t campaign
 
 std::vector<CalibrationStageRow> Store::calibration_stages(std::int64_t campaign_id) {
   Guard lock(*this);
-  Statement s(db_,
+  Statement s(*this,
               "SELECT stage, box_json, created FROM calibration_stages "
               "WHERE campaign_id = ? ORDER BY stage");
   s.bind(1, campaign_id);
@@ -589,17 +657,17 @@ std::vector<CalibrationStageRow> Store::calibration_stages(std::int64_t campaign
 std::optional<JobRow> Store::lease(const std::string& worker, double now) {
   Guard lock(*this);
   Transaction tx(*this);
-  Statement s(db_,
+  Statement s(*this,
               "SELECT j.id FROM jobs j JOIN campaigns c ON c.id = j.campaign_id "
               "WHERE j.state = 'queued' AND c.state = 'running' AND c.ready = 1 "
               "ORDER BY j.campaign_id, j.kind, j.run_order, j.id LIMIT 1");
   if (!s.step()) return std::nullopt;
   const std::int64_t id = s.i64(0);
-  Statement u(db_,
+  Statement u(*this,
               "UPDATE jobs SET state = 'leased', attempt = attempt + 1, counted = counted + 1, "
               "worker = ? WHERE id = ? AND state = 'queued'");
   u.bind(1, worker).bind(2, id).step();
-  Statement r(db_, (std::string(kJobColumns) + " WHERE j.id = ?").c_str());
+  Statement r(*this, (std::string(kJobColumns) + " WHERE j.id = ?").c_str());
   r.bind(1, id);
   r.step();
   JobRow job = read_job(r);
@@ -611,7 +679,7 @@ std::optional<JobRow> Store::lease(const std::string& worker, double now) {
 
 LeaseAnswer Store::check_lease(std::int64_t job_id, int attempt, const std::string& worker,
                                double now) {
-  Statement s(db_, "SELECT worker FROM jobs WHERE id = ? AND attempt = ? AND state = 'leased'");
+  Statement s(*this, "SELECT worker FROM jobs WHERE id = ? AND attempt = ? AND state = 'leased'");
   s.bind(1, job_id).bind(2, attempt);
   if (!s.step()) return LeaseAnswer::kStale;
   const auto it = deadlines_.find(job_id);
@@ -621,7 +689,7 @@ LeaseAnswer Store::check_lease(std::int64_t job_id, int attempt, const std::stri
 
 bool Store::already_stored(std::int64_t job_id, int attempt, const std::string& worker,
                            const std::string& metrics_json, double wall_seconds) {
-  Statement s(db_,
+  Statement s(*this,
               "SELECT 1 FROM results r JOIN jobs j ON j.id = r.job_id WHERE r.job_id = ? AND "
               "r.attempt = ? AND r.worker = ? AND r.metrics_json = ? AND r.wall_seconds = ? AND "
               "j.state = 'done'");
@@ -647,9 +715,9 @@ LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string&
   if (const auto answer = check_lease(job_id, attempt, worker, now); answer != LeaseAnswer::kOk)
     return answer;
   const double stored = server::wall_seconds();
-  Statement u(db_, "UPDATE jobs SET state = 'done', finished = ?, error = '' WHERE id = ?");
+  Statement u(*this, "UPDATE jobs SET state = 'done', finished = ?, error = '' WHERE id = ?");
   u.bind(1, stored).bind(2, job_id).step();
-  Statement r(db_,
+  Statement r(*this,
               "INSERT INTO results (job_id, attempt, worker, metrics_json, wall_seconds, stored, "
               "flags_json, cost_json) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
   r.bind(1, job_id).bind(2, attempt).bind(3, worker).bind(4, metrics_json);
@@ -667,10 +735,10 @@ LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string&
 bool Store::requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason,
                             bool retryable, double now) {
   const bool fail_now = !retryable || counted >= limits_.max_attempts;
-  Statement u(db_, fail_now ? "UPDATE jobs SET state = 'failed', error = ?, finished = ?, "
-                              "lease_deadline = 0 WHERE id = ?"
-                            : "UPDATE jobs SET state = 'queued', error = ?, finished = ?, "
-                              "lease_deadline = 0 WHERE id = ?");
+  Statement u(*this, fail_now ? "UPDATE jobs SET state = 'failed', error = ?, finished = ?, "
+                                "lease_deadline = 0 WHERE id = ?"
+                              : "UPDATE jobs SET state = 'queued', error = ?, finished = ?, "
+                                "lease_deadline = 0 WHERE id = ?");
   u.bind(1, reason).bind(2, fail_now ? now : 0.0).bind(3, job_id).step();
   return fail_now;
 }
@@ -681,12 +749,12 @@ LeaseAnswer Store::fail(std::int64_t job_id, int attempt, const std::string& wor
   Transaction tx(*this);
   if (const auto answer = check_lease(job_id, attempt, worker, now); answer != LeaseAnswer::kOk)
     return answer;
-  Statement s(db_, "SELECT counted FROM jobs WHERE id = ?");
+  Statement s(*this, "SELECT counted FROM jobs WHERE id = ?");
   s.bind(1, job_id).step();
   const int counted = s.i32(0);
   const double at = wall_seconds();
   if (give_back) {
-    Statement u(db_,
+    Statement u(*this,
                 "UPDATE jobs SET state = 'queued', counted = counted - 1, lease_deadline = 0, "
                 "error = ? WHERE id = ?");
     u.bind(1, "given back: " + reason).bind(2, job_id).step();
@@ -709,7 +777,7 @@ int Store::reap(double now) {
   const double at = wall_seconds();
   int reaped = 0;
   for (const auto id : due) {
-    Statement s(db_, "SELECT counted, worker FROM jobs WHERE id = ? AND state = 'leased'");
+    Statement s(*this, "SELECT counted, worker FROM jobs WHERE id = ? AND state = 'leased'");
     s.bind(1, id);
     if (!s.step()) continue;  // completed, failed or cancelled meanwhile
     const int counted = s.i32(0);
@@ -727,7 +795,7 @@ int Store::reap(double now) {
 }
 
 void Store::finish_campaigns(double now) {
-  Statement u(db_,
+  Statement u(*this,
               "UPDATE campaigns SET state = 'done', finished = ? WHERE state = 'running' AND "
               "ready = 1 AND "
               "NOT EXISTS (SELECT 1 FROM jobs j WHERE j.campaign_id = campaigns.id AND "
@@ -737,7 +805,7 @@ void Store::finish_campaigns(double now) {
 
 int Store::result_count(std::int64_t job_id) {
   Guard lock(*this);
-  Statement s(db_, "SELECT COUNT(*) FROM results WHERE job_id = ?");
+  Statement s(*this, "SELECT COUNT(*) FROM results WHERE job_id = ?");
   s.bind(1, job_id);
   s.step();
   return s.i32(0);

@@ -1,6 +1,12 @@
 #pragma once
 // The coordinator's SQLite store: all SQL of demcal lives in this class. WAL journal with
-// synchronous=FULL (a result acknowledged to a worker survives a power cut), versioned schema
+// synchronous=NORMAL by default: a commit reaches the operating system before it is
+// acknowledged, so it survives the coordinator's crash or SIGKILL, but the write-ahead log is
+// synced only at checkpoints, so a power cut or kernel crash can lose the last commits (never
+// corrupt the file: https://www.sqlite.org/pragma.html#pragma_synchronous, "WAL mode is always
+// consistent with synchronous=NORMAL, but WAL mode does lose durability"). With
+// StoreLimits::fsync_every_commit, synchronous=FULL: every commit is synced (an acknowledged
+// result survives a power cut) at an fsync per Lease and per Complete. Versioned schema
 // migrations (PRAGMA user_version), RAII transactions that roll back unless committed, and
 // BEGIN IMMEDIATE for every write so that two writers never deadlock on a lock upgrade.
 //
@@ -93,6 +99,8 @@ struct StoreLimits {
   /// The monotonic clock that measures how long the lock is held (empty: steady_seconds);
   /// tests give a fake one.
   std::function<double()> clock;
+  /// synchronous=FULL instead of NORMAL: every commit survives a power cut (see the top).
+  bool fsync_every_commit = false;
 };
 
 /// Seconds on the monotonic clock the store's lease deadlines are kept on.
@@ -191,6 +199,9 @@ class Store {
   double clock_now() const { return limits_.clock ? limits_.clock() : steady_seconds(); }
   /// Throws unless the file is in WAL mode (checked at opening).
   void require_wal(const std::string& path);
+  /// Throws, naming the file and the damage, unless PRAGMA quick_check finds the file sound
+  /// (checked at opening, before anything is written).
+  void require_intact(const std::string& path);
   std::string journal_mode_unlocked();
   /// Adds `seconds` to every lease deadline (the lock was held that long).
   void extend_deadlines(double seconds);
@@ -207,7 +218,13 @@ class Store {
   bool requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason, bool retryable,
                        double now);
 
+  /// Finalises the cached statements and closes the connection.
+  void close();
+
   sqlite3* db_ = nullptr;
+  /// Prepared statements not in use, by their SQL (Statement takes and gives back); guarded by
+  /// mutex_ like the connection.
+  std::unordered_map<std::string, sqlite3_stmt*> idle_statements_;
   StoreLimits limits_;
   std::mutex mutex_;
   std::unordered_map<std::int64_t, double> deadlines_;  ///< job -> its lease's deadline

@@ -2,6 +2,7 @@
 // a worker SIGKILLed mid-job, workers racing, the coordinator SIGKILLed and restarted, a late
 // Complete from an expired lease, invalid specs, missing or wrong tokens, and the CLI end to
 // end. Leases and heartbeats are short (flags); every wait is bounded.
+#include <google/protobuf/descriptor.pb.h>
 #include <grpcpp/generic/generic_stub.h>
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -19,6 +20,7 @@
 #include "core/common/error.hpp"
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
+#include "grpc/reflection/v1alpha/reflection.grpc.pb.h"
 #include "proto/channel.hpp"
 #include "tests/service/process.hpp"
 
@@ -311,13 +313,63 @@ grpc::Status call_by_name(const proto::ChannelOptions& o, const std::string& met
   return status;
 }
 
-TEST_F(Service, ReflectionIsServedOnlyWhenAskedFor) {
-  const std::string method = "/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo";
+/// One request on a reflection stream, as `o` presents itself: the status of the call and the
+/// response (empty unless the call was admitted).
+std::pair<grpc::Status, grpc::reflection::v1alpha::ServerReflectionResponse> reflect(
+    const proto::ChannelOptions& o, const grpc::reflection::v1alpha::ServerReflectionRequest& r) {
+  auto stub = grpc::reflection::v1alpha::ServerReflection::NewStub(proto::make_channel(o));
+  auto context = proto::make_context(o, 10);
+  auto stream = stub->ServerReflectionInfo(context.get());
+  grpc::reflection::v1alpha::ServerReflectionResponse response;
+  stream->Write(r);
+  stream->WritesDone();
+  while (stream->Read(&response)) {
+  }
+  return {stream->Finish(), response};
+}
+
+TEST_F(Service, ReflectionIsServedOnlyWhenAskedForAndOnlyToTheClientToken) {
+  grpc::reflection::v1alpha::ServerReflectionRequest list;
+  list.set_list_services("");
   start_server();
-  EXPECT_EQ(call_by_name(channel_, method).error_code(), grpc::StatusCode::UNIMPLEMENTED);
+  EXPECT_EQ(reflect(channel_, list).first.error_code(), grpc::StatusCode::UNIMPLEMENTED);
   server_.reset();
-  start_server(1.5, 0.3, 0, {"--reflection"});
-  EXPECT_NE(call_by_name(channel_, method).error_code(), grpc::StatusCode::UNIMPLEMENTED);
+  std::ofstream(path("worker.token")) << "worker-secret\n";
+  std::ofstream(path("client.token")) << "client-secret\n";
+  start_server(1.5, 0.3, 0,
+               {"--reflection", "--worker-token-file", path("worker.token"), "--client-token-file",
+                path("client.token")});
+  auto as = [&](const std::string& token) {
+    proto::ChannelOptions o = channel_;
+    o.token = token;
+    return o;
+  };
+  EXPECT_EQ(reflect(as(""), list).first.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(reflect(as("wrong"), list).first.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(reflect(as("worker-secret"), list).first.error_code(),
+            grpc::StatusCode::PERMISSION_DENIED);
+  // The health service stays open (an empty request asks about the whole server).
+  EXPECT_TRUE(call_by_name(as(""), "/grpc.health.v1.Health/Check").ok());
+
+  const auto [status, services] = reflect(as("client-secret"), list);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  std::set<std::string> names;
+  for (const auto& s : services.list_services_response().service()) names.insert(s.name());
+  EXPECT_TRUE(names.count("demcal.v1.CampaignService")) << services.DebugString();
+  EXPECT_TRUE(names.count("demcal.v1.WorkerService")) << services.DebugString();
+  // A client such as grpcurl then asks for the file of a service and gets it with its imports.
+  grpc::reflection::v1alpha::ServerReflectionRequest symbol;
+  symbol.set_file_containing_symbol("demcal.v1.CampaignService.Submit");
+  const auto [file_status, files] = reflect(as("client-secret"), symbol);
+  ASSERT_TRUE(file_status.ok()) << file_status.error_message();
+  ASSERT_GE(files.file_descriptor_response().file_descriptor_proto_size(), 1)
+      << files.DebugString();
+  google::protobuf::FileDescriptorProto first;
+  ASSERT_TRUE(first.ParseFromString(files.file_descriptor_response().file_descriptor_proto(0)));
+  EXPECT_EQ(first.name(), "demcal/v1/campaign.proto");
+  symbol.set_file_containing_symbol("demcal.v1.NoSuchThing");
+  EXPECT_EQ(reflect(as("client-secret"), symbol).second.error_response().error_code(),
+            grpc::StatusCode::NOT_FOUND);
 }
 
 TEST_F(Service, AMissingOrEmptyTokenFileStopsServerAndWorkerInsteadOfTurningAuthOff) {

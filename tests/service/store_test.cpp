@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 namespace demcal::server {
 namespace {
@@ -62,6 +64,54 @@ TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
   std::filesystem::remove(path);
   std::filesystem::remove(path.string() + "-wal");
   std::filesystem::remove(path.string() + "-shm");
+}
+
+std::string file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(Store, ADamagedFileIsRefusedNamingTheFileAndTheDamageAndIsLeftUnchanged) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("demcal_store_damaged_" + std::to_string(::getpid()) + ".db");
+  auto remove_all = [&] {
+    for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(path.string() + suffix);
+  };
+  remove_all();
+  {
+    // A real store with enough jobs to fill several pages; closing it copies the write-ahead
+    // log into the file and removes the log.
+    Store s(path.string());
+    s.create_campaign("c", "{}", "{}", jobs(500), 0.0);
+  }
+  ASSERT_FALSE(std::filesystem::exists(path.string() + "-wal"));
+  // The page of the jobs table's root (an interior page: 500 jobs fill several leaves).
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  sqlite3_stmt* stmt = nullptr;
+  sqlite3_prepare_v2(db, "SELECT rootpage FROM sqlite_schema WHERE name = 'jobs'", -1, &stmt,
+                     nullptr);
+  ASSERT_EQ(sqlite3_step(stmt), SQLITE_ROW);
+  const auto root = static_cast<std::size_t>(sqlite3_column_int(stmt, 0));
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+  std::string bytes = file_bytes(path);
+  constexpr std::size_t kPage = 4096;  // SQLite's default page size
+  ASSERT_GE(bytes.size(), root * kPage);
+  // Garbage over most of that page, as a torn write or a bad sector would leave it.
+  for (std::size_t i = (root - 1) * kPage + 8; i < root * kPage - 64; ++i)
+    bytes[i] = static_cast<char>(0xA5 ^ (i * 131));
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  try {
+    Store s(path.string());
+    FAIL() << "a damaged file was opened";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path.string()), std::string::npos) << what;
+    EXPECT_NE(what.find("quick_check"), std::string::npos) << what;
+  }
+  EXPECT_EQ(file_bytes(path), bytes) << "the damaged file was modified";
+  remove_all();
 }
 
 TEST(Store, LeasesInRunOrderAndStoresAResultExactlyOnce) {

@@ -1,0 +1,53 @@
+// The campaign spec parser of the CLI (client/spec_yaml.cpp) on text that is not UTF-8: an
+// InputError naming the file, line and column, never another exception (found by
+// fuzz_campaign_yaml; the input is kept in tests/fuzz/regressions/campaign_yaml).
+#include "client/spec_yaml.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "core/common/error.hpp"
+
+namespace demcal::cli {
+namespace {
+
+/// The message of the InputError parsing `text` throws ("" when it parses or throws another).
+std::string input_error(const std::string& text) {
+  try {
+    parse_campaign_spec(text, "c.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (...) {
+    return "another exception";
+  }
+  return "";
+}
+
+TEST(SpecYaml, TextThatIsNotUtf8IsAnInputErrorNamingLineAndColumn) {
+  std::ifstream in(DEMCAL_SOURCE_DIR "/tests/fuzz/regressions/campaign_yaml/invalid-utf8.yaml",
+                   std::ios::binary);
+  std::stringstream found;
+  found << in.rdbuf();
+  ASSERT_FALSE(found.str().empty());
+  EXPECT_NE(input_error(found.str()).find("c.yaml:1"), std::string::npos)
+      << input_error(found.str());
+  EXPECT_NE(input_error(found.str()).find("not UTF-8 text: byte 0xFF at column 11"),
+            std::string::npos)
+      << input_error(found.str());
+  // Overlong, surrogate, truncated and out-of-range sequences, each on line 2.
+  for (const std::string bad : {"\xC0\x80", "\xED\xA0\x80", "\xE2\x82", "\xF4\x90\x80\x80"}) {
+    const std::string message = input_error("name: a\ndescription: x" + bad + "\n");
+    EXPECT_NE(message.find("c.yaml:2: not UTF-8 text"), std::string::npos) << message;
+  }
+}
+
+TEST(SpecYaml, Utf8BeyondAsciiIsText) {
+  // U+00B5 and U+2013 (two and three bytes) in a name: no UTF-8 complaint.
+  const std::string message = input_error("name: \"\xC2\xB5m \xE2\x80\x93 test\"\n");
+  EXPECT_EQ(message.find("UTF-8"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace demcal::cli
