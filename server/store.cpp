@@ -548,7 +548,7 @@ std::vector<JobRow> Store::jobs(std::int64_t campaign_id) {
 
 std::map<std::int64_t, std::string> Store::series(std::int64_t campaign_id) {
   Guard lock(*this);
-  Statement s(db_,
+  Statement s(*this,
               "SELECT c.job_id, c.series_json FROM result_series c JOIN jobs j ON j.id = c.job_id "
               "WHERE j.campaign_id = ?");
   s.bind(1, campaign_id);
@@ -723,7 +723,7 @@ LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string&
   r.bind(1, job_id).bind(2, attempt).bind(3, worker).bind(4, metrics_json);
   r.bind(5, wall_seconds).bind(6, stored).bind(7, flags_json).bind(8, cost_json).step();
   if (!series_json.empty()) {
-    Statement c(db_, "INSERT INTO result_series (job_id, series_json) VALUES (?, ?)");
+    Statement c(*this, "INSERT INTO result_series (job_id, series_json) VALUES (?, ?)");
     c.bind(1, job_id).bind(2, series_json).step();
   }
   finish_campaigns(stored);
