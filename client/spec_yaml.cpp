@@ -84,6 +84,10 @@ class Converter {
         Json params = Json::object();
         int index = 0;
         for (const auto& kv : n) {
+          if (!kv.first.IsScalar())
+            throw InputError(file_ + ":" + std::to_string(kv.first.Mark().line + 1),
+                             (user_path.empty() ? std::string("the spec") : user_path) +
+                                 ": a key must be a name, not a list, a map or empty");
           const std::string key = kv.first.as<std::string>();
           const std::string child = path.empty() ? key : path + "." + key;
           const std::string user_child = user_path.empty() ? key : user_path + "." + key;

@@ -1,6 +1,6 @@
-// The campaign spec parser of the CLI (client/spec_yaml.cpp) on text that is not UTF-8: an
-// InputError naming the file, line and column, never another exception (found by
-// fuzz_campaign_yaml; the input is kept in tests/fuzz/regressions/campaign_yaml).
+// The campaign spec parser of the CLI (client/spec_yaml.cpp) on text that is not UTF-8 or a key
+// that is not a name: an InputError naming the file and line, never another exception (both
+// found by fuzz_campaign_yaml; the inputs are kept in tests/fuzz/regressions/campaign_yaml).
 #include "client/spec_yaml.hpp"
 
 #include <gtest/gtest.h>
@@ -12,6 +12,14 @@
 
 namespace demcal::cli {
 namespace {
+
+std::string regression(const std::string& name) {
+  std::ifstream in(DEMCAL_SOURCE_DIR "/tests/fuzz/regressions/campaign_yaml/" + name,
+                   std::ios::binary);
+  std::stringstream found;
+  found << in.rdbuf();
+  return found.str();
+}
 
 /// The message of the InputError parsing `text` throws ("" when it parses or throws another).
 std::string input_error(const std::string& text) {
@@ -26,21 +34,30 @@ std::string input_error(const std::string& text) {
 }
 
 TEST(SpecYaml, TextThatIsNotUtf8IsAnInputErrorNamingLineAndColumn) {
-  std::ifstream in(DEMCAL_SOURCE_DIR "/tests/fuzz/regressions/campaign_yaml/invalid-utf8.yaml",
-                   std::ios::binary);
-  std::stringstream found;
-  found << in.rdbuf();
-  ASSERT_FALSE(found.str().empty());
-  EXPECT_NE(input_error(found.str()).find("c.yaml:1"), std::string::npos)
-      << input_error(found.str());
-  EXPECT_NE(input_error(found.str()).find("not UTF-8 text: byte 0xFF at column 11"),
-            std::string::npos)
-      << input_error(found.str());
+  const std::string found = regression("invalid-utf8.yaml");
+  ASSERT_FALSE(found.empty());
+  EXPECT_NE(input_error(found).find("c.yaml:1"), std::string::npos) << input_error(found);
+  EXPECT_NE(input_error(found).find("not UTF-8 text: byte 0xFF at column 11"), std::string::npos)
+      << input_error(found);
   // Overlong, surrogate, truncated and out-of-range sequences, each on line 2.
   for (const std::string bad : {"\xC0\x80", "\xED\xA0\x80", "\xE2\x82", "\xF4\x90\x80\x80"}) {
     const std::string message = input_error("name: a\ndescription: x" + bad + "\n");
     EXPECT_NE(message.find("c.yaml:2: not UTF-8 text"), std::string::npos) << message;
   }
+}
+
+TEST(SpecYaml, AKeyThatIsNotANameIsAnInputErrorNamingItsLine) {
+  // examples/lh100_calibration_campaign.yaml with "?" opening a measurement: a complex key.
+  const std::string found = regression("complex-key.yaml");
+  ASSERT_FALSE(found.empty());
+  const std::string message = input_error(found);
+  EXPECT_NE(message.find("c.yaml:38"), std::string::npos) << message;
+  EXPECT_NE(message.find("a key must be a name"), std::string::npos) << message;
+  const std::string list_key = input_error("name: a\n[1, 2]: b\n");
+  EXPECT_NE(list_key.find("c.yaml:2: the spec: a key must be a name"), std::string::npos)
+      << list_key;
+  const std::string map_key = input_error("material:\n  {x: 1}: 2\n");
+  EXPECT_NE(map_key.find("c.yaml:2: material: a key must be a name"), std::string::npos) << map_key;
 }
 
 TEST(SpecYaml, Utf8BeyondAsciiIsText) {
