@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Coordinator throughput, no physics: lease + complete per second with N in-process fake
-# workers on loopback (real gRPC, real SQLite with synchronous=FULL) while 50 clients hold
+# workers on loopback (real gRPC, real SQLite, synchronous=NORMAL) while 50 clients hold
 # Watch streams on the campaign (1,088 jobs: 4 runs + 64 centre points, 16 replicates).
 #   bench/coordinator.sh [BUILD_DIR] [WORKERS] [WATCHERS]
 set -euo pipefail

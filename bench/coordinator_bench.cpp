@@ -1,7 +1,7 @@
 // Coordinator throughput without physics: an in-process coordinator on loopback (real gRPC,
-// real SQLite file with synchronous=FULL), N fake workers that Lease and Complete jobs as fast
-// as they can with synthetic metrics, and W clients holding Watch streams on the campaign
-// meanwhile. Prints jobs (lease + complete) per second. Run by bench/coordinator.sh.
+// real SQLite file with synchronous=NORMAL, the default), N fake workers that Lease and Complete
+// jobs as fast as they can with synthetic metrics, and W clients holding Watch streams on the
+// campaign meanwhile. Prints jobs (lease + complete) per second. Run by bench/coordinator.sh.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>

@@ -41,21 +41,25 @@ std::size_t utf8_sequence(const std::string& text, std::size_t at) {
   return 0;
 }
 
-/// InputError "name:line: ..." at the first byte of `text` that is not UTF-8. A spec is UTF-8
-/// text (its strings become protobuf strings, which must be UTF-8); yaml-cpp passes other bytes
-/// through, and the JSON writer on the way to protobuf would stop at them with an exception of
-/// its own.
+/// InputError "name:line: ..." at the first byte of `text` that is not UTF-8 or is a control
+/// character YAML does not allow. A spec is UTF-8 text (its strings become protobuf strings,
+/// which must be UTF-8); yaml-cpp passes other bytes through (and reads past a NUL), and the
+/// JSON writer on the way to protobuf would stop at them with an exception of its own.
 void require_utf8(const std::string& text, const std::string& name) {
   int line = 1;
   std::size_t line_start = 0;
   for (std::size_t at = 0; at < text.size();) {
     const std::size_t n = utf8_sequence(text, at);
-    if (n == 0) {
+    const auto c = static_cast<unsigned char>(text[at]);
+    // YAML 1.2 §5.1: a stream is printable: no C0 control but tab, LF and CR, no DEL.
+    const bool control = (c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7F;
+    if (n == 0 || control) {
       char byte[8];
-      std::snprintf(byte, sizeof byte, "0x%02X", static_cast<unsigned char>(text[at]));
-      throw InputError(name + ":" + std::to_string(line), std::string("not UTF-8 text: byte ") +
-                                                              byte + " at column " +
-                                                              std::to_string(at - line_start + 1));
+      std::snprintf(byte, sizeof byte, "0x%02X", c);
+      throw InputError(
+          name + ":" + std::to_string(line),
+          std::string(control ? "a control character, byte " : "not UTF-8 text: byte ") + byte +
+              " at column " + std::to_string(at - line_start + 1));
     }
     if (text[at] == '\n') {
       ++line;

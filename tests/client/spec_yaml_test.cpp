@@ -1,6 +1,7 @@
-// The campaign spec parser of the CLI (client/spec_yaml.cpp) on text that is not UTF-8 or a key
-// that is not a name: an InputError naming the file and line, never another exception (both
-// found by fuzz_campaign_yaml; the inputs are kept in tests/fuzz/regressions/campaign_yaml).
+// The campaign spec parser of the CLI (client/spec_yaml.cpp) on text that is not UTF-8, holds a
+// control character or has a key that is not a name: an InputError naming the file and line,
+// never another exception (each found by fuzz_campaign_yaml; the inputs are kept in
+// tests/fuzz/regressions/campaign_yaml).
 #include "client/spec_yaml.hpp"
 
 #include <gtest/gtest.h>
@@ -58,6 +59,21 @@ TEST(SpecYaml, AKeyThatIsNotANameIsAnInputErrorNamingItsLine) {
       << list_key;
   const std::string map_key = input_error("material:\n  {x: 1}: 2\n");
   EXPECT_NE(map_key.find("c.yaml:2: material: a key must be a name"), std::string::npos) << map_key;
+}
+
+TEST(SpecYaml, AControlCharacterOrALoneSurrogateIsAnInputError) {
+  // examples/lh100_calibration_campaign.yaml with a NUL byte in a key (fuzz_campaign_yaml): not
+  // printable YAML; yaml-cpp read past it.
+  const std::string found = regression("nul-in-key.yaml");
+  ASSERT_FALSE(found.empty());
+  const std::string message = input_error(found);
+  EXPECT_NE(message.find("c.yaml:27: a control character, byte 0x00 at column 8"),
+            std::string::npos)
+      << message;
+  // An escape of a lone surrogate (it would decode to bytes that are not UTF-8): yaml-cpp
+  // refuses it, and the error names the line.
+  const std::string value = input_error("name: a\ndescription: \"x\\uD800\"\n");
+  EXPECT_NE(value.find("c.yaml:2: invalid unicode"), std::string::npos) << value;
 }
 
 TEST(SpecYaml, Utf8BeyondAsciiIsText) {
