@@ -92,7 +92,7 @@ class Converter {
             throw InputError(file_ + ":" + std::to_string(kv.first.Mark().line + 1),
                              (user_path.empty() ? std::string("the spec") : user_path) +
                                  ": a key must be a name, not a list, a map or empty");
-          const std::string key = kv.first.as<std::string>();
+          const std::string key = decoded(kv.first, user_path);
           const std::string child = path.empty() ? key : path + "." + key;
           const std::string user_child = user_path.empty() ? key : user_path + "." + key;
           if (slot && key != "model" && key != "kind" && key != "params") {
@@ -117,7 +117,7 @@ class Converter {
         return j;
       }
       case YAML::NodeType::Scalar: {
-        const std::string s = n.Scalar();
+        const std::string s = decoded(n, user_path);
         if (n.Tag() == "!") return s;  // quoted: a string
         if (s == "true" || s == "false") return s == "true";
         try {
@@ -144,6 +144,22 @@ class Converter {
   }
 
  private:
+  /// A scalar's text as yaml-cpp decodes it, refused with its line when it is not UTF-8: the
+  /// YAML escapes "\_" (U+00A0) and "\N" (U+0085) of a double-quoted string come out of
+  /// yaml-cpp 0.7 as one byte each, not as their UTF-8 encoding.
+  std::string decoded(const YAML::Node& n, const std::string& user_path) const {
+    const std::string& s = n.Scalar();
+    for (std::size_t at = 0; at < s.size();) {
+      const std::size_t len = utf8_sequence(s, at);
+      if (len == 0)
+        throw InputError(file_ + ":" + std::to_string(n.Mark().line + 1),
+                         (user_path.empty() ? std::string("the spec") : user_path) +
+                             ": an escape decodes to text that is not UTF-8 (write \\u00A0 for "
+                             "\\_ and \\u0085 for \\N)");
+      at += len;
+    }
+    return s;
+  }
   static bool is_slot(const std::string& path) {
     static const std::regex re(
         R"((material\.(particle_law|wall_law)|tests\[\d+\]\.wall_law)\.(normal|cohesion|tangential|rolling)|material\.shape)");

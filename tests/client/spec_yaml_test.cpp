@@ -76,6 +76,24 @@ TEST(SpecYaml, AControlCharacterOrALoneSurrogateIsAnInputError) {
   EXPECT_NE(value.find("c.yaml:2: invalid unicode"), std::string::npos) << value;
 }
 
+TEST(SpecYaml, EscapesYamlCppDecodesToSingleBytesAreAnInputError) {
+  // A double-quoted string over several lines with "\_" in it (fuzz_campaign_yaml): yaml-cpp
+  // decodes the escape to the byte 0xA0 instead of U+00A0's two bytes.
+  const std::string found = regression("nbsp-escape.yaml");
+  ASSERT_FALSE(found.empty());
+  const std::string message = input_error(found);
+  EXPECT_NE(message.find("c.yaml:2: factors[0].source: an escape decodes to text that is not"),
+            std::string::npos)
+      << message;
+  for (const std::string escape : {"\\_", "\\N"}) {
+    const std::string value = input_error("name: a\ndescription: \"x" + escape + "\"\n");
+    EXPECT_NE(value.find("c.yaml:2: description: an escape decodes"), std::string::npos) << value;
+  }
+  // The same characters written as \u escapes are text.
+  EXPECT_EQ(input_error("name: a\ndescription: \"x\\u00A0\\u0085\"\n").find("escape"),
+            std::string::npos);
+}
+
 TEST(SpecYaml, Utf8BeyondAsciiIsText) {
   // U+00B5 and U+2013 (two and three bytes) in a name: no UTF-8 complaint.
   const std::string message = input_error("name: \"\xC2\xB5m \xE2\x80\x93 test\"\n");
