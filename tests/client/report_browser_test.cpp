@@ -240,7 +240,8 @@ class ReportBrowser : public ::testing::Test {
     }
     return std::stoll(m[1].str());
   }
-  /// Waits until the campaign is no longer running; its status as JSON.
+  /// Waits until the campaign is no longer running (asking the CLI twice a second); its status
+  /// as JSON.
   static json wait_finished(std::int64_t id, int seconds) {
     json status;
     demcal::test::wait_until(
@@ -248,11 +249,9 @@ class ReportBrowser : public ::testing::Test {
           const Output o = cli("status " + std::to_string(id) + " --format json", false);
           if (o.exit_code != 0) return false;
           status = json::parse(o.out);
-          if (status["state"] != "RUNNING") return true;
-          std::this_thread::sleep_for(std::chrono::milliseconds(500));
-          return false;
+          return status["state"] != "RUNNING";
         },
-        seconds);
+        seconds, 0.5);
     return status;
   }
   static Output cli(const std::string& args, bool merge = true) {

@@ -79,12 +79,12 @@ class Process {
   int status_ = 0;
 };
 
-/// Polls `done` every 20 ms for at most `seconds`.
-inline bool wait_until(const std::function<bool()>& done, double seconds) {
+/// Polls `done` every `poll` seconds (20 ms unless a check is costly) for at most `seconds`.
+inline bool wait_until(const std::function<bool()>& done, double seconds, double poll = 0.02) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (std::chrono::steady_clock::now() < end) {
     if (done()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::this_thread::sleep_for(std::chrono::duration<double>(poll));
   }
   return done();
 }

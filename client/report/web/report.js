@@ -551,17 +551,18 @@
 
   // Seed 000 Fig. 23: the measured yield points, the fitted locus and its Mohr circles per job.
   function yieldLocusPlot(parent, name, jobs) {
-    const points = jobs.flatMap((j) => curvePoints(j, 'yield_points', 'sigma_measured_kpa', 'yield_shear_stress_kpa'));
+    const perJob = jobs.map((j) => curvePoints(j, 'yield_points', 'sigma_measured_kpa', 'yield_shear_stress_kpa'));
+    const points = perJob.flat();
     if (!points.length) return false;
     const loci = [], circles = [];
-    for (const j of jobs) {
+    jobs.forEach((j, k) => {
       const m = j.metrics || {};
-      const top = Math.max(...curvePoints(j, 'yield_points', 'sigma_measured_kpa', 'yield_shear_stress_kpa').map((p) => p.x), m.major_consolidation_stress || 0);
+      const top = Math.max(...perJob[k].map((p) => p.x), m.major_consolidation_stress || 0);
       if (typeof m.yield_locus_slope === 'number' && isFinite(top))
         for (const x of [0, top]) loci.push({ job: jobLabel(j), i: x, x: x, y: m.yield_locus_intercept + m.yield_locus_slope * x });
       const s = (j.series || {}).mohr_circles;
       if (s) for (const r of s.rows) circles.push(...circlePoints(j, String(r[0]), r[1], r[2]));
-    }
+    });
     const axes = { xTitle: 'normal stress (kPa)', yTitle: 'shear stress (kPa)' };
     const layers = [
       { data: { values: points }, mark: { type: 'point', filled: true, size: 50 }, encoding: { x: { field: 'x', type: 'quantitative', title: axes.xTitle }, y: { field: 'y', type: 'quantitative', title: axes.yTitle }, color: { field: 'job', type: 'nominal', legend: { title: null } }, tooltip: [{ field: 'job' }, { field: 'x', format: '.4g' }, { field: 'y', format: '.4g' }] } },
