@@ -95,7 +95,7 @@ class Converter {
           const std::string key = decoded(kv.first, user_path);
           const std::string child = path.empty() ? key : path + "." + key;
           const std::string user_child = user_path.empty() ? key : user_path + "." + key;
-          if (slot && key != "model" && key != "kind" && key != "params") {
+          if (slot && key != "model" && key != "kind" && key != "method" && key != "params") {
             // Parameters sit next to `model` in the YAML; in the proto they are a map.
             const std::string p = path + ".params[" + std::to_string(index++) + "]";
             places[p + ".value"] = {user_child, kv.second.Mark().line + 1};
@@ -162,7 +162,7 @@ class Converter {
   }
   static bool is_slot(const std::string& path) {
     static const std::regex re(
-        R"((material\.(particle_law|wall_law)|tests\[\d+\]\.wall_law)\.(normal|cohesion|tangential|rolling)|material\.shape)");
+        R"((material\.(particle_law|wall_law)|tests\[\d+\]\.wall_law)\.(normal|cohesion|tangential|rolling)|material\.(shape|preparation))");
     return std::regex_match(path, re);
   }
   std::string file_;

@@ -80,6 +80,13 @@ lab::MaterialModel to_material_model(const v1::Material& m, const std::string& w
     model.shape = particles::make_shape_spec(m.shape().kind().empty() ? "sphere" : m.shape().kind(),
                                              params, where + ".shape.params");
   }
+  if (m.has_preparation()) {
+    std::map<std::string, double> params(m.preparation().params().begin(),
+                                         m.preparation().params().end());
+    model.preparation = lab::make_preparation(
+        m.preparation().method().empty() ? "pour" : m.preparation().method(), params,
+        where + ".preparation.params");
+  }
   try {
     model.validate();
   } catch (const InputError& e) {

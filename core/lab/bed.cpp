@@ -173,6 +173,116 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
   return clock.stop(w, "settle", target, rest);
 }
 
+namespace {
+
+/// The particle law with its van der Waals range cut to contact (D_max = 1.01 D_min): the
+/// "cohesion when in contact" of seed 000 §2.7.1 methods 2-4.
+contact::ContactLawSpec contact_only(contact::ContactLawSpec spec) {
+  if (spec.cohesion.model == "van_der_waals") {
+    const double d_min =
+        spec.cohesion.params.count("d_min") ? spec.cohesion.params["d_min"] : 4e-10;
+    spec.cohesion.params["d_max"] = 1.01 * d_min;
+  }
+  return spec;
+}
+
+double mean_diameter(const particles::ParticleStore& p) {
+  double sum = 0.0;
+  for (double r : p.radius) sum += 2.0 * r;
+  return p.size() ? sum / static_cast<double>(p.size()) : 0.0;
+}
+
+/// Methods clusters and random_motion: free motion without cohesion and gravity under a lid at
+/// `lid`, then (clusters) the motion stopped and the full law on, or (random motion) the motion
+/// kept and cohesion in contact, still without gravity; the lid is removed, gravity restored.
+void agitate(sim::World& w, const MaterialModel& material, const sim::HealthLimits& limits,
+             double lid, std::uint64_t seed) {
+  const PreparationSpec& s = material.preparation;
+  auto& p = w.particles;
+  const Vec3 g = w.gravity;
+  const auto full_law = w.pair_law(0, 0);
+  contact::ContactLawSpec plain = material.particle_law;
+  plain.cohesion = {"none", {}};
+  w.set_pair_law(0, 0, simulated_law(material, plain));
+  w.gravity = {};
+  w.walls.push_back(walls::make_wall("lid", walls::Plane{{0, 0, lid}, {0, 0, -1}}, kWallDie));
+  const double d_mean = mean_diameter(p);
+  const double v_a = s.agitation_speed > 0.0 ? s.agitation_speed : std::sqrt(norm(g) * d_mean);
+  const double t_a = s.agitation_time > 0.0 ? s.agitation_time : 3.0 * d_mean / v_a;
+  const double t_c = s.cluster_time > 0.0 ? s.cluster_time : t_a;
+  Rng rng(seed ^ 0xa917a7e);
+  for (auto& v : p.v) v = {v_a * rng.normal(), v_a * rng.normal(), v_a * rng.normal()};
+  run_checked(w, std::lround(t_a / w.dt), limits);
+  if (s.method == PreparationMethod::kClusters) {
+    for (auto& v : p.v) v = {};
+    for (auto& o : p.omega) o = {};
+    w.set_pair_law(0, 0, full_law);
+  } else {
+    w.set_pair_law(0, 0, simulated_law(material, contact_only(material.particle_law)));
+  }
+  run_checked(w, std::lround(t_c / w.dt), limits);
+  w.walls.pop_back();
+  w.gravity = g;
+}
+
+/// Method terminal_velocity: the fall with every particle's speed capped at its Stokes terminal
+/// velocity in air (mu = 1.81e-5 Pa s), or the given cap, from the top `lid` to the floor.
+void fall_at_terminal_velocity(sim::World& w, const MaterialModel& material,
+                               const sim::HealthLimits& limits, double lid) {
+  constexpr double kMuAir = 1.81e-5;
+  auto& p = w.particles;
+  std::vector<double> cap(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double rho = p.mass[i] / (4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3));
+    cap[i] = material.preparation.terminal_velocity > 0.0
+                 ? material.preparation.terminal_velocity
+                 : rho * norm(w.gravity) * 4.0 * p.radius[i] * p.radius[i] / (18.0 * kMuAir);
+  }
+  if (cap.empty()) return;
+  const double fall = std::max(lid / *std::min_element(cap.begin(), cap.end()), 0.0);
+  run_checked(w, std::lround(std::min(fall, 20.0) / w.dt), limits, [&](sim::World& world) {
+    for (std::size_t i = 0; i < world.particles.size(); ++i) {
+      const double v = norm(world.particles.v[i]);
+      if (v > cap[i]) world.particles.v[i] *= cap[i] / v;
+    }
+    return true;
+  });
+}
+
+}  // namespace
+
+void require_pour(const MaterialModel& material, const std::string& test) {
+  if (material.preparation.method != PreparationMethod::kPour)
+    throw InputError("material.preparation.method",
+                     "the " + test + " test builds its bed by pouring only: use 'pour' or leave "
+                     "preparation out");
+}
+
+PreparedBed prepare_and_settle(sim::World& w, const MaterialModel& material, const BedSpec& spec,
+                               const sim::HealthLimits& limits, double lid, std::uint64_t seed) {
+  const auto full_law = w.pair_law(0, 0);
+  const PhaseClock clock(w);
+  switch (material.preparation.method) {
+    case PreparationMethod::kClusters:
+    case PreparationMethod::kRandomMotion:
+      agitate(w, material, limits, lid, seed);
+      break;
+    case PreparationMethod::kTerminalVelocity:
+      w.set_pair_law(0, 0, simulated_law(material, contact_only(material.particle_law)));
+      fall_at_terminal_velocity(w, material, limits, lid);
+      break;
+    case PreparationMethod::kPour:
+      w.set_pair_law(0, 0, simulated_law(material, contact_only(material.particle_law)));
+      break;
+  }
+  PreparedBed out;
+  out.prepared = clock.stop(
+      w, "prepare " + preparation_method_name(material.preparation.method), "its fixed time", true);
+  out.settled = settle(w, spec, limits);
+  w.set_pair_law(0, 0, full_law);
+  return out;
+}
+
 }  // namespace demcal::lab
 
 namespace demcal::lab {
@@ -362,7 +472,8 @@ namespace demcal::lab {
 void add_bed_phases(LabOutput& out, const PistonBed& bed,
                     const std::vector<std::string>& depending) {
   out.add_phase(bed.filled, {});
-  out.add_phase(bed.settled, depending);
+  if (bed.built.prepared.steps > 0) out.add_phase(bed.built.prepared, {});
+  out.add_phase(bed.built.settled, depending);
 }
 
 void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string& name,
@@ -392,7 +503,7 @@ PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, 
   b.limits = die_limits(w, b.radius, top);
   b.piston = add_piston(w, 1e3 * top + 1.0);
   w.dt = sim::adapted_time_step(w, safety);
-  b.settled = settle(w, spec, b.limits);
+  b.built = prepare_and_settle(w, material, spec, b.limits, top, options.seed);
   b.h0 = metrics_top(w);
   auto& disk = std::get<walls::Disk>(w.walls[b.piston].shape);
   disk.centre.z = b.h0;

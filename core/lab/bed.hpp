@@ -74,6 +74,24 @@ double metrics_top(const sim::World& world);
 /// health every few hundred steps. Returns the phase "settle" with whether it came to rest.
 PhaseCost settle(sim::World& world, const BedSpec& spec, const sim::HealthLimits& limits);
 
+/// Refuses a preparation other than pouring for a test that builds its bed only so, naming the
+/// field: material.preparation.method.
+void require_pour(const MaterialModel& material, const std::string& test);
+
+/// The phases that built a bed from its inserted particles.
+struct PreparedBed {
+  PhaseCost prepared;  ///< "prepare <method>": no steps for pouring
+  PhaseCost settled;
+};
+/// Builds the bed by the material's preparation method (material.preparation, seed 000 §2.7.1)
+/// from the particles inserted below `lid` (the top of the insertion region, where the lid of
+/// the methods with free motion sits), settles it under the law the method settles with (the
+/// full van der Waals law after clusters, cohesion only in contact otherwise), and gives the
+/// particles back the material's full law.
+PreparedBed prepare_and_settle(sim::World& world, const MaterialModel& material,
+                               const BedSpec& spec, const sim::HealthLimits& limits, double lid,
+                               std::uint64_t seed);
+
 /// Steps `steps` steps with a health check every `check_every`, calling `each` (if given) after
 /// every step; stops early when `each` returns false. Returns the steps done.
 long run_checked(sim::World& world, long steps, const sim::HealthLimits& limits,
@@ -159,7 +177,8 @@ struct PistonBed {
   double radius = 0.0, area = 0.0;
   double h0 = 0.0;  ///< settled bed height = initial piston position (m)
   sim::HealthLimits limits;
-  PhaseCost filled, settled;  ///< the phases that built it
+  PhaseCost filled;  ///< the phases that built it
+  PreparedBed built;
 };
 /// Records the bed's fill and settle phases in `out`; `depending` are the metrics read from the
 /// settled state (its height).

@@ -15,8 +15,8 @@ namespace demcal::lab {
 LabTestInfo packing_info() {
   return {
       "packing",
-      "bed poured into a cylindrical die and settled; solid fraction and coordination number in a "
-      "sampling volume away from the walls",
+      "bed built in a cylindrical die by the material's preparation and settled; solid fraction "
+      "and coordination number in a sampling volume away from the walls",
       "seed 000 §2.7.1, §3.1",
       {{"solid_fraction", "-", "solid volume over sampling volume"},
        {"coordination_number", "-",

@@ -86,10 +86,10 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
   limits.max_kinetic_energy =
       1e3 * w.particles.total_mass() * std::max(norm(w.gravity), 1.0) * (h + bin);
 
-  // 1. Fill and settle with the gate closed.
+  // 1. Fill, prepare (a lid at the top of the fill region) and settle with the gate closed.
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.5;
-  const PhaseCost settled = settle(w, settle_spec, limits);
+  const PreparedBed built = prepare_and_settle(w, material, settle_spec, limits, h + bin, options.seed);
 
   // Bulk density of the settled bed: a box in the middle of the wedge, two diameters from the
   // walls (at its height the wedge is wider than the box).
@@ -102,7 +102,8 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
 
   LabOutput out;
   out.add_phase(filled, {});
-  out.add_phase(settled, {"bulk_density", "beverloo_ratio"});
+  if (built.prepared.steps > 0) out.add_phase(built.prepared, {});
+  out.add_phase(built.settled, {"bulk_density", "beverloo_ratio"});
   if (!options.snapshot_dir.empty()) {
     io::write_particles_vtk(options.snapshot_dir + "/hopper_settled_particles.vtk", w);
     io::write_walls_vtk(options.snapshot_dir + "/hopper_walls.vtk", w, top);

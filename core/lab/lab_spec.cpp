@@ -4,9 +4,29 @@
 #include "core/io/scene_yaml.hpp"
 
 namespace demcal::lab {
+namespace {
+
+/// A block of a kind and its parameters (`shape: {kind: rod, aspect_ratio: 2}`, `preparation:
+/// {method: clusters, cluster_time: 0.02}`) built by `make(kind, params, name)`; an error of
+/// `make` is reported at the line of the key it names.
+template <class Make>
+auto read_kind_block(const io::YamlNode& s, const std::string& kind_key, const std::string& name,
+                     Make make) {
+  std::map<std::string, double> params;
+  for (const auto& key : s.keys())
+    if (key != kind_key) params[key] = s[key].as_number();
+  try {
+    return make(s[kind_key].as_string(), params, name);
+  } catch (const InputError& e) {
+    s[e.where().substr(name.size() + 1)].fail(e.message());
+  }
+}
+
+}  // namespace
 
 MaterialModel read_material(const io::YamlNode& n) {
-  n.expect_only({"particle_law", "wall_law", "sizes", "size_scale", "density", "scaling", "shape"});
+  n.expect_only({"particle_law", "wall_law", "sizes", "size_scale", "density", "scaling", "shape",
+                 "preparation"});
   MaterialModel m;
   m.particle_law = io::read_contact_law_spec(n["particle_law"]);
   m.wall_law = n.has("wall_law") ? io::read_contact_law_spec(n["wall_law"]) : m.particle_law;
@@ -18,17 +38,10 @@ MaterialModel read_material(const io::YamlNode& n) {
     m.scaling = contact::scaling_law_from_name((*s)["law"].as_string(), s->where() + ".law");
     m.scale_factor = s->number("factor", 1.0);
   }
-  if (auto s = n.child("shape")) {
-    std::map<std::string, double> params;
-    for (const auto& key : s->keys())
-      if (key != "kind") params[key] = (*s)[key].as_number();
-    try {
-      m.shape = particles::make_shape_spec((*s)["kind"].as_string(), params, "shape");
-    } catch (const InputError& e) {
-      const std::string key = e.where().substr(std::string("shape.").size());
-      (*s)[key].fail(e.message());
-    }
-  }
+  if (auto s = n.child("shape"))
+    m.shape = read_kind_block(*s, "kind", "shape", particles::make_shape_spec);
+  if (auto s = n.child("preparation"))
+    m.preparation = read_kind_block(*s, "method", "preparation", make_preparation);
   try {
     m.validate();
   } catch (const InputError& e) {

@@ -1,5 +1,6 @@
 #include "core/lab/material.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/common/error.hpp"
@@ -74,6 +75,16 @@ double* shape_field(particles::ShapeSpec& shape, const std::string& path) {
   return nullptr;
 }
 
+double* preparation_field(PreparationSpec& prep, const std::string& path) {
+  if (path.rfind("preparation.", 0) != 0) return nullptr;
+  const auto own = preparation_params(prep.method);
+  const std::string name = path.substr(12);
+  if (std::find(own.begin(), own.end(), name) == own.end()) return nullptr;
+  for (const auto& info : PreparationSpec::table())
+    if (name == info.name) return &(prep.*info.field);
+  return nullptr;
+}
+
 }  // namespace
 
 contact::ScaleFactors MaterialModel::factors() const {
@@ -133,6 +144,11 @@ std::vector<ParameterInfo> parameters(const MaterialModel& model) {
   for (const auto& info : particles::ShapeSpec::table())
     if (shape_now.count(std::string(info.name)))
       out.push_back({"shape." + std::string(info.name), std::string(info.unit), info.lo, info.hi});
+  const auto own = preparation_params(model.preparation.method);
+  for (const auto& info : PreparationSpec::table())
+    if (std::find(own.begin(), own.end(), std::string(info.name)) != own.end())
+      out.push_back(
+          {"preparation." + std::string(info.name), std::string(info.unit), info.lo, info.hi});
   return out;
 }
 
@@ -151,8 +167,10 @@ void set_parameter(MaterialModel& model, const std::string& path, double value) 
         model.density = value;
       } else if (path == "scaling.factor") {
         model.scale_factor = value;
-      } else if (double* f = shape_field(model.shape, path)) {
-        *f = value;
+      } else if (double* shape = shape_field(model.shape, path)) {
+        *shape = value;
+      } else if (double* prep = preparation_field(model.preparation, path)) {
+        *prep = value;
       } else {
         *size_field(model, path) = value;
       }
@@ -178,6 +196,7 @@ double get_parameter(const MaterialModel& model, const std::string& path) {
   MaterialModel copy = model;
   if (double* f = size_field(copy, path)) return *f;
   if (double* f = shape_field(copy.shape, path)) return *f;
+  if (double* f = preparation_field(copy.preparation, path)) return *f;
   throw InputError(path, "not a parameter of this material model");
 }
 

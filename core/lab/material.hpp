@@ -10,12 +10,14 @@
 //   sizes.radius | sizes.median_radius | sizes.sigma_g | sizes.scale   (scale multiplies every
 //   radius) scaling.factor
 //   shape.<param>                 e.g. shape.aspect_ratio (particles::ShapeSpec, per shape kind)
+//   preparation.<param>           e.g. preparation.cluster_time (PreparationSpec, per method)
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "core/contact/contact_law.hpp"
 #include "core/contact/scaling.hpp"
+#include "core/lab/preparation.hpp"
 #include "core/particles/clump_shape.hpp"
 #include "core/particles/size_distribution.hpp"
 
@@ -33,6 +35,8 @@ struct MaterialModel {
   /// Particle shape: spheres, or rigid multisphere clumps whose volume-equivalent radius
   /// follows `sizes` (so mass and volume do not change with the shape).
   particles::ShapeSpec shape;
+  /// How every lab test builds its bed before settling (seed 000 §2.7.1).
+  PreparationSpec preparation;
 
   /// The simulated laws, radii and density after coarse-graining (seed 000 eq. 24-30 or
   /// seed 001 eq. 15-18).

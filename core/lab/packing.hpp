@@ -1,15 +1,7 @@
 #pragma once
-// packing (seed 000 §2.7.1, §3.1): four ways of building the initial bed, selected by `method`
-// (the seed's numbering):
-//   1 van der Waals cluster formation: random insertion, Gaussian velocities, free motion without
-//     cohesion and gravity (under a lid), motion stopped, van der Waals on without gravity
-//     (clusters form), then settling under gravity;
-//   2 contact promotion by random motion: as 1, but the motion is not stopped and cohesion acts
-//     only between touching particles;
-//   3 limited settling velocity: poured under gravity with every particle's speed capped at its
-//     Stokes terminal velocity in air, cohesion only in contact;
-//   4 plain pouring (default): poured under gravity, cohesion only in contact.
-// "Cohesion only in contact" is the material's van der Waals law with D_max = 1.01 D_min.
+// packing (seed 000 §2.7.1, §3.1): the bed of a cylindrical die built by the material's
+// preparation (material.preparation: the four methods of §2.7.1, preparation.hpp) and settled;
+// its solid fraction and coordination number away from the walls.
 #include <array>
 
 #include "core/lab/lab_test.hpp"
@@ -22,14 +14,9 @@ struct PackingSettings {
   double time_step_safety;
   double
       wall_margin;  ///< sampling volume keeps this many largest diameters from die, floor and top
-  double method;
-  double agitation_speed;    ///< (m/s) standard deviation of each Gaussian velocity component
-  double agitation_time;     ///< (s)
-  double cluster_time;       ///< (s)
-  double terminal_velocity;  ///< (m/s)
   double cut_fraction;       ///< bed cut at this fraction of its height
 
-  static std::array<contact::ParamInfo<PackingSettings>, 9> table() {
+  static std::array<contact::ParamInfo<PackingSettings>, 4> table() {
     using S = PackingSettings;
     return {
         {{"particles", "-", 20, 1e7, 300, "number of particles", &S::particles},
@@ -38,20 +25,6 @@ struct PackingSettings {
          {"wall_margin", "-", 0.0, 10.0, 1.0,
           "distance of the sampling volume from the walls and the top, in largest diameters",
           &S::wall_margin},
-         {"method", "-", 1, 4, 4,
-          "1 van der Waals clusters, 2 random-motion contact promotion, 3 limited settling "
-          "velocity, 4 plain pouring (seed 000 §2.7.1)",
-          &S::method},
-         {"agitation_speed", "m/s", 0.0, 1e3, 0.0,
-          "Gaussian velocity per component (methods 1-2); 0 = sqrt(g d_mean)", &S::agitation_speed},
-         {"agitation_time", "s", 0.0, 1e4, 0.0,
-          "free motion without gravity (methods 1-2); 0 = 3 mean diameters at agitation_speed",
-          &S::agitation_time},
-         {"cluster_time", "s", 0.0, 1e4, 0.0,
-          "cohesion on without gravity (methods 1-2); 0 = agitation_time", &S::cluster_time},
-         {"terminal_velocity", "m/s", 0.0, 1e3, 0.0,
-          "speed cap of method 3; 0 = Stokes rho g d^2 / (18 mu_air) per particle",
-          &S::terminal_velocity},
          {"cut_fraction", "-", 0.1, 1.0, 1.0,
           "particles above this fraction of the settled bed height are removed",
           &S::cut_fraction}}};

@@ -135,6 +135,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
   const auto sizes = material.simulated_sizes();
   const double r_max = particles::max_radius(sizes);
 
+  require_pour(material, "rotating_drum");
   const DrumBed bed = drum_bed(s, sizes, "settings");
   const double radius = bed.radius, depth = bed.length;
   Rng rng(options.seed);

@@ -89,6 +89,7 @@ double shear_stress(const sim::World& w, double radius) {
 
 LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
                          const RunOptions& options) {
+  require_pour(material, "shear_cell");
   const auto s = read_settings<ShearCellSettings>(values, "settings");
   sim::World w = make_material_world(material, options);
   const auto sizes = material.simulated_sizes();
