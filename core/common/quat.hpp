@@ -34,32 +34,12 @@ inline Quat operator*(const Quat& a, const Quat& b) {
 }
 
 /// The rotation by the rotation vector phi (axis phi/|phi|, angle |phi|): the exact exponential
-/// map, so a constant angular velocity omega turns a body by exactly omega dt per step,
-///   q = (cos h, sin h phi / |phi|),  h = |phi| / 2.
-/// The turn of one time step is small: for h < 0.1 the Taylor series of cos h and of
-/// sin h / (2 h) to their h^8 terms are used (the first term left out, h^10 / 10!, is below
-/// 2^-53 there), so the step's turn costs neither a square root nor a sine.
+/// map, so a constant angular velocity omega turns a body by exactly omega dt per step.
 inline Quat rotation_quat(const Vec3& phi) {
-  const double h2 = 0.25 * dot(phi, phi);
-  if (h2 < 0.01) {
-    const double c =
-        1.0 + h2 * (-1.0 / 2.0 + h2 * (1.0 / 24.0 + h2 * (-1.0 / 720.0 + h2 * (1.0 / 40320.0))));
-    const double s =
-        0.5 * (1.0 + h2 * (-1.0 / 6.0 +
-                           h2 * (1.0 / 120.0 + h2 * (-1.0 / 5040.0 + h2 * (1.0 / 362880.0)))));
-    return {c, s * phi.x, s * phi.y, s * phi.z};
-  }
-  const double angle = std::sqrt(4.0 * h2);
+  const double angle = norm(phi);
+  if (angle < 1e-12) return Quat{1.0, 0.5 * phi.x, 0.5 * phi.y, 0.5 * phi.z}.normalized();
   const double s = std::sin(0.5 * angle) / angle;
   return {std::cos(0.5 * angle), s * phi.x, s * phi.y, s * phi.z};
-}
-
-/// A product of unit quaternions brought back to unit length. Its norm differs from 1 by
-/// rounding only (e = |q|^2 - 1 of order 1e-16), so one Newton step for 1/sqrt(1 + e),
-/// 1 - e/2, leaves an error of 3 e^2 / 8: unit to rounding, without a square root or division.
-inline Quat renormalized(const Quat& q) {
-  const double f = 1.5 - 0.5 * (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-  return {q.w * f, q.x * f, q.y * f, q.z * f};
 }
 
 }  // namespace demcal

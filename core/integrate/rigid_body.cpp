@@ -83,8 +83,8 @@ void first_kick(particles::ParticleStore& p, std::size_t b, const Rotation& r0, 
 
 // The drift runs in three passes over the bodies, each ending where the next needs a whole
 // quaternion: the kick and the half turn, the full turn, the new pose. A body's drift is one long
-// chain of dependent products (each turn: a series in |phi|^2, a quaternion product, a
-// renormalisation; quat.hpp); in one loop the processor works on one body at a time, in passes on the next bodies while a
+// chain of dependent square roots, divisions and sines (each turn: |phi|, sin/cos, normalise);
+// in one loop the processor works on one body at a time, in passes on the next bodies while a
 // chain waits. The arithmetic of every body is the same as in one loop.
 
 /// Pass 1 of the drift of body b: the first half kick, the move of the centre of mass, and the
@@ -98,14 +98,14 @@ void kick_and_half_turn(particles::ParticleStore& p, std::size_t b, ClumpFrames&
   c.x[b] += c.v[b] * dt;
   domain.wrap(c.x[b]);
   const Vec3 omega0 = angular_velocity(r0, frames.inv_inertia[b], c.angular_momentum[b]);
-  frames.q_mid[b] = renormalized(rotation_quat(omega0 * half) * c.q[b]);
+  frames.q_mid[b] = (rotation_quat(omega0 * half) * c.q[b]).normalized();
 }
 
 /// Pass 2: the orientation turned by a whole step at the angular velocity of q_mid.
 void full_turn(particles::Clumps& c, std::size_t b, const ClumpFrames& frames, double dt) {
   const Vec3 omega_mid =
       angular_velocity(rotation_of(frames.q_mid[b]), frames.inv_inertia[b], c.angular_momentum[b]);
-  c.q[b] = renormalized(rotation_quat(omega_mid * dt) * c.q[b]);
+  c.q[b] = (rotation_quat(omega_mid * dt) * c.q[b]).normalized();
 }
 
 /// Pass 3: the new rotation (kept in the frames), angular velocity and members.

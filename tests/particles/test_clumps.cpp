@@ -1,15 +1,13 @@
 // Rigid multisphere clumps (seed 004 §2.2.2.1): the mass properties of a union of spheres against
 // closed forms (one sphere, two touching spheres by the parallel-axis theorem, two overlapping
 // spheres less their lens), the rod / helix / cluster templates, the shape.* parameter errors,
-// clump insertion without overlap and the removal of whole clumps; the per-step rotation's
-// series against the closed form of the exponential map.
+// clump insertion without overlap and the removal of whole clumps.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/common/error.hpp"
-#include "core/common/quat.hpp"
 #include "core/particles/clump_shape.hpp"
 #include "core/particles/insertion.hpp"
 
@@ -25,40 +23,6 @@ double lens_volume(double r, double d) {
 
 void expect_rel(double actual, double expected, double rel, const char* what) {
   EXPECT_NEAR(actual, expected, rel * std::abs(expected)) << what;
-}
-
-/// The exponential map in closed form: (cos h, sin h phi / |phi|), h = |phi| / 2.
-Quat closed_form_rotation(const Vec3& phi) {
-  const double angle = norm(phi);
-  const double s = std::sin(0.5 * angle) / angle;
-  return {std::cos(0.5 * angle), s * phi.x, s * phi.y, s * phi.z};
-}
-
-TEST(ParticlesClumps, StepRotationSeriesEqualsTheExponentialMapToRounding) {
-  // Angles of one step (1e-9 rad) up to the series' limit (h = 0.1) and past it.
-  for (double angle : {1e-9, 1e-5, 1e-3, 0.05, 0.1999, 0.2001, 1.0, 3.0}) {
-    const Vec3 axis = Vec3{0.3, -0.5, 0.8} / norm(Vec3{0.3, -0.5, 0.8});
-    const Quat a = rotation_quat(axis * angle), b = closed_form_rotation(axis * angle);
-    EXPECT_NEAR(a.w, b.w, 4e-16) << angle;
-    EXPECT_NEAR(a.x, b.x, 4e-16) << angle;
-    EXPECT_NEAR(a.y, b.y, 4e-16) << angle;
-    EXPECT_NEAR(a.z, b.z, 4e-16) << angle;
-    EXPECT_NEAR(a.w * a.w + dot(a.vec(), a.vec()), 1.0, 4e-16) << angle;
-  }
-  EXPECT_EQ(rotation_quat({}).w, 1.0);
-  EXPECT_EQ(rotation_quat({}).x, 0.0);
-}
-
-TEST(ParticlesClumps, RenormalisationOfAStepProductIsUnitToRounding) {
-  // A million turns of 1e-3 rad about changing axes stay unit length.
-  Quat q{};
-  for (int k = 0; k < 1000000; ++k)
-    q = renormalized(rotation_quat({1e-3 * std::sin(1e-3 * k), 1e-3, -5e-4}) * q);
-  EXPECT_NEAR(q.w * q.w + dot(q.vec(), q.vec()), 1.0, 1e-15);
-  // One step of the Newton iteration from a length 1 + 1e-8 leaves an error of order 1e-16.
-  const Quat off{0.6 * (1.0 + 5e-9), 0.8 * (1.0 + 5e-9), 0.0, 0.0};
-  const Quat r = renormalized(off);
-  EXPECT_NEAR(r.w * r.w + r.x * r.x, 1.0, 1e-15);
 }
 
 TEST(ParticlesClumps, UnionMassPropertiesOfOneSphere) {
