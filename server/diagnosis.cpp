@@ -40,6 +40,10 @@ diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan&
   p.size_kind = m.sizes().has_monodisperse() ? "monodisperse" : "distribution";
   for (const auto& [path, value] : spec.fixed()) p.fixed[path] = value;
   const auto model = proto::to_material_model(m, "spec.material");
+  p.cohesion_model = model.particle_law.cohesion.model;
+  p.preparation = lab::preparation_method_name(model.preparation.method);
+  for (const auto& t : spec.tests()) p.preparable &= !lab::pours_only(t.test());
+  p.agitation_time_max = lab::default_agitation_time(model);
   for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
   const auto& o = spec.diagnose();
   p.options.candidates.assign(o.candidates().begin(), o.candidates().end());
@@ -86,6 +90,9 @@ v1::Material switched(const v1::Material& base, const std::map<std::string, std:
       auto* slot = m.mutable_particle_law()->mutable_rolling();
       slot->set_model(value);
       (*slot->mutable_params())["mu_r"] = 0.0;
+    } else if (what == "preparation") {
+      // Only the method: the run sets its parameter (the agitation time).
+      m.mutable_preparation()->set_method(value);
     } else if (what == "sizes" && value == "lognormal" && m.sizes().has_monodisperse()) {
       // One size becomes the median of a log-normal number distribution; the run sets sigma_g.
       const double radius = m.sizes().monodisperse().radius();

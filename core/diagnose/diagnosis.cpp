@@ -101,6 +101,21 @@ Plan size_distribution_plan(const Problem& p) {
       {"sizes.sigma_g", doe::Factor{"sizes.sigma_g", low, p.options.sigma_g_max}}, 1.0);
 }
 
+/// Poured beds against beds built from clusters (seed 000 §2.7.1 method 1): particles moved
+/// without cohesion and gravity for an agitation time, stopped, the van der Waals law on, then
+/// gravity. The agitation time is the factor: as it goes to 0 the particles fall from where they
+/// were inserted, as when poured, so the poured base runs are its low end; the candidate's runs
+/// are at the longest time and the middle.
+Plan preparation_plan(const Problem& p) {
+  const double hi = p.agitation_time_max, lo = kAgitationLowFraction * hi;
+  return new_factor_plan(
+      p, "preparation",
+      "bed preparation: cohesive clusters formed before gravity acts (seed 000 §2.7.1 method 1) "
+      "instead of poured beds",
+      {{"preparation", "clusters"}},
+      {"preparation.agitation_time", doe::Factor{"preparation.agitation_time", lo, hi}}, lo);
+}
+
 std::vector<Plan> candidate_plans(const Problem& p) {
   std::vector<Plan> plans;
   const auto& o = p.options;
@@ -118,6 +133,9 @@ std::vector<Plan> candidate_plans(const Problem& p) {
         0.0));
   if (p.size_kind == "monodisperse" && !has_factor(p, "sizes.radius"))
     plans.push_back(size_distribution_plan(p));
+  if (p.preparation == "pour" && p.cohesion_model != "none" && p.preparable &&
+      p.agitation_time_max > 0.0)
+    plans.push_back(preparation_plan(p));
   for (const auto& [path, value] : p.fixed) {
     if (has_factor(p, path) || !(value > 0.0)) continue;
     double lo = value / o.fixed_span, hi = value * o.fixed_span;

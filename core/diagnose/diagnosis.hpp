@@ -13,6 +13,8 @@
 //       rolling      a rolling-resistance model (CDT, mu_r) where the model has none;
 //       size_distribution  a log-normal size distribution (its width sigma_g) where the
 //                    material has one size;
+//       preparation  a cohesive bed built from clusters (seed 000 §2.7.1 method 1; its
+//                    agitation time) where the material's beds are poured;
 //       fixed:<p>    a parameter held fixed, varied over [v / span, v * span];
 //       curvature    non-linearity: axial runs, main effects and squares;
 //       interaction  a two-factor interaction aliased in the design: the fold-over;
@@ -38,6 +40,9 @@ namespace demcal::diagnose {
 inline constexpr double kPending = std::numeric_limits<double>::quiet_NaN();
 /// size_distribution: the narrowest log-normal width it runs (sigma_g = 1 is one size).
 inline constexpr double kSigmaGLow = 1.01;
+/// preparation: the shortest agitation it runs, as a fraction of the longest (an agitation
+/// time of 0 is pouring; the preparation reads 0 as "the default").
+inline constexpr double kAgitationLowFraction = 1e-3;
 
 struct Factor {
   std::string path;  ///< material parameter path
@@ -82,6 +87,13 @@ struct Problem {
   std::string shape_kind = "sphere";       ///< the material's particle shape
   std::string rolling_model = "none";      ///< its particle-particle rolling model
   std::string size_kind = "monodisperse";  ///< its size distribution: monodisperse | other
+  std::string cohesion_model = "none";     ///< its particle-particle cohesion model
+  std::string preparation = "pour";        ///< how its beds are built (material.preparation)
+  /// Every lab test of the campaign builds its bed by the material's preparation.
+  bool preparable = true;
+  /// preparation: the longest agitation time it runs (s, simulated): the preparation's own
+  /// default, 3 largest diameters at the speed sqrt(g d).
+  double agitation_time_max = 0.0;
   std::map<std::string, double> fixed;     ///< parameters held fixed (path -> value)
   std::map<std::string, std::pair<double, double>> valid;  ///< valid range of each path
   Options options;
@@ -93,7 +105,8 @@ struct RunRequest {
   std::string group;  ///< "baseline", "<candidate>" or "<candidate>/verify"
   int row = 1;
   std::map<std::string, std::string>
-      switches;  ///< "shape" -> "rod", "particle_law.rolling" -> "cdt", "sizes" -> "lognormal"
+      switches;  ///< "shape" -> "rod", "particle_law.rolling" -> "cdt", "sizes" -> "lognormal",
+                 ///< "preparation" -> "clusters"
   std::map<std::string, double> parameters;
 };
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 
 #include "core/common/rng.hpp"
 #include "core/io/vtk.hpp"
@@ -176,14 +177,23 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
 namespace {
 
 /// The particle law with its van der Waals range cut to contact (D_max = 1.01 D_min): the
-/// "cohesion when in contact" of seed 000 §2.7.1 methods 2-4.
-contact::ContactLawSpec contact_only(contact::ContactLawSpec spec) {
-  if (spec.cohesion.model == "van_der_waals") {
-    const double d_min =
-        spec.cohesion.params.count("d_min") ? spec.cohesion.params["d_min"] : 4e-10;
-    spec.cohesion.params["d_max"] = 1.01 * d_min;
-  }
+/// "cohesion when in contact" of seed 000 §2.7.1 methods 2-4; none when the law already is so
+/// (no van der Waals, or its range no longer).
+std::optional<contact::ContactLawSpec> contact_only(contact::ContactLawSpec spec) {
+  if (spec.cohesion.model != "van_der_waals") return std::nullopt;
+  auto& params = spec.cohesion.params;
+  const double d_min = params.count("d_min") ? params["d_min"] : 4e-10;
+  const double reach = 1.01 * d_min;
+  if (params.count("d_max") && params["d_max"] <= reach) return std::nullopt;
+  params["d_max"] = reach;
   return spec;
+}
+
+/// Cohesion only in contact from now on, for the fall (the contact history of the fill starts
+/// afresh).
+void cohesion_in_contact(sim::World& w, const MaterialModel& material) {
+  if (const auto spec = contact_only(material.particle_law))
+    w.set_pair_law(0, 0, simulated_law(material, *spec));
 }
 
 double mean_diameter(const particles::ParticleStore& p) {
@@ -218,7 +228,8 @@ void agitate(sim::World& w, const MaterialModel& material, const sim::HealthLimi
     for (auto& o : p.omega) o = {};
     w.set_pair_law(0, 0, full_law);
   } else {
-    w.set_pair_law(0, 0, simulated_law(material, contact_only(material.particle_law)));
+    const auto touch = contact_only(material.particle_law);
+    w.set_pair_law(0, 0, touch ? simulated_law(material, *touch) : full_law);
   }
   run_checked(w, std::lround(t_c / w.dt), limits);
   w.walls.pop_back();
@@ -252,7 +263,7 @@ void fall_at_terminal_velocity(sim::World& w, const MaterialModel& material,
 }  // namespace
 
 void require_pour(const MaterialModel& material, const std::string& test) {
-  if (material.preparation.method != PreparationMethod::kPour)
+  if (pours_only(test) && material.preparation.method != PreparationMethod::kPour)
     throw InputError("material.preparation.method",
                      "the " + test + " test builds its bed by pouring only: use 'pour' or leave "
                      "preparation out");
@@ -268,18 +279,21 @@ PreparedBed prepare_and_settle(sim::World& w, const MaterialModel& material, con
       agitate(w, material, limits, lid, seed);
       break;
     case PreparationMethod::kTerminalVelocity:
-      w.set_pair_law(0, 0, simulated_law(material, contact_only(material.particle_law)));
+      cohesion_in_contact(w, material);
       fall_at_terminal_velocity(w, material, limits, lid);
       break;
     case PreparationMethod::kPour:
-      w.set_pair_law(0, 0, simulated_law(material, contact_only(material.particle_law)));
+      cohesion_in_contact(w, material);
       break;
   }
   PreparedBed out;
   out.prepared = clock.stop(
       w, "prepare " + preparation_method_name(material.preparation.method), "its fixed time", true);
   out.settled = settle(w, spec, limits);
-  w.set_pair_law(0, 0, full_law);
+  // The settled bed keeps its contacts' history under the full law.
+  if (material.preparation.method != PreparationMethod::kClusters &&
+      contact_only(material.particle_law))
+    w.change_pair_law(0, 0, full_law);
   return out;
 }
 

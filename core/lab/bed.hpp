@@ -74,8 +74,8 @@ double metrics_top(const sim::World& world);
 /// health every few hundred steps. Returns the phase "settle" with whether it came to rest.
 PhaseCost settle(sim::World& world, const BedSpec& spec, const sim::HealthLimits& limits);
 
-/// Refuses a preparation other than pouring for a test that builds its bed only so, naming the
-/// field: material.preparation.method.
+/// Refuses a preparation other than pouring for a test that builds its bed only so
+/// (pours_only), naming the field: material.preparation.method.
 void require_pour(const MaterialModel& material, const std::string& test);
 
 /// The phases that built a bed from its inserted particles.

@@ -152,6 +152,12 @@ std::vector<ParameterInfo> parameters(const MaterialModel& model) {
   return out;
 }
 
+double default_agitation_time(const MaterialModel& model) {
+  constexpr double kG = 9.81;
+  const double d = 2.0 * particles::max_radius(model.simulated_sizes());
+  return 3.0 * std::sqrt(d / kG);
+}
+
 void set_parameter(MaterialModel& model, const std::string& path, double value) {
   for (const auto& info : parameters(model))
     if (info.path == path) {

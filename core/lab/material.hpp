@@ -59,6 +59,9 @@ struct ParameterInfo {
 /// Every addressable parameter of the model as it stands (its models' tables, plus density,
 /// sizes and scaling), for validating factor paths and bounds.
 std::vector<ParameterInfo> parameters(const MaterialModel& model);
+/// The agitation time of the clusters preparation by default for this material's largest
+/// simulated particles: 3 diameters at sqrt(g d), i.e. 3 sqrt(d / g), g = 9.81 m/s^2 (s).
+double default_agitation_time(const MaterialModel& model);
 /// Sets one parameter by path; throws InputError naming the path if unknown or out of range.
 void set_parameter(MaterialModel& model, const std::string& path, double value);
 double get_parameter(const MaterialModel& model, const std::string& path);

@@ -41,6 +41,10 @@ std::vector<std::string> preparation_params(PreparationMethod method) {
   return {};
 }
 
+bool pours_only(const std::string& test) {
+  return test == "rotating_drum" || test == "shear_cell";
+}
+
 PreparationSpec make_preparation(const std::string& method,
                                  const std::map<std::string, double>& params,
                                  const std::string& where) {

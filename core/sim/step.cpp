@@ -31,13 +31,6 @@ bool kick_drift(World& w) {
   return worst > half_skin * half_skin;
 }
 
-void rebuild_neighbour_list(World& w) {
-  for (auto& x : w.particles.x) w.domain.wrap(x);
-  w.list.build(w.particles.x, w.particles.radius, w.domain,
-               w.interaction_range() + w.effective_skin(), w.active_threads(), w.pair_history,
-               w.pair_stride(), w.clump_bodies());
-}
-
 }  // namespace
 
 void step(World& w) {
@@ -59,7 +52,7 @@ void step(World& w) {
   // 2. First half kick with the forces of the last step, then drift (velocity Verlet).
   // 3. Neighbour list: rebuilt only once some particle moved more than half the skin; the
   //    history of pairs still in range is carried to the new list.
-  if (kick_drift(w)) rebuild_neighbour_list(w);
+  if (kick_drift(w)) w.rebuild_list();
 
   // 4. Forces: gravity, particle-particle and particle-wall contacts (which also give each wall
   //    its force and torque); 5. in the same region, the second half kick with the new forces

@@ -51,6 +51,24 @@ void World::set_wall_law(int wall_material, int particle_material, const contact
   prepared_ = false;
 }
 
+void World::change_pair_law(int a, int b, const contact::ContactLaw& law) {
+  if (!prepared_ || composition(law) != composition(pair_law(a, b))) {
+    set_pair_law(a, b, law);
+    return;
+  }
+  pair_laws_[a * n_materials_ + b] = law;
+  pair_laws_[b * n_materials_ + a] = law;
+  check_time_step(*this);
+  rebuild_list();
+  compute_forces(*this);
+}
+
+void World::rebuild_list() {
+  for (auto& x : particles.x) domain.wrap(x);
+  list.build(particles.x, particles.radius, domain, interaction_range() + skin_, active_threads(),
+             pair_history, pair_stride_, clump_bodies());
+}
+
 const contact::ContactLaw& World::pair_law(int a, int b) const {
   return pair_laws_[a * n_materials_ + b];
 }

@@ -48,6 +48,11 @@ class World {
   /// of models (their parameters differ), and so do all laws of one wall material.
   void set_pair_law(int material_i, int material_j, const contact::ContactLaw& law);
   void set_wall_law(int wall_material, int particle_material, const contact::ContactLaw& law);
+  /// Replaces a particle-particle law during a run. A law of the same composition (other
+  /// parameters, e.g. another cohesion range) keeps the contact history: the neighbour list is
+  /// rebuilt at once for the new reach (pairs still listed keep their history) and the forces
+  /// recomputed for the next kick. Another composition needs fresh history: as set_pair_law.
+  void change_pair_law(int material_i, int material_j, const contact::ContactLaw& law);
   const contact::ContactLaw& pair_law(int material_i, int material_j) const;
   const contact::ContactLaw& wall_law(int wall_material, int particle_material) const;
   int materials() const { return n_materials_; }
@@ -62,6 +67,9 @@ class World {
 
   /// The largest interaction reach beyond contact over all laws (cohesion range), m.
   double interaction_range() const;
+  /// Builds the neighbour list for the current positions (wrapped into periodic boxes), carrying
+  /// the history of the pairs still in reach.
+  void rebuild_list();
 
   // State carried between steps, used by the step function and by metrics.
   neighbour::VerletList list;

@@ -31,6 +31,7 @@ const char* const kB = "particle_law.restitution";
 const char* const kC = "wall.friction.mu_s";
 const char* const kMuR = "particle_law.rolling.mu_r";
 const char* const kSigmaG = "sizes.sigma_g";
+const char* const kAgitation = "preparation.agitation_time";
 const char* const kSf = "packing.solid_fraction";
 const char* const kCn = "packing.coordination_number";
 const char* const kSlope = "shear.yield_slope";
@@ -178,6 +179,19 @@ Responses size_truth(const Parameters& p, const Switches& s) {
   const double width = it != s.end() && it->second == "lognormal" ? p.at(kSigmaG) - 1.0 : 0.0;
   const double l = a + 0.5 * b + 0.3 * c;
   return {{kSf, 0.60 - 0.02 * l + 0.1 * width}, {kCn, 5.0 + 0.5 * l - 3.0 * width}};
+}
+
+/// As the rolling truth, but what the base factors cannot reach is how the bed was built:
+/// cohesive clusters formed during an agitation time before gravity (the switch; poured without
+/// it, the limit of no agitation) leave a looser bed with fewer contacts.
+constexpr double kAgitationMax = 0.04;
+constexpr double kTrueAgitation = 0.025;
+Responses preparation_truth(const Parameters& p, const Switches& s) {
+  const auto [a, b, c] = coded_point(p);
+  const auto it = s.find("preparation");
+  const double t = it != s.end() && it->second == "clusters" ? p.at(kAgitation) : 0.0;
+  const double l = a + 0.5 * b + 0.3 * c;
+  return {{kSf, 0.60 - 0.02 * l - 4.0 * t}, {kCn, 5.0 + 0.5 * l - 30.0 * t}};
 }
 
 std::vector<Measurement> targets_at(const Responses& y, const std::vector<std::string>& which) {
@@ -335,6 +349,59 @@ TEST(Diagnosis, HiddenSizeDistributionIsNamedAndItsWidthRecovered) {
   truth_point[kSigmaG] = kTrueSigmaG;
   expect_hidden_cause_found(size_truth, truth_point, {{"sizes", "lognormal"}}, "size_distribution",
                             kSigmaG, 0.1 * (kTrueSigmaG - 1.0));
+}
+
+/// A problem whose material is cohesive and poured: the preparation candidate applies.
+Problem cohesive_poured(Problem p) {
+  p.cohesion_model = "van_der_waals";
+  p.agitation_time_max = kAgitationMax;
+  return p;
+}
+
+TEST(Diagnosis, HiddenClusterPreparationIsNamedAndItsAgitationRecovered) {
+  auto truth_point = natural_point(0.1, -0.5, 0.3);
+  truth_point[kAgitation] = kTrueAgitation;
+  const auto ms = targets_at(preparation_truth(truth_point, {{"preparation", "clusters"}}),
+                             {kSf, kCn});
+  const Driven d =
+      drive(cohesive_poured(make_problem(preparation_truth, {kSf, kCn}, ms)), preparation_truth);
+  const Report& r = d.step.report;
+  EXPECT_EQ(r.state, "done");
+  EXPECT_EQ(r.named_cause, "preparation") << r.conclusion;
+  const CandidateOutcome* c = candidate(r, "preparation");
+  ASSERT_NE(c, nullptr);
+  ASSERT_TRUE(c->proposed.count(kAgitation));
+  EXPECT_NEAR(c->proposed.at(kAgitation), kTrueAgitation, 0.1 * kTrueAgitation);
+  EXPECT_LT(c->verified_rms, 0.7 * r.baseline_verified_rms);
+}
+
+TEST(Diagnosis, PreparationIsACandidateOnlyForPouredCohesiveBedsOfEveryTest) {
+  const Simulator sim = linear_truth;
+  const auto ms = targets_at(sim(natural_point(0.3, -0.4, 0.2), {}), {kSf, kCn});
+  const Problem base = cohesive_poured(make_problem(sim, {kSf, kCn}, ms));
+  auto groups = [](const Problem& p) {
+    std::vector<RunRequest> out;
+    for (const auto& r : diagnose::advance(p, {}).requests)
+      if (r.group == "preparation") out.push_back(r);
+    return out;
+  };
+  // Poured, cohesive, every test building its bed so: the factorial runs at the longest
+  // agitation and the middle run, all switched to clusters.
+  const auto runs = groups(base);
+  ASSERT_EQ(runs.size(), 5u);
+  for (const auto& r : runs) EXPECT_EQ(r.switches, (Switches{{"preparation", "clusters"}}));
+  EXPECT_NEAR(runs[0].parameters.at(kAgitation), kAgitationMax, 1e-15);
+  EXPECT_NEAR(runs[4].parameters.at(kAgitation),
+              0.5 * (1.0 + kAgitationLowFraction) * kAgitationMax, 1e-15);
+  Problem p = base;
+  p.cohesion_model = "none";  // without cohesion no clusters form
+  EXPECT_TRUE(groups(p).empty());
+  p = base;
+  p.preparation = "clusters";  // already built so
+  EXPECT_TRUE(groups(p).empty());
+  p = base;
+  p.preparable = false;  // a test of the campaign pours only (drum, shear cell)
+  EXPECT_TRUE(groups(p).empty());
 }
 
 TEST(Diagnosis, SizeDistributionIsACandidateOnlyForOneSize) {
