@@ -60,7 +60,6 @@ void World::change_pair_law(int a, int b, const contact::ContactLaw& law) {
   pair_laws_[b * n_materials_ + a] = law;
   check_time_step(*this);
   rebuild_list();
-  compute_forces(*this);
 }
 
 void World::rebuild_list() {

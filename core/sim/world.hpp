@@ -50,8 +50,9 @@ class World {
   void set_wall_law(int wall_material, int particle_material, const contact::ContactLaw& law);
   /// Replaces a particle-particle law during a run. A law of the same composition (other
   /// parameters, e.g. another cohesion range) keeps the contact history: the neighbour list is
-  /// rebuilt at once for the new reach (pairs still listed keep their history) and the forces
-  /// recomputed for the next kick. Another composition needs fresh history: as set_pair_law.
+  /// rebuilt at once for the new reach (pairs still listed keep their history); the new law acts
+  /// from the next force evaluation (the next first half kick uses the forces of the last step,
+  /// as after any step). Another composition needs fresh history: as set_pair_law.
   void change_pair_law(int material_i, int material_j, const contact::ContactLaw& law);
   const contact::ContactLaw& pair_law(int material_i, int material_j) const;
   const contact::ContactLaw& wall_law(int wall_material, int particle_material) const;

@@ -8,7 +8,11 @@
 //                interaction matters, confounded by the design with restitution (C = AB);
 //   size_distribution  spheres of a log-normal number distribution of sigma_g in [1.25, 1.45]
 //                about the campaign's one radius (drawn only when asked for: a second
-//                argument names the cause, so the seeds above keep their draws).
+//                argument names the cause, so the seeds above keep their draws);
+//   preparation  cohesive spheres (A_H 1e-16 J, granular Bond number ~100, in the campaign's
+//                material too) whose bed was built from clusters (seed 000 §2.7.1 method 1)
+//                with an agitation time in [0.03, 0.055] s where the campaign pours (asked for
+//                by name as well).
 // The shape and rolling truths are measured against one campaign (factors mu_s, wall mu_s,
 // restitution); the interaction needs a factor pair that interacts and that the two metrics
 // tell apart (friction lowers both, cohesion lowers the solid fraction but raises the
@@ -47,11 +51,13 @@ constexpr int kParticles = 300;
 struct Truth {
   std::string cause;  ///< the candidate id the diagnosis must name
   double mu_s = 0.3, hamaker = 0.0, restitution = 0.5, mu_r = 0.0, aspect_ratio = 1.0;
-  double sigma_g = 1.0;  ///< 1: one size
+  double sigma_g = 1.0;         ///< 1: one size
+  double agitation_time = 0.0;  ///< 0: poured; > 0: built from clusters (s)
   bool rods = false, rolling = false;
 };
 
 constexpr double kHamakerMax = 3e-17;
+constexpr double kHamakerCohesive = 1e-16;  ///< the preparation case's cohesion, both materials
 
 double in_box(Rng& rng, double lo, double hi) {
   return rng.uniform(lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo));
@@ -74,8 +80,12 @@ Truth draw_truth(std::uint64_t seed, const std::string& cause) {
   if (cause == "size_distribution") {
     t.cause = cause;
     t.sigma_g = rng.uniform(1.25, 1.45);
+  } else if (cause == "preparation") {
+    t.cause = cause;
+    t.hamaker = kHamakerCohesive;
+    t.agitation_time = rng.uniform(0.03, 0.055);
   } else if (!cause.empty()) {
-    ADD_FAILURE() << "a cause asked for by name is size_distribution, not " << cause;
+    ADD_FAILURE() << "a cause asked for by name is size_distribution or preparation, not " << cause;
   } else if (which == 0) {
     t.cause = "shape";
     t.rods = true;
@@ -142,7 +152,10 @@ std::map<std::string, double> measure(const Truth& t, const std::filesystem::pat
 std::string campaign_yaml(const Truth& t, const std::map<std::string, double>& measured) {
   const bool cohesion = t.cause == "interaction";
   std::ostringstream y;
-  y << "name: hidden-" << g_seed << "\n" << material_yaml(Truth{}, false);
+  // The campaign's model knows the cohesion of the preparation case (it is not the cause).
+  Truth model;
+  if (t.cause == "preparation") model.hamaker = t.hamaker;
+  y << "name: hidden-" << g_seed << "\n" << material_yaml(model, false);
   y << "tests:\n  - test: packing\n    settings: {particles: " << kParticles
     << "}\n    seed: 3\n    threads: 1\n";
   y << "factors:\n"
@@ -178,7 +191,7 @@ TEST(HiddenEffects, DiagnosisNamesTheHiddenCause) {
   std::cout << "seed " << g_seed << ": hidden " << truth.cause << " (mu_s " << truth.mu_s
             << ", A_H " << truth.hamaker << ", restitution " << truth.restitution << ", mu_r "
             << truth.mu_r << ", aspect ratio " << truth.aspect_ratio << ", sigma_g "
-            << truth.sigma_g << ")\n"
+            << truth.sigma_g << ", agitation time " << truth.agitation_time << ")\n"
             << report.dump(2) << "\n";
 
   ASSERT_EQ(report["state"], "done");

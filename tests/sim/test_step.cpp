@@ -1,7 +1,10 @@
 // The step pipeline on the simplest motion: free fall under gravity is integrated exactly by
 // velocity Verlet (constant force), whether or not the caller prepared the world first, and a
-// particle added between steps falls exactly too.
+// particle added between steps falls exactly too. A law changed during a run keeps the contact
+// history when only its parameters change, and starts it afresh when its models change.
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "core/sim/step.hpp"
 
@@ -70,6 +73,60 @@ TEST(SimStep, WallAddedBetweenStepsIsPickedUp) {
       0.001 - (w.particles.x[0].z - std::get<walls::Plane>(w.walls[0].shape).point.z);
   EXPECT_GT(overlap, 0.0);
   EXPECT_NEAR(w.walls[0].force.z, -1e3 * overlap, 0.05 * 1e3 * overlap);
+}
+
+}  // namespace
+}  // namespace demcal
+
+namespace demcal {
+namespace {
+
+contact::ContactLaw sliding_law(const std::string& cohesion, double d_max) {
+  contact::ContactLawSpec s;
+  s.normal = {"linear", {{"kn", 1e3}}};
+  s.tangential = {"history", {{"mu_s", 0.5}}};
+  if (cohesion != "none") s.cohesion = {cohesion, {{"hamaker", 1e-19}, {"d_max", d_max}}};
+  return contact::ContactLaw::from_spec(s, "law");
+}
+
+/// Two touching spheres sheared against each other for a few steps: their tangential spring
+/// holds a history.
+sim::World sheared_pair(const contact::ContactLaw& law) {
+  sim::World w;
+  w.gravity = {};
+  w.set_pair_law(0, 0, law);
+  w.particles.add_sphere({0, 0, 0}, 0.001, 2500, 0);
+  w.particles.add_sphere({0.00199, 0, 0}, 0.001, 2500, 0);
+  w.particles.v[1] = {0, 0.01, 0};
+  w.dt = 1e-6;
+  sim::run(w, 50);
+  return w;
+}
+
+double history_norm(const sim::World& w) {
+  double sum = 0.0;
+  for (double h : w.pair_history) sum += h * h;
+  return std::sqrt(sum);
+}
+
+TEST(SimStep, ChangedLawOfTheSameModelsKeepsTheContactHistory) {
+  sim::World w = sheared_pair(sliding_law("van_der_waals", 1e-7));
+  ASSERT_GT(history_norm(w), 0.0);
+  const auto before = w.pair_history;
+  const auto shorter = sliding_law("van_der_waals", 4.04e-10);
+  w.change_pair_law(0, 0, shorter);
+  EXPECT_EQ(w.pair_history, before);
+  EXPECT_DOUBLE_EQ(w.pair_law(0, 0).range(), shorter.range());
+  EXPECT_TRUE(w.prepared());
+}
+
+TEST(SimStep, ChangedLawOfOtherModelsStartsTheContactHistoryAfresh) {
+  sim::World w = sheared_pair(sliding_law("van_der_waals", 1e-7));
+  const double sheared = history_norm(w);  // 50 steps of sliding
+  w.change_pair_law(0, 0, sliding_law("none", 0.0));
+  EXPECT_FALSE(w.prepared());
+  sim::run(w, 1);
+  EXPECT_LT(history_norm(w), 0.1 * sheared);  // one step's worth
 }
 
 }  // namespace
