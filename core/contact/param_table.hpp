@@ -1,12 +1,14 @@
 #pragma once
 // One table per model: the names, units, valid ranges and meaning of its parameters.
 // The same table drives spec parsing, validation of factor paths and bounds, and docs.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/common/error.hpp"
 
@@ -27,6 +29,20 @@ struct ParamInfo {
   std::string_view doc;
   double P::*field;
 };
+
+/// Refuses a key of `values` that is not among `own` (the parameters of the kind chosen, e.g. a
+/// shape or a preparation method), naming `where.<key>`, `kind` and the known ones.
+inline void require_own_params(const std::map<std::string, double>& values,
+                               const std::vector<std::string>& own, const std::string& where,
+                               const std::string& kind) {
+  for (const auto& [name, value] : values) {
+    if (std::find(own.begin(), own.end(), name) != own.end()) continue;
+    std::string known;
+    for (const auto& o : own) known += (known.empty() ? "" : ", ") + o;
+    throw InputError(where + "." + name, "not a parameter of " + kind + " (known: " +
+                                             (known.empty() ? "none" : known) + ")");
+  }
+}
 
 /// Reads `values` into a parameter struct through its table. Every key must be known and every
 /// value inside its range; `where` is the field path used in error messages. The model's

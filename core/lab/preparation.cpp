@@ -1,7 +1,5 @@
 #include "core/lab/preparation.hpp"
 
-#include <algorithm>
-
 #include "core/common/error.hpp"
 
 namespace demcal::lab {
@@ -49,15 +47,8 @@ PreparationSpec make_preparation(const std::string& method,
                                  const std::map<std::string, double>& params,
                                  const std::string& where) {
   const PreparationMethod m = parse_preparation_method(method, where + ".method");
-  const auto own = preparation_params(m);
-  for (const auto& [name, value] : params)
-    if (std::find(own.begin(), own.end(), name) == own.end()) {
-      std::string known;
-      for (const auto& o : own) known += (known.empty() ? "" : ", ") + o;
-      throw InputError(where + "." + name, "not a parameter of preparation '" + method +
-                                               "' (known: " + (known.empty() ? "none" : known) +
-                                               ")");
-    }
+  contact::require_own_params(params, preparation_params(m), where,
+                              "preparation '" + method + "'");
   PreparationSpec s = contact::params_from_map<PreparationSpec>(params, where);
   s.method = m;
   return s;

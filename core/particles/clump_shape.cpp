@@ -48,14 +48,7 @@ std::vector<std::string> shape_params(ShapeKind kind) {
 ShapeSpec make_shape_spec(const std::string& kind, const std::map<std::string, double>& params,
                           const std::string& where) {
   const ShapeKind k = parse_shape_kind(kind, where + ".kind");
-  const auto own = shape_params(k);
-  for (const auto& [name, value] : params)
-    if (std::find(own.begin(), own.end(), name) == own.end()) {
-      std::string known;
-      for (const auto& o : own) known += (known.empty() ? "" : ", ") + o;
-      throw InputError(where + "." + name, "not a parameter of shape '" + kind + "' (known: " +
-                                               (known.empty() ? "none" : known) + ")");
-    }
+  contact::require_own_params(params, shape_params(k), where, "shape '" + kind + "'");
   ShapeSpec s = contact::params_from_map<ShapeSpec>(params, where);
   s.kind = k;
   return s;
