@@ -85,7 +85,7 @@ inline PairOutput evaluate(const N& nm, const C& cm, const T& tm, const R& rm, c
   PairOutput out;
   const double f_coh = cm.force(in);
   if (in.delta <= 0.0) {
-    for (int k = 0; k < H::kSize; ++k) history[k] = 0.0;
+    clear_history<H::kSize>(history);
     out.fn = -f_coh;
     out.force = in.n * f_coh;
     return out;

@@ -50,6 +50,16 @@ inline void rotate_into_plane(Vec3& h, const Vec3& n) {
   if (after > 0.0) h *= std::sqrt(before / after);
 }
 
+/// Clears the history of a contact that ended. Most such pairs were not touching before either:
+/// their history is only read, not written again every step.
+template <int kStride>
+void clear_history(double* h) {
+  bool set = false;
+  for (int s = 0; s < kStride; ++s) set |= h[s] != 0.0;
+  if (set)
+    for (int s = 0; s < kStride; ++s) h[s] = 0.0;
+}
+
 inline Vec3 load_vec(const double* p) {
   return {p[0], p[1], p[2]};
 }

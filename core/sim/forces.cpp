@@ -24,16 +24,6 @@ TypedLaw<N, C, T, R> typed(const contact::ContactLaw& law) {
           std::get<R>(law.rolling)};
 }
 
-/// Clears the history of a pair beyond reach. Most such pairs were not touching before either:
-/// their history is only read, not written again every step.
-template <int kStride>
-void clear_history(double* h) {
-  bool set = false;
-  for (int s = 0; s < kStride; ++s) set |= h[s] != 0.0;
-  if (set)
-    for (int s = 0; s < kStride; ++s) h[s] = 0.0;
-}
-
 /// A force and a torque, e.g. the particles' push on a wall.
 struct Wrench {
   Vec3 force, torque;
@@ -83,7 +73,7 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
         double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
         walls::WallGeometry g;
         if (!walls::wall_geometry(wall.shape, p.x[i], p.radius[i], range, g)) {
-          for (int s = 0; s < kStride; ++s) h[s] = 0.0;
+          contact::clear_history<kStride>(h);
           continue;
         }
         apply(i, g, h);
@@ -129,8 +119,7 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
             }
         }
         for (int s = 0; s < kSlots; ++s)
-          if (!used[s])
-            for (int k = 0; k < kSlot; ++k) h[s * kSlot + k] = 0.0;
+          if (!used[s]) contact::clear_history<kSlot>(h + s * kSlot);
         for (int c = 0; c < found; ++c) {
           double* hs = h + slot_of[c] * kSlot;
           hs[kStride] = g[c].n.x;
@@ -217,7 +206,7 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
         const double reach = ri + rj + range;
         const double dist2 = norm2(d);
         if (dist2 >= reach * reach) {
-          clear_history<kStride>(h);
+          contact::clear_history<kStride>(h);
           continue;
         }
         const double dist = std::sqrt(dist2);

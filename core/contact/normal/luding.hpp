@@ -54,12 +54,23 @@ struct Luding {
   void finalize(const std::string& where) {
     if (is_set(k1) == is_set(youngs_modulus))
       throw InputError(where, "give exactly one of 'k1' and 'youngs_modulus' (eq. 3)");
+    // The factors of eq. 3, 4 and 7 that do not depend on the pair, computed once with the
+    // operations in the order the formulas below apply them (so every force keeps its bits).
+    if (!is_set(k1)) {
+      eq3_modulus_ = (4.0 / 3.0) * youngs_modulus;
+      eq3_root_ = std::sqrt(delta_prime);
+    }
+    eq4_factor_ = k2_ratio / (k2_ratio - 1.0) * phi_f;
+    if (restitution < 1.0) {
+      const double q = M_PI / std::log(restitution);
+      eq7_denominator_ = 1.0 + q * q;
+    }
   }
   double loading_stiffness(double r_eff) const {
-    return is_set(k1) ? k1 : (4.0 / 3.0) * youngs_modulus * r_eff * std::sqrt(delta_prime);
+    return is_set(k1) ? k1 : eq3_modulus_ * r_eff * eq3_root_;
   }
   /// delta*_max of eq. 4: the overlap beyond which un-/reloading has the full k2.
-  double plastic_limit(double r_eff) const { return k2_ratio / (k2_ratio - 1.0) * phi_f * r_eff; }
+  double plastic_limit(double r_eff) const { return eq4_factor_ * r_eff; }
   /// The largest slope of the force-overlap curve: k2 (eq. 10) or kc (eq. 11), whichever is larger.
   double max_stiffness(double r_eff) const {
     return std::max(k2_ratio, kc_ratio) * loading_stiffness(r_eff);
@@ -74,8 +85,7 @@ struct Luding {
   }
   double damping(double m_star, double k) const {
     if (restitution >= 1.0) return 0.0;
-    const double q = M_PI / std::log(restitution);
-    return std::sqrt(4.0 * m_star * k / (1.0 + q * q));
+    return std::sqrt(4.0 * m_star * k / eq7_denominator_);
   }
 
   NormalResult force(const PairInput& in, double* history) const {
@@ -117,6 +127,11 @@ struct Luding {
     r.f_adhesive = kc * delta;
     return r;
   }
+
+ private:
+  // Derived by finalize(): 4/3 Y and sqrt(delta') of eq. 3, k2 / (k2 - k1) phi_f of eq. 4,
+  // 1 + (pi / ln e)^2 of eq. 7.
+  double eq3_modulus_ = 0.0, eq3_root_ = 0.0, eq4_factor_ = 0.0, eq7_denominator_ = 1.0;
 };
 
 }  // namespace demcal::contact::normal
