@@ -155,12 +155,7 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
   constexpr double kSolidFraction = 0.6;
   const double weight = kSolidFraction * rho * g * height;
   const double sigma = spec.rest_stress > 0.0 ? std::min(spec.rest_stress, weight) : weight;
-  // rho <v^2> < I^2 sigma with <v^2> = 2 KE / M, KE the translational kinetic energy: the
-  // inertial number measures the velocity fluctuations that carry stress. Spins are left out:
-  // the constant directional rolling torque (seed 000 eq. 23) does not vanish at rest, so it
-  // rocks the particles of a bed at rest about their contacts (Ai et al., Powder Technol. 206
-  // (2011) 269, model A): an LH220 bed of 300 kept 1-5 times its translational energy in spins
-  // for 0.08 s after the translation had come to rest (docs/lab-tests.md).
+  // rho <v^2> < I^2 sigma with <v^2> = 2 KE / M.
   const double ke_limit =
       0.5 * mass * spec.rest_inertial_number * spec.rest_inertial_number * sigma / rho;
   // Freshly inserted particles are at rest before they fall: the criterion counts only after
@@ -171,7 +166,7 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
   bool rest = false;
   while (!rest && w.time - t0 < spec.max_settle_time) {
     run_checked(w, chunk, limits);
-    rest = w.time - t0 >= fall && p.translational_kinetic_energy() < ke_limit;
+    rest = w.time - t0 >= fall && p.kinetic_energy() < ke_limit;
   }
   char target[128];
   std::snprintf(target, sizeof target, "kinetic stress < %.3g^2 x %s (simulated) within %.3g s",

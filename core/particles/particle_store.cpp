@@ -182,10 +182,4 @@ double ParticleStore::kinetic_energy() const {
   return e;
 }
 
-double ParticleStore::translational_kinetic_energy() const {
-  double e = 0.0;
-  for (std::size_t i = 0; i < size(); ++i) e += 0.5 * mass[i] * norm2(v[i]);
-  return e;
-}
-
 }  // namespace demcal::particles

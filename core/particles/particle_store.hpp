@@ -80,8 +80,6 @@ class ParticleStore {
 
   double total_mass() const;
   double kinetic_energy() const;  ///< translational + rotational (J)
-  /// Translational part alone, sum of m v^2 / 2 (J): the kinetic stress rho <v^2> of a bed.
-  double translational_kinetic_energy() const;
 };
 
 }  // namespace demcal::particles
