@@ -68,16 +68,23 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
       wt += cross(g.point - wall.pivot, -out.force) + out.torque_j;
     };
     if (!mesh) {
-      // Plane, cylinder, disk: at most one contact per particle, one history per particle.
-      for (int i = lo; i < hi; ++i) {
-        double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
-        walls::WallGeometry g;
-        if (!walls::wall_geometry(wall.shape, p.x[i], p.radius[i], range, g)) {
-          contact::clear_history<kStride>(h);
-          continue;
-        }
-        apply(i, g, h);
-      }
+      // Plane, cylinder, disk: at most one contact per particle, one history per particle; the
+      // loop is compiled for the wall's shape.
+      std::visit(
+          [&](const auto& shape) {
+            if constexpr (!std::is_same_v<std::decay_t<decltype(shape)>, walls::Mesh>) {
+              for (int i = lo; i < hi; ++i) {
+                double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
+                walls::WallGeometry g;
+                if (!walls::primitive_geometry(shape, p.x[i], p.radius[i], range, g)) {
+                  contact::clear_history<kStride>(h);
+                  continue;
+                }
+                apply(i, g, h);
+              }
+            }
+          },
+          wall.shape);
     } else {
       // Mesh: up to kMaxContacts contacts per particle, each continuing the history slot whose
       // last normal is nearest its own (within 45 deg), so a contact keeps its tangential spring

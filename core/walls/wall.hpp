@@ -2,6 +2,7 @@
 // Walls: infinite planes, cylinders (inner surface) and disks, moved rigidly by a prescribed
 // or controlled velocity and angular velocity. Each wall reports the force and torque the
 // particles exert on it in the last step.
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -70,6 +71,66 @@ inline int contact_slots(const Shape& shape) {
 /// mesh slot adds the slot's last contact normal (3 doubles; zero = slot free).
 inline int history_stride(const Shape& shape, int law_stride) {
   return std::holds_alternative<Mesh>(shape) ? Mesh::kMaxContacts * (law_stride + 3) : law_stride;
+}
+
+/// Nearest-point geometry of a sphere (centre x, radius r) against a plane, a cylinder or a disk;
+/// false when the gap exceeds `range` (or the sphere is beside a finite wall's extent). Inline, so
+/// the force kernel's loop over the particles of one wall compiles for its shape. A sphere
+/// clearly out of reach (by more than a billionth of the wall's size, far beyond rounding) is
+/// refused before any square root: the answer is the one the exact test would give.
+inline bool primitive_geometry(const Plane& p, const Vec3& x, double r, double range,
+                               WallGeometry& g) {
+  const double d = dot(x - p.point, p.normal);
+  g.delta = r - d;
+  if (-g.delta > range) return false;
+  g.n = -p.normal;
+  g.point = x - p.normal * d;
+  return true;
+}
+
+inline bool primitive_geometry(const Cylinder& c, const Vec3& x, double r, double range,
+                               WallGeometry& g) {
+  const Vec3 rel = x - c.point;
+  const double s = dot(rel, c.axis);
+  if (s < c.lo || s > c.hi) return false;
+  const Vec3 radial = rel - c.axis * s;
+  // In reach only at rho >= R - r - range.
+  const double inner = c.radius - r - range - 1e-9 * c.radius;
+  const double rho2 = norm2(radial);
+  if (inner > 0.0 && rho2 < inner * inner) return false;
+  const double rho = std::sqrt(rho2);
+  g.delta = r - (c.radius - rho);
+  if (-g.delta > range || rho == 0.0) return false;
+  g.n = radial / rho;
+  g.point = c.point + c.axis * s + g.n * c.radius;
+  return true;
+}
+
+inline bool primitive_geometry(const Disk& k, const Vec3& x, double r, double range,
+                               WallGeometry& g) {
+  const Vec3 rel = x - k.centre;
+  const double h = dot(rel, k.normal);
+  // Every point of the disk (face or rim) lies in its plane, at least |h| from the centre.
+  if (std::abs(h) - r - range > 1e-9 * (std::abs(h) + k.radius)) return false;
+  const Vec3 in_plane = rel - k.normal * h;
+  const double rho = norm(in_plane);
+  if (rho <= k.radius) {
+    // Face contact on whichever side the sphere is.
+    g.delta = r - std::abs(h);
+    if (-g.delta > range) return false;
+    g.n = h >= 0.0 ? -k.normal : k.normal;
+    g.point = x - k.normal * h;
+    return true;
+  }
+  // Rim contact: nearest point on the edge circle.
+  const Vec3 rim = k.centre + in_plane * (k.radius / rho);
+  const Vec3 to_rim = rim - x;
+  const double d = norm(to_rim);
+  g.delta = r - d;
+  if (-g.delta > range || d == 0.0) return false;
+  g.n = to_rim / d;
+  g.point = rim;
+  return true;
 }
 
 /// Nearest-point geometry of a sphere (centre x, radius r) against a shape; false when the gap
