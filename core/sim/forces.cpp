@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <vector>
 
 namespace demcal::sim {
@@ -46,6 +47,10 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
   auto& p = w.particles;
   double* hist = w.wall_history[wall_index].data();
   const walls::Mesh* mesh = std::get_if<walls::Mesh>(&wall.shape);
+  // Only the particles that may touch the wall (World::wall_reach), those of [lo, hi).
+  const std::vector<int>& near = w.wall_reach[wall_index].near;
+  const auto first = std::lower_bound(near.begin(), near.end(), lo);
+  const auto last = std::lower_bound(first, near.end(), hi);
   {
     Vec3 wf{}, wt{};
     auto apply = [&](int i, const walls::WallGeometry& g, double* h) {
@@ -73,7 +78,8 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
       std::visit(
           [&](const auto& shape) {
             if constexpr (!std::is_same_v<std::decay_t<decltype(shape)>, walls::Mesh>) {
-              for (int i = lo; i < hi; ++i) {
+              for (auto it = first; it != last; ++it) {
+                const int i = *it;
                 double* h = hist + static_cast<std::ptrdiff_t>(i) * kStride;
                 walls::WallGeometry g;
                 if (!walls::primitive_geometry(shape, p.x[i], p.radius[i], range, g)) {
@@ -93,7 +99,8 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
       constexpr int kSlots = walls::Mesh::kMaxContacts;
       constexpr int kSlot = kStride + 3;
       constexpr double kSameContact = 0.7071;
-      for (int i = lo; i < hi; ++i) {
+      for (auto it = first; it != last; ++it) {
+        const int i = *it;
         double* h = hist + static_cast<std::ptrdiff_t>(i) * kSlots * kSlot;
         walls::WallGeometry g[kSlots];
         const int found = walls::mesh_contacts(*mesh, p.x[i], p.radius[i], range, g);
@@ -266,6 +273,7 @@ void compute_forces(World& world, const OwnedRangeTask& after) {
     for (auto& wall : world.walls) wall.force = wall.torque = {};
     return;
   }
+  world.refresh_wall_reach();
   contact::visit(world.pair_law(0, 0),
                  [&](const auto& n, const auto& c, const auto& t, const auto& r) {
                    force_region(world, after, n, c, t, r);

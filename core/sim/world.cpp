@@ -5,6 +5,7 @@
 #include "core/common/error.hpp"
 #include "core/sim/forces.hpp"
 #include "core/sim/time_step.hpp"
+#include "core/walls/reach.hpp"
 
 namespace demcal::sim {
 namespace {
@@ -66,6 +67,40 @@ void World::rebuild_list() {
   for (auto& x : particles.x) domain.wrap(x);
   list.build(particles.x, particles.radius, domain, interaction_range() + skin_, active_threads(),
              pair_history, pair_stride_, clump_bodies());
+  for (auto& reach : wall_reach) reach.valid = false;
+}
+
+void World::refresh_wall_reach() {
+  if (wall_reach.size() != walls.size()) wall_reach.assign(walls.size(), {});
+  const double margin = 1.5 * skin_;
+  for (std::size_t k = 0; k < walls.size(); ++k) {
+    const walls::Wall& wall = walls[k];
+    WallReach& reach = wall_reach[k];
+    double range = 0.0;
+    for (int m = 0; m < n_materials_; ++m)
+      range = std::max(range, wall_law(wall.material, m).range());
+    if (reach.valid && reach.range == range &&
+        walls::surface_shift(reach.shape, wall.shape, reach.extent) <= 0.5 * skin_)
+      continue;
+    const Vec3 origin = walls::reference_point(wall.shape);
+    const int stride = wall_strides_[k];
+    double* history = wall_history[k].data();
+    reach.near.clear();
+    reach.extent = 0.0;
+    for (std::size_t i = 0; i < particles.size(); ++i) {
+      reach.extent = std::max(reach.extent, norm2(particles.x[i] - origin));
+      if (walls::may_reach(wall.shape, particles.x[i], particles.radius[i], range, margin)) {
+        reach.near.push_back(static_cast<int>(i));
+        continue;
+      }
+      double* h = history + static_cast<std::ptrdiff_t>(i) * stride;
+      std::fill(h, h + stride, 0.0);
+    }
+    reach.extent = std::sqrt(reach.extent) + 2.0 * skin_;
+    reach.shape = wall.shape;
+    reach.range = range;
+    reach.valid = true;
+  }
 }
 
 const contact::ContactLaw& World::pair_law(int a, int b) const {
@@ -132,6 +167,7 @@ void World::prepare() {
   wall_history.assign(walls.size(), {});
   for (std::size_t w = 0; w < walls.size(); ++w)
     wall_history[w].assign(particles.size() * wall_strides_[w], 0.0);
+  wall_reach.clear();
   prepared_ = true;
   // The forces of this configuration, for the first half kick of the next step: step() relies on
   // them whether it called prepare() itself or the caller did.

@@ -76,6 +76,22 @@ class World {
   neighbour::VerletList list;
   std::vector<double> pair_history;               ///< history_stride() doubles per listed pair
   std::vector<std::vector<double>> wall_history;  ///< per wall: particles * wall_stride
+  /// Per wall, the particles that may touch it (walls/reach.hpp); the force kernel visits only
+  /// these. Listed again at every neighbour-list build and whenever the wall's surface has moved
+  /// by half the skin since. Since a listing every particle has moved less than the skin (half
+  /// the skin since the list build, before and after it) and the wall less than half of it, so a
+  /// particle not listed with a margin of 1.5 skins is still out of reach.
+  struct WallReach {
+    std::vector<int> near;  ///< particle indices, ascending
+    walls::Shape shape;     ///< the wall's shape when listed
+    double range = -1.0;    ///< the wall laws' reach beyond contact when listed (m)
+    double extent = 0.0;    ///< the largest distance of a particle from the shape's reference (m)
+    bool valid = false;
+  };
+  std::vector<WallReach> wall_reach;
+  /// Lists again the particles of every wall whose list is out of date (forces.cpp calls it
+  /// before each force evaluation); clears the history of a particle a wall no longer lists.
+  void refresh_wall_reach();
   /// A pair force on a particle owned by another thread, added after the pair loop.
   struct DeferredForce {
     int particle;

@@ -8,9 +8,13 @@ bool wall_geometry(const Shape& shape, const Vec3& x, double r, double range, Wa
   return std::visit(
       [&](const auto& s) {
         using S = std::decay_t<decltype(s)>;
-        if constexpr (std::is_same_v<S, Mesh>)
-          return mesh_contacts(s, x, r, range, &out) > 0;
-        else
+        if constexpr (std::is_same_v<S, Mesh>) {
+          // mesh_contacts writes up to kMaxContacts contacts, the deepest first.
+          WallGeometry contacts[Mesh::kMaxContacts];
+          if (mesh_contacts(s, x, r, range, contacts) == 0) return false;
+          out = contacts[0];
+          return true;
+        } else
           return primitive_geometry(s, x, r, range, out);
       },
       shape);
