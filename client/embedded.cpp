@@ -74,6 +74,10 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
   co.db = db_ = (workdir / "campaign.db").string();
   co.token = random_token();
   co.grace_seconds = 0.0;  // its workers die with it: no lease of a previous run is still worked on
+  // Its workers ask over loopback, where an empty poll costs microseconds: a worker that found
+  // the queue empty takes a job a tenth of a second after it appears, not a second (with jobs
+  // of a fraction of a second, one worker would otherwise run them all while the other waits).
+  co.idle_retry_seconds = 0.1;
   coordinator_ = std::make_unique<server::Coordinator>(co);
   channel_.address = "127.0.0.1:" + std::to_string(coordinator_->port());
   channel_.token = co.token;

@@ -33,8 +33,11 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
     throw std::invalid_argument("--max-starts must lie in [1, 1000]");
   if (!(options_.max_watch_interval >= kMinWatchInterval && options_.max_watch_interval <= 3600))
     throw std::invalid_argument("--max-watch-interval must lie in [0.05, 3600] s");
+  if (!(options_.idle_retry_seconds >= 0.01 && options_.idle_retry_seconds <= 60.0))
+    throw std::invalid_argument("the idle retry must lie in [0.01, 60] s");
   ServiceConfig config{tokens, options_.heartbeat_seconds,
-                       std::min(1.0, options_.heartbeat_seconds), options_.max_starts,
+                       std::min(options_.idle_retry_seconds, options_.heartbeat_seconds),
+                       options_.max_starts,
                        options_.max_watch_interval};
   campaigns_ = std::make_unique<CampaignServiceImpl>(*store_, config, stopping_);
   workers_ = std::make_unique<WorkerServiceImpl>(*store_, config);

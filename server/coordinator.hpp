@@ -26,6 +26,8 @@ struct CoordinatorOptions {
   double lease_seconds = 60.0;
   double heartbeat_seconds = 10.0;
   double reaper_seconds = 1.0;
+  /// How long a worker that found no job waits before it asks again (at most the heartbeat).
+  double idle_retry_seconds = 1.0;
   /// A lease found in the file at start-up expires no sooner than this (nor than a lease)
   /// after start-up: workers that ran on while the coordinator was down reconnect and report.
   double grace_seconds = 30.0;
