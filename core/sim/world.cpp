@@ -85,11 +85,12 @@ void World::refresh_wall_reach() {
     const Vec3 origin = walls::reference_point(wall.shape);
     const int stride = wall_strides_[k];
     double* history = wall_history[k].data();
+    const walls::ReachTest test(wall.shape, range, margin);
     reach.near.clear();
     reach.extent = 0.0;
     for (std::size_t i = 0; i < particles.size(); ++i) {
       reach.extent = std::max(reach.extent, norm2(particles.x[i] - origin));
-      if (walls::may_reach(wall.shape, particles.x[i], particles.radius[i], range, margin)) {
+      if (test.may_reach(particles.x[i], particles.radius[i])) {
         reach.near.push_back(static_cast<int>(i));
         continue;
       }

@@ -25,18 +25,6 @@ bool may_reach_shape(const Disk& k, const Vec3& x, double r, double range, doubl
   return std::abs(dot(x - k.centre, k.normal)) - r <= range + margin;
 }
 
-bool may_reach_shape(const Mesh& m, const Vec3& x, double r, double range, double margin) {
-  if (m.vertices.empty()) return false;
-  Vec3 lo = m.vertices[0], hi = m.vertices[0];
-  for (const Vec3& v : m.vertices) {
-    lo = {std::min(lo.x, v.x), std::min(lo.y, v.y), std::min(lo.z, v.z)};
-    hi = {std::max(hi.x, v.x), std::max(hi.y, v.y), std::max(hi.z, v.z)};
-  }
-  const double reach = r + range + margin;
-  return x.x >= lo.x - reach && x.x <= hi.x + reach && x.y >= lo.y - reach &&
-         x.y <= hi.y + reach && x.z >= lo.z - reach && x.z <= hi.z + reach;
-}
-
 /// |a - b| for two ends of an extent that may be infinite (the same infinity: no change).
 double end_shift(double a, double b) {
   return a == b ? 0.0 : std::abs(a - b);
@@ -66,8 +54,30 @@ double shift(const Mesh& a, const Mesh& b, double) {
 
 }  // namespace
 
-bool may_reach(const Shape& shape, const Vec3& x, double r, double range, double margin) {
-  return std::visit([&](const auto& s) { return may_reach_shape(s, x, r, range, margin); }, shape);
+ReachTest::ReachTest(const Shape& shape, double range, double margin)
+    : shape_(&shape), range_(range), margin_(margin) {
+  const Mesh* m = std::get_if<Mesh>(&shape);
+  if (!m || m->vertices.empty()) return;
+  lo_ = hi_ = m->vertices[0];
+  for (const Vec3& v : m->vertices) {
+    lo_ = {std::min(lo_.x, v.x), std::min(lo_.y, v.y), std::min(lo_.z, v.z)};
+    hi_ = {std::max(hi_.x, v.x), std::max(hi_.y, v.y), std::max(hi_.z, v.z)};
+  }
+}
+
+bool ReachTest::may_reach(const Vec3& x, double r) const {
+  return std::visit(
+      [&](const auto& s) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(s)>, Mesh>) {
+          if (s.vertices.empty()) return false;
+          const double reach = r + range_ + margin_;
+          return x.x >= lo_.x - reach && x.x <= hi_.x + reach && x.y >= lo_.y - reach &&
+                 x.y <= hi_.y + reach && x.z >= lo_.z - reach && x.z <= hi_.z + reach;
+        } else {
+          return may_reach_shape(s, x, r, range_, margin_);
+        }
+      },
+      *shape_);
 }
 
 Vec3 reference_point(const Shape& shape) {

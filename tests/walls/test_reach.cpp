@@ -57,7 +57,7 @@ TEST(WallReach, AListedParticleIsNeverMissedAfterAMoveBelowTheMargin) {
   for (const Shape& shape : shapes) {
     for (int trial = 0; trial < 20000; ++trial) {
       const Vec3 x = Vec3{0, 0, 0.008} + random_in_ball(rng, 0.014);
-      const bool listed = may_reach(shape, x, r, range, margin);
+      const bool listed = ReachTest(shape, range, margin).may_reach(x, r);
       // The wall moves, then the sphere moves by what is left of the margin.
       const Shape now = moved(shape, random_in_ball(rng, 0.3 * margin), random_unit(rng),
                               rng.uniform(0.0, 0.003));
