@@ -37,8 +37,7 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
     throw std::invalid_argument("the idle retry must lie in [0.01, 60] s");
   ServiceConfig config{tokens, options_.heartbeat_seconds,
                        std::min(options_.idle_retry_seconds, options_.heartbeat_seconds),
-                       options_.max_starts,
-                       options_.max_watch_interval};
+                       options_.max_starts, options_.max_watch_interval};
   campaigns_ = std::make_unique<CampaignServiceImpl>(*store_, config, stopping_);
   workers_ = std::make_unique<WorkerServiceImpl>(*store_, config);
 

@@ -15,13 +15,17 @@ void Mesh::append(const Mesh& other) {
   fitted = false;
 }
 
-void Mesh::fit_bounds() {
-  lo = hi = vertices.empty() ? Vec3{} : vertices.front();
+void Mesh::vertex_bounds(Vec3& box_lo, Vec3& box_hi) const {
+  box_lo = box_hi = vertices.empty() ? Vec3{} : vertices.front();
   for (const auto& v : vertices)
     for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], v[k]);
-      hi[k] = std::max(hi[k], v[k]);
+      box_lo[k] = std::min(box_lo[k], v[k]);
+      box_hi[k] = std::max(box_hi[k], v[k]);
     }
+}
+
+void Mesh::fit_bounds() {
+  vertex_bounds(lo, hi);
   fitted = true;
 }
 

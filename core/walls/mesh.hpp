@@ -38,6 +38,8 @@ struct Mesh {
   std::size_t size() const { return triangles.size(); }
   /// Appends another mesh's triangles (the mesh is no longer fitted).
   void append(const Mesh& other);
+  /// The vertices' bounding box (a point at the origin when there are none).
+  void vertex_bounds(Vec3& box_lo, Vec3& box_hi) const;
   /// Sets lo, hi to the vertices' bounding box.
   void fit_bounds();
 };

@@ -56,13 +56,7 @@ double shift(const Mesh& a, const Mesh& b, double) {
 
 ReachTest::ReachTest(const Shape& shape, double range, double margin)
     : shape_(&shape), range_(range), margin_(margin) {
-  const Mesh* m = std::get_if<Mesh>(&shape);
-  if (!m || m->vertices.empty()) return;
-  lo_ = hi_ = m->vertices[0];
-  for (const Vec3& v : m->vertices) {
-    lo_ = {std::min(lo_.x, v.x), std::min(lo_.y, v.y), std::min(lo_.z, v.z)};
-    hi_ = {std::max(hi_.x, v.x), std::max(hi_.y, v.y), std::max(hi_.z, v.z)};
-  }
+  if (const Mesh* m = std::get_if<Mesh>(&shape)) m->vertex_bounds(lo_, hi_);
 }
 
 bool ReachTest::may_reach(const Vec3& x, double r) const {

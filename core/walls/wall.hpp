@@ -75,9 +75,7 @@ inline int history_stride(const Shape& shape, int law_stride) {
 
 /// Nearest-point geometry of a sphere (centre x, radius r) against a plane, a cylinder or a disk;
 /// false when the gap exceeds `range` (or the sphere is beside a finite wall's extent). Inline, so
-/// the force kernel's loop over the particles of one wall compiles for its shape. A sphere
-/// clearly out of reach (by more than a billionth of the wall's size, far beyond rounding) is
-/// refused before any square root: the answer is the one the exact test would give.
+/// the force kernel's loop over the particles of one wall compiles for its shape.
 inline bool primitive_geometry(const Plane& p, const Vec3& x, double r, double range,
                                WallGeometry& g) {
   const double d = dot(x - p.point, p.normal);
@@ -94,11 +92,7 @@ inline bool primitive_geometry(const Cylinder& c, const Vec3& x, double r, doubl
   const double s = dot(rel, c.axis);
   if (s < c.lo || s > c.hi) return false;
   const Vec3 radial = rel - c.axis * s;
-  // In reach only at rho >= R - r - range.
-  const double inner = c.radius - r - range - 1e-9 * c.radius;
-  const double rho2 = norm2(radial);
-  if (inner > 0.0 && rho2 < inner * inner) return false;
-  const double rho = std::sqrt(rho2);
+  const double rho = norm(radial);
   g.delta = r - (c.radius - rho);
   if (-g.delta > range || rho == 0.0) return false;
   g.n = radial / rho;
@@ -110,8 +104,6 @@ inline bool primitive_geometry(const Disk& k, const Vec3& x, double r, double ra
                                WallGeometry& g) {
   const Vec3 rel = x - k.centre;
   const double h = dot(rel, k.normal);
-  // Every point of the disk (face or rim) lies in its plane, at least |h| from the centre.
-  if (std::abs(h) - r - range > 1e-9 * (std::abs(h) + k.radius)) return false;
   const Vec3 in_plane = rel - k.normal * h;
   const double rho = norm(in_plane);
   if (rho <= k.radius) {

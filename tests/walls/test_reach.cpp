@@ -86,8 +86,7 @@ TEST(WallReach, TheShiftBoundsTheChangeOfEveryGap) {
   };
   const double extent = 0.03;
   for (int trial = 0; trial < 2000; ++trial) {
-    const Shape now =
-        moved(c, random_in_ball(rng, 1e-3), random_unit(rng), rng.uniform(0.0, 0.05));
+    const Shape now = moved(c, random_in_ball(rng, 1e-3), random_unit(rng), rng.uniform(0.0, 0.05));
     const Cylinder& d = std::get<Cylinder>(now);
     const double bound = surface_shift(c, now, extent);
     const Vec3 x = c.point + random_in_ball(rng, extent);
@@ -125,7 +124,8 @@ World piston_world() {
         w.particles.add_sphere({0.002 * i + 1e-4 * k, 0.002 * j, 0.001 + 0.00199 * k}, 0.001,
                                2500.0, 0);
   w.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}));
-  w.walls.push_back(walls::make_wall("piston", walls::Disk{{0.005, 0.005, 0.0081}, {0, 0, -1}, 0.02}));
+  w.walls.push_back(
+      walls::make_wall("piston", walls::Disk{{0.005, 0.005, 0.0081}, {0, 0, -1}, 0.02}));
   return w;
 }
 
