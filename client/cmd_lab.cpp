@@ -54,6 +54,7 @@ void run_lab(const LabOptions& opt) {
 struct StudyOptions {
   std::string spec, scale, particles, out_dir;
   int threads = 0;
+  int seeds = 1;
 };
 
 std::vector<double> parse_list(const std::string& text, const std::string& flag) {
@@ -68,8 +69,72 @@ std::vector<double> parse_list(const std::string& text, const std::string& flag)
   return v;
 }
 
-/// `demcal lab study SPEC.yaml --scale 1,2,4 | --particles 200,400,800`: the same test at each
-/// value, and how every metric moves (seed 001 App. B; seed 004 §3.1).
+nlohmann::json optional_json(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json study_json(const lab::StudyResult& r, const std::string& test) {
+  nlohmann::json j;
+  j["test"] = test;
+  j["axis"] = r.axis == lab::StudyAxis::kScaleFactor ? "scale_factor" : "particles";
+  j["seeds"] = r.seeds;
+  for (const auto& run : r.runs) {
+    nlohmann::json reps = nlohmann::json::array();
+    for (const auto& rep : run.replicates)
+      reps.push_back({{"seed", rep.seed},
+                      {"metrics", rep.metrics},
+                      {"flags", rep.flags},
+                      {"wall_seconds", rep.wall_seconds}});
+    j["runs"].push_back({{"value", run.value},
+                         {"particles", run.particles},
+                         {"metrics", run.metrics},
+                         {"spread", run.spread},
+                         {"flagged", run.flagged},
+                         {"replicates", reps}});
+  }
+  j["relative_change"] = r.relative_change;
+  j["max_deviation_from_last"] = r.max_deviation_from_last;
+  if (r.seeds >= 2) {
+    for (const auto& [name, from] : r.converged_from) j["converged_from"][name] = optional_json(from);
+    j["chosen"] = optional_json(r.chosen);
+  }
+  return j;
+}
+
+/// runs.csv: one row per value and seed (the curves behind a bed-size table); summary.csv: per
+/// value the mean and the seed-to-seed spread of every metric.
+void write_study_csv(const lab::StudyResult& r, const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& [name, unused] : r.runs.front().metrics) names.push_back(name);
+  std::vector<std::string> columns{"value", "particles", "seed", "wall_seconds"};
+  for (const auto& n : names) columns.push_back(n);
+  io::CsvWriter runs(dir + "/runs.csv", columns);
+  columns = {"value", "particles", "seeds"};
+  for (const auto& n : names) {
+    columns.push_back(n + "_mean");
+    columns.push_back(n + "_sd");
+  }
+  io::CsvWriter summary(dir + "/summary.csv", columns);
+  for (const auto& run : r.runs) {
+    for (const auto& rep : run.replicates) {
+      std::vector<double> row{run.value, run.particles, static_cast<double>(rep.seed),
+                              rep.wall_seconds};
+      for (const auto& n : names) row.push_back(rep.metrics.at(n));
+      runs.row(row);
+    }
+    std::vector<double> row{run.value, run.particles, static_cast<double>(run.replicates.size())};
+    for (const auto& n : names) {
+      row.push_back(run.metrics.at(n));
+      row.push_back(run.spread.at(n));
+    }
+    summary.row(row);
+  }
+}
+
+/// `demcal lab study SPEC.yaml --scale 1,2,4 | --particles 200,400,800 [--seeds 3]`: the same
+/// test at each value (and seed), how every metric moves, and with two or more seeds the size
+/// from which the metrics stay within their seed-to-seed spread (seed 000 §2.3, seed 001 App. B;
+/// seed 004 §3.1).
 void run_lab_study(const StudyOptions& opt) {
   auto spec = lab::read_lab_run(io::YamlNode::load_file(opt.spec));
   if (opt.threads > 0) spec.options.threads = opt.threads;
@@ -78,20 +143,14 @@ void run_lab_study(const StudyOptions& opt) {
   const bool by_scale = !opt.scale.empty();
   const auto values =
       by_scale ? parse_list(opt.scale, "--scale") : parse_list(opt.particles, "--particles");
-  const auto r =
-      lab::run_study(spec.test, spec.material, spec.settings, spec.options,
-                     by_scale ? lab::StudyAxis::kScaleFactor : lab::StudyAxis::kParticles, values);
-  nlohmann::json j;
-  j["test"] = spec.test;
-  j["axis"] = by_scale ? "scale_factor" : "particles";
-  for (const auto& run : r.runs)
-    j["runs"].push_back(
-        {{"value", run.value}, {"particles", run.particles}, {"metrics", run.metrics}});
-  j["relative_change"] = r.relative_change;
-  j["max_deviation_from_last"] = r.max_deviation_from_last;
+  const auto r = lab::run_study(
+      spec.test, spec.material, spec.settings, spec.options,
+      by_scale ? lab::StudyAxis::kScaleFactor : lab::StudyAxis::kParticles, values, opt.seeds);
+  const nlohmann::json j = study_json(r, spec.test);
   if (!opt.out_dir.empty()) {
     std::filesystem::create_directories(opt.out_dir);
     std::ofstream(opt.out_dir + "/study.json") << j.dump(2) << "\n";
+    write_study_csv(r, opt.out_dir);
   }
   std::cout << j.dump(2) << "\n";
 }
@@ -129,7 +188,11 @@ void add_lab_command(CLI::App& app) {
   study->add_option("spec", sopt->spec, "lab-run YAML")->required()->check(CLI::ExistingFile);
   study->add_option("--scale", sopt->scale, "scale factors, e.g. 1,2,4 (needs material.scaling)");
   study->add_option("--particles", sopt->particles, "particle counts, e.g. 200,400,800");
-  study->add_option("--out", sopt->out_dir, "directory for study.json");
+  study->add_option("--seeds", sopt->seeds,
+                    "seeds per value (the spec's seed and the next ones); 2 or more: the size "
+                    "from which every metric stays within its seed-to-seed spread")
+      ->check(CLI::Range(1, lab::kMaxStudySeeds));
+  study->add_option("--out", sopt->out_dir, "directory for study.json, runs.csv, summary.csv");
   study->add_option("--threads", sopt->threads, "override the spec's thread count");
   study->callback([sopt] { run_lab_study(*sopt); });
   lab->add_subcommand("list", "List the lab tests, their metrics and settings")

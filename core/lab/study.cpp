@@ -5,11 +5,70 @@
 #include "core/common/error.hpp"
 
 namespace demcal::lab {
+namespace {
+
+/// Mean and sample standard deviation of every metric over the replicates, and the metrics some
+/// replicate flagged.
+void summarise(StudyRun& run) {
+  const double n = static_cast<double>(run.replicates.size());
+  for (const auto& [name, unused] : run.replicates.front().metrics) {
+    double sum = 0.0;
+    for (const auto& rep : run.replicates) sum += rep.metrics.at(name);
+    const double mean = sum / n;
+    double squares = 0.0;
+    for (const auto& rep : run.replicates) {
+      const double d = rep.metrics.at(name) - mean;
+      squares += d * d;
+    }
+    run.metrics[name] = mean;
+    run.spread[name] = n > 1.0 ? std::sqrt(squares / (n - 1.0)) : 0.0;
+  }
+  for (const auto& rep : run.replicates)
+    for (const auto& [name, why] : rep.flags) run.flagged.insert(name);
+}
+
+void relative_changes(StudyResult& r) {
+  for (const auto& [name, last] : r.runs.back().metrics) {
+    auto& ch = r.relative_change[name];
+    double dev = 0.0;
+    for (std::size_t i = 0; i < r.runs.size(); ++i) {
+      const double m = r.runs[i].metrics.at(name);
+      if (i > 0) {
+        const double prev = r.runs[i - 1].metrics.at(name);
+        ch.push_back(prev != 0.0 ? (m - prev) / std::abs(prev) : 0.0);
+      }
+      if (last != 0.0) dev = std::max(dev, std::abs(m - last) / std::abs(last));
+    }
+    r.max_deviation_from_last[name] = dev;
+  }
+}
+
+/// Whether runs a and b agree on `metric` within their combined seed-to-seed spread, neither
+/// flagged for it.
+bool agree(const StudyRun& a, const StudyRun& b, const std::string& metric) {
+  if (a.flagged.count(metric) || b.flagged.count(metric)) return false;
+  const double sa = a.spread.at(metric), sb = b.spread.at(metric);
+  return std::abs(b.metrics.at(metric) - a.metrics.at(metric)) <= std::sqrt(sa * sa + sb * sb);
+}
+
+}  // namespace
+
+std::optional<std::size_t> converged_index(const std::vector<StudyRun>& runs,
+                                           const std::string& metric) {
+  for (std::size_t i = 0; i + 1 < runs.size(); ++i) {
+    bool all = true;
+    for (std::size_t j = i + 1; j < runs.size() && all; ++j) all = agree(runs[i], runs[j], metric);
+    if (all) return i;
+  }
+  return std::nullopt;
+}
 
 StudyResult run_study(const std::string& test, const MaterialModel& material,
                       const Settings& settings, const RunOptions& options, StudyAxis axis,
-                      const std::vector<double>& values) {
+                      const std::vector<double>& values, int seeds) {
   if (values.size() < 2) throw InputError("study", "give at least two values");
+  if (seeds < 1 || seeds > kMaxStudySeeds)
+    throw InputError("study.seeds", "must be in [1, " + std::to_string(kMaxStudySeeds) + "]");
   if (axis == StudyAxis::kScaleFactor && material.scaling == contact::ScalingLaw::kNone)
     throw InputError("material.scaling.law",
                      "a scale study needs a scaling law (kottlan2018 or tiscar2019)");
@@ -26,6 +85,7 @@ StudyResult run_study(const std::string& test, const MaterialModel& material,
   if (auto it = settings.find("particles"); it != settings.end()) n0 = it->second;
   StudyResult r;
   r.axis = axis;
+  r.seeds = seeds;
   const double l0 = axis == StudyAxis::kScaleFactor
                         ? contact::scale_factors(material.scaling, values[0]).length
                         : 1.0;
@@ -42,22 +102,26 @@ StudyResult run_study(const std::string& test, const MaterialModel& material,
     }
     StudyRun run;
     run.value = v;
-    run.metrics = run_lab_test(test, m, s, options).metrics;
-    run.particles = counted ? s["particles"] : run.metrics.at("particles");
+    for (int k = 0; k < seeds; ++k) {
+      RunOptions o = options;
+      o.seed = options.seed + static_cast<std::uint64_t>(k);
+      LabOutput out = run_lab_test(test, m, s, o);
+      run.replicates.push_back({o.seed, std::move(out.metrics), std::move(out.flags),
+                                out.cost.wall_seconds});
+    }
+    run.particles = counted ? s["particles"] : run.replicates.front().metrics.at("particles");
+    summarise(run);
     r.runs.push_back(std::move(run));
   }
-  for (const auto& [name, last] : r.runs.back().metrics) {
-    auto& ch = r.relative_change[name];
-    double dev = 0.0;
-    for (std::size_t i = 0; i < r.runs.size(); ++i) {
-      const double m = r.runs[i].metrics.at(name);
-      if (i > 0) {
-        const double prev = r.runs[i - 1].metrics.at(name);
-        ch.push_back(prev != 0.0 ? (m - prev) / std::abs(prev) : 0.0);
-      }
-      if (last != 0.0) dev = std::max(dev, std::abs(m - last) / std::abs(last));
+  relative_changes(r);
+  if (seeds >= 2) {
+    std::optional<std::size_t> chosen = 0;
+    for (const auto& metric : info.metrics) {
+      const auto i = converged_index(r.runs, metric.name);
+      r.converged_from[metric.name] = i ? std::optional<double>(r.runs[*i].value) : std::nullopt;
+      chosen = i && chosen ? std::optional<std::size_t>(std::max(*i, *chosen)) : std::nullopt;
     }
-    r.max_deviation_from_last[name] = dev;
+    if (chosen) r.chosen = r.runs[*chosen].value;
   }
   return r;
 }

@@ -62,6 +62,71 @@ TEST(Study, DrumScaleStudyKeepsTheDrumAndCoarsensItsBed) {
                InputError);
 }
 
+/// A study value with the given means and spreads of metric "m", as if from three seeds.
+StudyRun summary(double value, double mean, double sd, bool flagged = false) {
+  StudyRun r;
+  r.value = value;
+  r.metrics["m"] = mean;
+  r.spread["m"] = sd;
+  if (flagged) r.flagged.insert("m");
+  return r;
+}
+
+TEST(Study, ConvergedFromTheFirstValueEveryLaterOneMatchesWithinTheSpread) {
+  // 1.00 -> 1.50 is far beyond the combined spread 0.14; 1.50, 1.52, 1.45 agree pairwise.
+  std::vector<StudyRun> runs{summary(250, 1.0, 0.1), summary(500, 1.5, 0.1),
+                             summary(1000, 1.52, 0.1), summary(2000, 1.45, 0.05)};
+  EXPECT_EQ(converged_index(runs, "m"), std::optional<std::size_t>(1));
+  // Agreement with the next value alone is not enough: every later one must agree.
+  runs[3] = summary(2000, 1.8, 0.05);
+  EXPECT_EQ(converged_index(runs, "m"), std::nullopt);
+  // A flagged run never counts as agreeing.
+  runs[3] = summary(2000, 1.5, 0.05, true);
+  EXPECT_EQ(converged_index(runs, "m"), std::nullopt);
+  // Without spread only equal means agree (a yes/no metric that stays the same).
+  EXPECT_EQ(converged_index({summary(1, 0.0, 0.0), summary(2, 0.0, 0.0)}, "m"),
+            std::optional<std::size_t>(0));
+  EXPECT_EQ(converged_index({summary(1, 0.3, 0.0), summary(2, 0.31, 0.0)}, "m"), std::nullopt);
+  // The last value alone has nothing to agree with.
+  EXPECT_EQ(converged_index({summary(1, 1.0, 0.1)}, "m"), std::nullopt);
+}
+
+TEST(Study, SeedsGiveMeansSpreadsAndTheChosenSize) {
+  RunOptions o;
+  o.seed = 7;
+  const auto r = run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120}, 2);
+  ASSERT_EQ(r.runs.size(), 2u);
+  EXPECT_EQ(r.seeds, 2);
+  bool every = true;
+  for (const auto& metric : find_lab_info("packing").metrics) {
+    ASSERT_TRUE(r.converged_from.count(metric.name)) << metric.name;
+    const auto& from = r.converged_from.at(metric.name);
+    if (!from) every = false;
+    if (from) {
+      EXPECT_EQ(*from, 60.0) << metric.name;  // the only value before the last
+    }
+  }
+  EXPECT_EQ(r.chosen.has_value(), every);
+  if (r.chosen) {
+    EXPECT_EQ(*r.chosen, 60.0);
+  }
+  for (const auto& run : r.runs) {
+    ASSERT_EQ(run.replicates.size(), 2u);
+    EXPECT_EQ(run.replicates[0].seed, 7u);
+    EXPECT_EQ(run.replicates[1].seed, 8u);
+    const double a = run.replicates[0].metrics.at("solid_fraction");
+    const double b = run.replicates[1].metrics.at("solid_fraction");
+    EXPECT_NE(a, b);  // different beds
+    EXPECT_DOUBLE_EQ(run.metrics.at("solid_fraction"), 0.5 * (a + b));
+    EXPECT_NEAR(run.spread.at("solid_fraction"), std::abs(a - b) / std::sqrt(2.0), 1e-12);
+  }
+  EXPECT_THROW(run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120}, 0),
+               InputError);
+  EXPECT_THROW(run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120},
+                         kMaxStudySeeds + 1),
+               InputError);
+}
+
 TEST(Study, ScaleStudyNeedsAScalingLaw) {
   EXPECT_THROW(run_study("packing", glass(), {}, {}, StudyAxis::kScaleFactor, {1, 2}), InputError);
 }
