@@ -8,6 +8,7 @@
 
 #include "client/commands.hpp"
 #include "client/json_out.hpp"
+#include "client/markdown.hpp"
 #include "core/io/csv.hpp"
 #include "core/lab/lab_spec.hpp"
 #include "core/lab/study.hpp"
@@ -167,6 +168,19 @@ void list_labs() {
   }
 }
 
+/// The catalogue as Markdown: per test its metrics and its settings table (docs/lab-tests.md).
+void list_labs_markdown() {
+  for (const auto& t : lab::lab_catalog()) {
+    std::cout << "### `" << t.name << "`\n\n" << t.description << " (" << t.source << ").\n\n"
+              << "| metric | unit | meaning |\n|---|---|---|\n";
+    for (const auto& m : t.metrics)
+      std::cout << "| `" << m.name << "` | " << m.unit << " | " << m.description << " |\n";
+    std::cout << "\n";
+    print_param_table(std::cout, t.settings, "setting");
+    std::cout << "\n";
+  }
+}
+
 }  // namespace
 
 void add_lab_command(CLI::App& app) {
@@ -195,8 +209,10 @@ void add_lab_command(CLI::App& app) {
   study->add_option("--out", sopt->out_dir, "directory for study.json, runs.csv, summary.csv");
   study->add_option("--threads", sopt->threads, "override the spec's thread count");
   study->callback([sopt] { run_lab_study(*sopt); });
-  lab->add_subcommand("list", "List the lab tests, their metrics and settings")
-      ->callback(list_labs);
+  auto markdown = std::make_shared<bool>(false);
+  auto* list = lab->add_subcommand("list", "List the lab tests, their metrics and settings");
+  list->add_flag("--markdown", *markdown, "as Markdown tables (the reference in docs/lab-tests.md)");
+  list->callback([markdown] { *markdown ? list_labs_markdown() : list_labs(); });
 }
 
 }  // namespace demcal::cli

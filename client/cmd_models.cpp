@@ -1,36 +1,25 @@
 // `demcal models`: the contact-law slots, their models and every parameter with unit, valid range
 // and default, printed from the same tables that parse and validate specs.
-#include <cmath>
 #include <iostream>
 
 #include "client/commands.hpp"
+#include "client/markdown.hpp"
 #include "core/contact/contact_law.hpp"
 
 namespace demcal::cli {
 namespace {
 
-std::string number(double v) {
-  if (std::isnan(v)) return "none";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 void print_models() {
   for (const auto& slot : contact::slot_names()) {
-    std::cout << "## " << slot << "\n\n";
+    std::cout << "### Slot: " << slot << "\n\n";
     for (const auto& model : contact::model_names(slot)) {
-      std::cout << "### `" << model << "`\n\n";
+      std::cout << "#### `" << model << "`\n\n";
       const auto params = contact::model_params(slot, model);
       if (params.empty()) {
         std::cout << "No parameters.\n\n";
         continue;
       }
-      std::cout
-          << "| parameter | unit | valid range | default | meaning |\n|---|---|---|---|---|\n";
-      for (const auto& p : params)
-        std::cout << "| `" << p.name << "` | " << p.unit << " | [" << number(p.lo) << ", "
-                  << number(p.hi) << "] | " << number(p.fallback) << " | " << p.doc << " |\n";
+      print_param_table(std::cout, params, "parameter");
       std::cout << "\n";
     }
   }

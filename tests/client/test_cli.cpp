@@ -38,6 +38,33 @@ fs::path scratch_dir(const std::string& name) {
   return p;
 }
 
+/// The text a doc holds between "<!-- begin: MARK -->" and "<!-- end: MARK -->" lines; empty
+/// when it has no such section.
+std::string generated_section(const std::string& doc_path, const std::string& mark) {
+  std::ifstream in(doc_path);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string doc = text.str();
+  const std::string begin = "<!-- begin: " + mark + " -->\n", end = "<!-- end: " + mark + " -->";
+  const auto a = doc.find(begin);
+  const auto b = doc.find(end);
+  if (a == std::string::npos || b == std::string::npos || b < a) return {};
+  return doc.substr(a + begin.size(), b - a - begin.size());
+}
+
+TEST(Cli, DocsHoldTheTablesTheCommandsPrint) {
+  const std::array<std::pair<const char*, const char*>, 2> generated{
+      {{"docs/contact-models.md", "models"}, {"docs/lab-tests.md", "lab list --markdown"}}};
+  for (const auto& [doc, args] : generated) {
+    const Result r = demcal(args);
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    ASSERT_NE(r.out.find("| `"), std::string::npos) << args << " printed no table";
+    EXPECT_EQ(generated_section(source(doc), std::string("demcal ") + args), r.out)
+        << doc << " differs from `demcal " << args << "`: paste the command's output between "
+        << "its markers";
+  }
+}
+
 TEST(Cli, DesignReportsTheAliasStructureOfTheSeedScreening) {
   const Result r = demcal("design --factors 12 --runs 32 --center 1 --format json");
   ASSERT_EQ(r.exit_code, 0) << r.out;

@@ -1,5 +1,5 @@
 #pragma once
-// Small materials for the lab-test tests (issue 4): soft Luding spheres of 1 mm radius so that a
+// Small materials for the lab-test tests: soft Luding spheres of 1 mm radius so that a
 // few hundred particles run in seconds.
 #include "core/lab/lab_test.hpp"
 

@@ -1,4 +1,4 @@
-// Every lab test with rigid multisphere clumps (issue 7 §1): each runs with rods at a small bed
+// Every lab test with rigid multisphere clumps: each runs with rods at a small bed
 // and reports finite metrics; and the packing answers to the shape the way physics says:
 // elongated particles touch more neighbours (e.g. Williams and Philipse 2003 for spherocylinder
 // packings), a rod of aspect ratio 1 is a sphere, and solid volumes count each union once.

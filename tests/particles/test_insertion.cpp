@@ -1,4 +1,4 @@
-// Insertion without overlap (issue 2 §2): random sequential insertion into box and cylinder
+// Insertion without overlap: random sequential insertion into box and cylinder
 // regions, the error for a request too dense for random insertion, and lattices with jitter.
 #include <gtest/gtest.h>
 

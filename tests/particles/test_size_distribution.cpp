@@ -1,4 +1,4 @@
-// Size distributions (issue 2 §2): discrete mass-fraction classes (seed 000 Fig. 4) are sampled by
+// Size distributions: discrete mass-fraction classes (seed 000 Fig. 4) are sampled by
 // number with the right number fractions; log-normal sampling (seed 001 §3.1) has the requested
 // number median and geometric standard deviation and respects its truncation.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Determinism (issue 2 §2, DESIGN "Determinism"): the same scene and thread count give bitwise
+// Determinism (DESIGN "Determinism"): the same scene and thread count give bitwise
 // identical states; and with one thread the Verlet skin does not change a single bit, on a dense
 // sheared bed with friction and rolling resistance whose contacts outlive many list rebuilds —
 // which holds only if the per-contact history is carried across every rebuild (pairs outside

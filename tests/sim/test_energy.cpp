@@ -1,4 +1,4 @@
-// Energy conservation of the whole engine (issue 2 §5): an elastic gas in a closed box of six
+// Energy conservation of the whole engine: an elastic gas in a closed box of six
 // plane walls — linear springs without damping or clipping, no friction, no gravity — keeps its
 // total energy (kinetic + spring potential of every overlapping pair and wall contact) to a
 // relative drift below 1e-4 over 1e5 steps. Exercises the step pipeline, the Verlet list with

@@ -1,4 +1,4 @@
-// The time-step bound of a world (issue 2 §3): the Rayleigh time for Hertz laws (seed 000 eq. 1),
+// The time-step bound of a world: the Rayleigh time for Hertz laws (seed 000 eq. 1),
 // sqrt(m/k) for linear and Luding laws (seed 001 eq. 14), and a step above it is an error that
 // names both numbers.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// What walls report (issue 2 §2): the floor under a bed at rest carries the bed's weight, a
+// What walls report: the floor under a bed at rest carries the bed's weight, a
 // frictionless cylinder around it carries (almost) nothing axially; a wall moving with a
 // prescribed velocity has moved v t; a wall rotating about its pivot reports the torque of the
 // particle forces about that pivot.

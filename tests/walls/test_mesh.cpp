@@ -1,4 +1,4 @@
-// Mesh walls (issue 5 §1): sphere-triangle distances on a face, an edge and a vertex against
+// Mesh walls: sphere-triangle distances on a face, an edge and a vertex against
 // analytic values; one contact (not two) on a flat seam and on a convex edge, two in a concave
 // corner; a sphere sliding across a two-triangle seam feels a constant normal force; STL ASCII
 // and binary round trips; a rotating paddle reports the torque of the particle force about its
