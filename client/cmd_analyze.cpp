@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "client/commands.hpp"
+#include "client/format.hpp"
 #include "core/common/error.hpp"
 #include "core/doe/analysis.hpp"
 #include "core/io/csv.hpp"
@@ -73,13 +74,6 @@ std::optional<doe::Factor> factor_from_levels(const std::string& name, std::vect
                    "middle level " + std::to_string(mid) +
                        " is neither the arithmetic nor the geometric mean of " +
                        std::to_string(lo) + " and " + std::to_string(hi));
-}
-
-std::string fmt(double v, int precision = 5) {
-  if (!std::isfinite(v)) return "n/a";
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
 }
 
 void run_analyze(const AnalyzeOptions& opt) {

@@ -3,22 +3,17 @@
 // that parse and validate specs; docs/contact-models.md and docs/lab-tests.md hold this output
 // verbatim (tests/client/test_cli.cpp fails when they drift).
 #include <cmath>
-#include <cstdio>
 #include <ostream>
 #include <string>
 #include <vector>
 
+#include "client/format.hpp"
 #include "core/contact/contact_law.hpp"
 
 namespace demcal::cli {
 
-/// A bound or default as printed in the tables: %g, "none" for an unset value.
-inline std::string table_number(double v) {
-  if (std::isnan(v)) return "none";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+/// A bound or default as printed in the tables: six digits, "none" for an unset value.
+inline std::string table_number(double v) { return std::isnan(v) ? "none" : fmt(v, 6); }
 
 /// One row per parameter: name, unit, valid range, default, meaning; `first_column` heads the
 /// names.

@@ -11,17 +11,11 @@
 #include <stdexcept>
 #include <thread>
 
+#include "client/format.hpp"
 #include "core/common/error.hpp"
 
 namespace demcal::cli {
 namespace {
-
-std::string fmt(double v, int precision = 5) {
-  if (!std::isfinite(v)) return "n/a";
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
-}
 
 std::string duration(double s) {
   if (s < 0 || !std::isfinite(s)) return "--:--";
