@@ -42,6 +42,7 @@ ScaleFactors scale_factors(ScalingLaw law, double factor) {
       s.stiffness = 1.0 / factor;
       s.stress = 1.0 / (factor * factor);
       s.hamaker = factor;
+      s.time = std::sqrt(factor);
       break;
     case ScalingLaw::kTiscar2019: {
       const double third = std::cbrt(factor);
@@ -51,6 +52,7 @@ ScaleFactors scale_factors(ScalingLaw law, double factor) {
       s.modulus = 1.0 / (third * third);
       s.stress = 1.0 / (third * third);
       s.hamaker = third;
+      s.time = std::sqrt(third);
       break;
     }
   }

@@ -25,6 +25,9 @@ struct ScaleFactors {
   double modulus = 1.0;    ///< Young's modulus (Pa)
   double stress = 1.0;     ///< applied stresses (Pa) of a lab test
   double hamaker = 1.0;    ///< (J)
+  /// Durations of a lab test's protocol (s): sqrt(length) for both laws, whose masses and forces
+  /// are those of the real system's similar bed (time^2 ~ length x mass / force).
+  double time = 1.0;
 };
 
 /// The factors simulated / real for a law and its factor (SF or lambda).

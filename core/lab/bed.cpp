@@ -57,8 +57,10 @@ particles::InsertRequest material_insert_request(const MaterialModel& material,
   return req;
 }
 
-void fill_region(sim::World& w, particles::InsertRequest req, Rng& rng, double safety, double pause,
-                 int rounds) {
+void fill_region(sim::World& w, particles::InsertRequest req, Rng& rng, double safety,
+                 double time_factor, int rounds) {
+  constexpr double kPause = 0.1;  // real seconds
+  const double pause = kPause * time_factor;
   const std::size_t goal = w.particles.units() + req.count;
   for (int round = 1;; ++round) {
     req.count = goal - w.particles.units();
@@ -74,9 +76,10 @@ void fill_region(sim::World& w, particles::InsertRequest req, Rng& rng, double s
   }
 }
 
-PhaseCost timed_fill(sim::World& w, const particles::InsertRequest& req, Rng& rng, double safety) {
+PhaseCost timed_fill(sim::World& w, const particles::InsertRequest& req, Rng& rng, double safety,
+                     double time_factor) {
   const PhaseClock clock(w);
-  fill_region(w, req, rng, safety);
+  fill_region(w, req, rng, safety, time_factor);
   return clock.stop(w, "fill", "all particles inserted", true);
 }
 
@@ -104,7 +107,7 @@ sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
   w.walls.push_back(
       walls::make_wall("die", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius}, kWallDie));
   req.region = particles::CylinderRegion{{0, 0, 0}, radius, 0.0, height};
-  fill_region(w, req, rng, spec.time_step_safety);
+  fill_region(w, req, rng, spec.time_step_safety, material.factors().time);
   return w;
 }
 
@@ -135,8 +138,10 @@ long run_checked(sim::World& world, long steps, const sim::HealthLimits& limits,
   return steps;
 }
 
-PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limits) {
+PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limits,
+                 double time_factor) {
   const PhaseClock clock(w);
+  const double max_time = spec.max_settle_time * time_factor;
   const auto& p = w.particles;
   double mass = 0.0, volume = 0.0;
   double bottom = std::numeric_limits<double>::infinity(), top = -bottom;
@@ -162,15 +167,15 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
   // the free-fall time of the column they were inserted in.
   const double fall = g > 0.0 ? std::sqrt(2.0 * height / g) : 0.0;
   const double t0 = w.time;
-  const long chunk = std::max<long>(200, std::lround(0.002 / w.dt));
+  const long chunk = std::max<long>(200, std::lround(0.002 * time_factor / w.dt));
   bool rest = false;
-  while (!rest && w.time - t0 < spec.max_settle_time) {
+  while (!rest && w.time - t0 < max_time) {
     run_checked(w, chunk, limits);
     rest = w.time - t0 >= fall && p.kinetic_energy() < ke_limit;
   }
   char target[128];
   std::snprintf(target, sizeof target, "kinetic stress < %.3g^2 x %s (simulated) within %.3g s",
-                spec.rest_inertial_number, stress_text(sigma).c_str(), spec.max_settle_time);
+                spec.rest_inertial_number, stress_text(sigma).c_str(), max_time);
   return clock.stop(w, "settle", target, rest);
 }
 
@@ -289,7 +294,7 @@ PreparedBed prepare_and_settle(sim::World& w, const MaterialModel& material, con
   PreparedBed out;
   out.prepared = clock.stop(
       w, "prepare " + preparation_method_name(material.preparation.method), "its fixed time", true);
-  out.settled = settle(w, spec, limits);
+  out.settled = settle(w, spec, limits, material.factors().time);
   // The settled bed keeps its contacts' history under the full law.
   if (material.preparation.method != PreparationMethod::kClusters &&
       contact_only(material.particle_law))

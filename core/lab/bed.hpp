@@ -24,7 +24,7 @@ struct BedSpec {
   /// 1e-3: the motion carries 1e-6 of that stress (GDR MiDi's quasi-static bound on I).
   double rest_inertial_number = 1e-3;
   double rest_stress = 0.0;      ///< stress level of the test (Pa, simulated); 0 = the bed's weight
-  double max_settle_time = 2.0;  ///< (s) of simulated time
+  double max_settle_time = 2.0;  ///< (s), real: x the material's time factor when simulated
 };
 
 /// Wall materials used by the lab tests: the particle-wall law of the material model is given
@@ -47,15 +47,15 @@ particles::InsertRequest material_insert_request(const MaterialModel& material,
                                                  std::size_t count);
 
 /// Inserts the request's particles into the world as a filling would: what fits at random
-/// without overlap, then a pause of `pause` simulated seconds in which it falls, then the rest,
-/// for at most `rounds` rounds (a dense fill, or clumps that take more room than spheres).
-/// Sets the world's time step to `time_step_safety` times the critical one.
+/// without overlap, then a pause of 0.1 s (real; x `time_factor` as in settle()) in which it
+/// falls, then the rest, for at most `rounds` rounds (a dense fill, or clumps that take more room
+/// than spheres). Sets the world's time step to `time_step_safety` times the critical one.
 void fill_region(sim::World& world, particles::InsertRequest request, Rng& rng,
-                 double time_step_safety, double pause = 0.1, int rounds = 8);
+                 double time_step_safety, double time_factor, int rounds = 8);
 
 /// fill_region as a recorded phase "fill".
 PhaseCost timed_fill(sim::World& world, const particles::InsertRequest& request, Rng& rng,
-                     double time_step_safety);
+                     double time_step_safety, double time_factor);
 
 /// Expected solid volume of `count` particles of the distribution (mean of 2,000 seeded samples),
 /// for sizing a die, drum or hopper to its bed.
@@ -72,7 +72,12 @@ double metrics_top(const sim::World& world);
 
 /// Steps until the bed is at rest (mean kinetic energy criterion of BedSpec) or max time; checks
 /// health every few hundred steps. Returns the phase "settle" with whether it came to rest.
-PhaseCost settle(sim::World& world, const BedSpec& spec, const sim::HealthLimits& limits);
+/// `time_factor` turns the protocol's real seconds (the checks every 0.002 s, max_settle_time)
+/// into simulated ones: the material's ScaleFactors::time where the test's geometry follows its
+/// particles (a coarse-grained bed is then the similar bed of the real particles, exactly), 1
+/// where the geometry is the real apparatus (the rotating drum).
+PhaseCost settle(sim::World& world, const BedSpec& spec, const sim::HealthLimits& limits,
+                 double time_factor);
 
 /// Refuses a preparation other than pouring for a test that builds its bed only so
 /// (pours_only), naming the field: material.preparation.method.

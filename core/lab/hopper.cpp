@@ -78,7 +78,7 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
       material, particles::BoxRegion{{-0.5 * top, 0.0, h}, {0.5 * top, depth, h + bin}},
       static_cast<std::size_t>(s.particles));
   // Spheres stay inside the region, so none overlaps a periodic image across y = 0 / depth.
-  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety);
+  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety, material.factors().time);
 
   sim::HealthLimits limits;
   limits.lo = {-top - bin, -1e3, -(h + bin) * 4.0 - 1.0};

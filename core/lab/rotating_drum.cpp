@@ -30,6 +30,10 @@
 namespace demcal::lab {
 namespace {
 
+/// The drum is the real apparatus in real units (only its particles are coarse-grained): its
+/// protocol's seconds are simulated seconds (settle(), fill_region()).
+constexpr double kRealApparatus = 1.0;
+
 constexpr double kSeedDrumDiameter = 0.100;  // seed 001 §3.2.2
 
 bool centrifuging(const sim::World& w, double radius) {
@@ -143,7 +147,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
 
   particles::InsertRequest req = material_insert_request(
       material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth}, bed.particles);
-  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety);
+  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety, kRealApparatus);
 
   sim::HealthLimits limits;
   limits.lo = {-1.5 * radius, -1.5 * radius, -radius};
@@ -152,7 +156,7 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
 
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.0;
-  const PhaseCost settled = settle(w, settle_spec, limits);
+  const PhaseCost settled = settle(w, settle_spec, limits, kRealApparatus);
 
   // Froude scaling: Fr = w^2 R / g of the seed's drum at the seed's rpm.
   const double speed_factor =

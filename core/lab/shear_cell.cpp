@@ -108,14 +108,14 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   particles::InsertRequest req =
       material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, fill_h},
                               static_cast<std::size_t>(s.particles));
-  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety);
+  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety, material.factors().time);
   sim::HealthLimits limits = die_limits(w, radius, fill_h + h_v);
   limits.lo.z = -fill_h;
 
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.0;
   settle_spec.rest_stress = kShearPreKPa * 1e3 * s.stress_scale;
-  const PhaseCost settled = settle(w, settle_spec, limits);
+  const PhaseCost settled = settle(w, settle_spec, limits, material.factors().time);
 
   // The head: its disk half a diameter above the bed top, vanes reaching into the bed's top.
   const double top = metrics::bed_top(w);

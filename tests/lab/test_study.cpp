@@ -127,6 +127,26 @@ TEST(Study, SeedsGiveMeansSpreadsAndTheChosenSize) {
                InputError);
 }
 
+TEST(Study, CoarseGrainingAtAFixedCountIsASimilarity) {
+  // Both scaling laws map a bed onto a geometrically similar one: lengths x l, masses kept, forces
+  // kept (stiffness / l times overlap x l; van der Waals A_H l R l / (l D_min)^2), so the time
+  // step and every process time grow as sqrt(l) and the settings' stresses are scaled by 1 / l^2.
+  // At a fixed particle count the factor changes no metric; with l = 4 every product is exact (the
+  // time step doubles), so not a bit. (It matters through the size of the real system only, which
+  // a scale study keeps: fewer particles at a larger factor.)
+  for (auto law : {contact::ScalingLaw::kKottlan2018, contact::ScalingLaw::kTiscar2019}) {
+    auto m = testing::soft_luding(1e7, 5.0, 0.5, 1e-16);
+    m.scaling = law;
+    Settings s{{"particles", 60}};
+    const auto base = run_lab_test("packing", m, s, {});
+    m.scale_factor = law == contact::ScalingLaw::kKottlan2018 ? 4.0 : 64.0;  // l = 4 for both
+    const auto scaled = run_lab_test("packing", m, s, {});
+    EXPECT_EQ(scaled.metrics, base.metrics);
+    EXPECT_EQ(scaled.cost.steps, base.cost.steps);
+    EXPECT_GT(base.metrics.at("solid_fraction"), 0.2);
+  }
+}
+
 TEST(Study, ScaleStudyNeedsAScalingLaw) {
   EXPECT_THROW(run_study("packing", glass(), {}, {}, StudyAxis::kScaleFactor, {1, 2}), InputError);
 }

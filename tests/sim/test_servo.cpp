@@ -20,7 +20,7 @@ TEST(StressServo, PistonReachesAndHoldsTheTargetStress) {
   sim::World w = lab::make_die_world(m, bed, opt);
   const double radius = std::get<walls::Cylinder>(w.walls[1].shape).radius;
   const auto limits = lab::die_limits(w, radius, 0.05);
-  lab::settle(w, bed, limits);
+  lab::settle(w, bed, limits, m.factors().time);
 
   double top = 0.0;
   for (std::size_t i = 0; i < w.particles.size(); ++i)
