@@ -14,18 +14,20 @@
 #include "core/lab/catalog.hpp"
 #include "proto/material_convert.hpp"
 #include "server/calibration.hpp"
+#include "server/diagnosis.hpp"
 
 namespace demcal::server {
-namespace {
-
-std::string idx(const std::string& field, int i) {
-  return field + "[" + std::to_string(i) + "]";
-}
 
 std::string fmt(double v) {
   std::ostringstream s;
   s << std::setprecision(6) << v;
   return s.str();
+}
+
+namespace {
+
+std::string idx(const std::string& field, int i) {
+  return field + "[" + std::to_string(i) + "]";
 }
 
 const lab::ParameterInfo* find_parameter(const std::vector<lab::ParameterInfo>& table,
@@ -313,8 +315,10 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
     plan.targets.push_back(t);
   }
 
-  // Checked at submission so that a bad calibration block is refused before anything runs.
+  // Checked at submission so that a bad calibration or diagnosis block is refused before
+  // anything runs.
   (void)calibration_options(spec.calibration(), "spec.calibration");
+  (void)diagnose_options(spec.diagnose(), "spec.diagnose");
   jobs = design_jobs(spec, plan, plan.factors, "design", 0);
   return plan;
 }

@@ -13,6 +13,9 @@
 
 namespace demcal::server {
 
+/// A number in an error message: six significant digits.
+std::string fmt(double v);
+
 /// Validates a spec and plans it; InputError names the field ("spec.factors[2].high").
 /// Factor paths must exist in the material's parameter table (lab::parameters) with bounds
 /// inside the valid range; tests, settings and measured metrics must exist in the catalogue.

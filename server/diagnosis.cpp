@@ -20,8 +20,13 @@ namespace {
 
 constexpr std::string_view kPrefix = "diagnose:";
 
-double or_default(double v, double fallback) {
-  return v > 0.0 ? v : fallback;
+/// An option: `fallback` when unset (0), else `v` if lo < v <= hi.
+double option(double v, double fallback, double lo, double hi, const std::string& field) {
+  if (v == 0.0) return fallback;
+  if (!(v > lo && v <= hi))
+    throw InputError(field, "must be 0 (the default, " + fmt(fallback) + ") or in (" + fmt(lo) +
+                                ", " + fmt(hi) + "]");
+  return v;
 }
 
 diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan& plan,
@@ -45,13 +50,7 @@ diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan&
   for (const auto& t : spec.tests()) p.preparable &= !lab::pours_only(t.test());
   p.agitation_time_max = lab::default_agitation_time(model);
   for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
-  const auto& o = spec.diagnose();
-  p.options.candidates.assign(o.candidates().begin(), o.candidates().end());
-  p.options.aspect_ratio_max = or_default(o.aspect_ratio_max(), 3.0);
-  p.options.rolling_max = or_default(o.rolling_max(), 0.3);
-  p.options.sigma_g_max = or_default(o.sigma_g_max(), 1.5);
-  p.options.fixed_span = or_default(o.fixed_span(), 2.0);
-  p.options.margin = or_default(o.margin(), 0.3);
+  p.options = diagnose_options(spec.diagnose(), "spec.diagnose");
   p.options.seed = seed ? seed : 1;
   return p;
 }
@@ -164,6 +163,21 @@ nlohmann::json report_json(const diagnose::Report& r) {
 }
 
 }  // namespace
+
+diagnose::Options diagnose_options(const v1::DiagnoseOptions& o, const std::string& where) {
+  // Ranges: the parameter tables' (rods up to aspect ratio 20, mu_r up to 10, sigma_g up to 10),
+  // a fixed parameter at most 100 x off, a margin below 1 (an error cut by 100 % cannot be).
+  diagnose::Options out;
+  out.candidates.assign(o.candidates().begin(), o.candidates().end());
+  out.aspect_ratio_max =
+      option(o.aspect_ratio_max(), out.aspect_ratio_max, 1.0, 20.0, where + ".aspect_ratio_max");
+  out.rolling_max = option(o.rolling_max(), out.rolling_max, 0.0, 10.0, where + ".rolling_max");
+  out.sigma_g_max = option(o.sigma_g_max(), out.sigma_g_max, diagnose::kSigmaGLow, 10.0,
+                           where + ".sigma_g_max");
+  out.fixed_span = option(o.fixed_span(), out.fixed_span, 1.0, 100.0, where + ".fixed_span");
+  out.margin = option(o.margin(), out.margin, 0.0, 0.99, where + ".margin");
+  return out;
+}
 
 v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::uint64_t seed,
                                     bool read_only) {

@@ -428,6 +428,12 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
       {tiny_spec(30, 0, "", "calibration: {model: quadratic}\n"), "spec.calibration.model"},
       {tiny_spec(30, 0, "", "calibration: {surrogate: kriging}\n"), "spec.calibration.surrogate"},
       {tiny_spec(30, 0, "", "calibration: {batch: -1}\n"), "spec.calibration.batch"},
+      {tiny_spec(30, 0, "", "diagnose: {aspect_ratio_max: 1.0e9}\n"),
+       "spec.diagnose.aspect_ratio_max"},
+      {tiny_spec(30, 0, "", "diagnose: {rolling_max: -0.3}\n"), "spec.diagnose.rolling_max"},
+      {tiny_spec(30, 0, "", "diagnose: {sigma_g_max: 1.0}\n"), "spec.diagnose.sigma_g_max"},
+      {tiny_spec(30, 0, "", "diagnose: {fixed_span: -3}\n"), "spec.diagnose.fixed_span"},
+      {tiny_spec(30, 0, "", "diagnose: {margin: 7}\n"), "spec.diagnose.margin"},
       {[] {
          auto s = tiny_spec(30);
          s.replace(s.find("  - test: packing\n"), 18, "  - test: packing\n    threads: 100000\n");
