@@ -45,14 +45,23 @@ void poll_progress() {
     (*current_progress.report)(current_progress.last);
 }
 
+const std::map<std::string, LabRunner>& lab_runners() {
+  // One line per lab test; its catalogue entry (name, metrics, settings) is in catalog.cpp.
+  static const std::map<std::string, LabRunner> runners{
+      {"packing", run_packing},
+      {"confined_compression", run_confined_compression},
+      {"tensile", run_tensile},
+      {"wall_friction", run_wall_friction},
+      {"shear_cell", run_shear_cell},
+      {"rotating_drum", run_rotating_drum},
+      {"hopper", run_hopper},
+  };
+  return runners;
+}
+
 LabRunner find_lab_runner(const std::string& name) {
-  if (name == "packing") return run_packing;
-  if (name == "shear_cell") return run_shear_cell;
-  if (name == "rotating_drum") return run_rotating_drum;
-  if (name == "hopper") return run_hopper;
-  if (name == "wall_friction") return run_wall_friction;
-  if (name == "tensile") return run_tensile;
-  if (name == "confined_compression") return run_confined_compression;
+  const auto& runners = lab_runners();
+  if (const auto it = runners.find(name); it != runners.end()) return it->second;
   find_lab_info(name);  // throws with the known names
   throw InputError("test", "lab test '" + name + "' is catalogued but has no runner");
 }

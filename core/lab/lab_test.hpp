@@ -46,6 +46,8 @@ struct RunOptions {
 
 using LabRunner = LabOutput (*)(const MaterialModel&, const Settings&, const RunOptions&);
 
+/// Every lab test's runner by name: one per catalogue entry (tests/lab/test_phase_cost.cpp).
+const std::map<std::string, LabRunner>& lab_runners();
 /// The runner of a catalogued test; InputError for an unknown name.
 LabRunner find_lab_runner(const std::string& name);
 

@@ -1,11 +1,14 @@
 // Where the time of a lab test goes (the cost block) and phases that must reach their targets:
 // every phase is recorded with its steps and times, a phase that misses its target flags the
 // metrics computed from it, and the seed-000 lactose material (LH220 of examples/) reaches every
-// target of a confined compression with the default protocol.
+// target of a confined compression with the default protocol. And the registry: every
+// catalogued test has a runner, every runner a catalogue entry.
 #include <gtest/gtest.h>
 
 #include <numeric>
+#include <set>
 
+#include "core/common/error.hpp"
 #include "core/io/yaml_node.hpp"
 #include "core/lab/lab_spec.hpp"
 #include "core/sim/time_step.hpp"
@@ -16,6 +19,21 @@ namespace {
 
 Settings one_cycle(double particles) {
   return {{"particles", particles}, {"cycles", 1}, {"wall_stiffness_factor", 1}};
+}
+
+TEST(Registry, EveryCatalogueEntryHasARunnerAndEveryRunnerAnEntry) {
+  std::set<std::string> catalogued;
+  for (const auto& info : lab_catalog()) {
+    catalogued.insert(info.name);
+    EXPECT_TRUE(lab_runners().count(info.name)) << info.name << " has no runner";
+    EXPECT_NO_THROW(find_lab_runner(info.name)) << info.name;
+  }
+  for (const auto& [name, runner] : lab_runners()) {
+    EXPECT_TRUE(catalogued.count(name)) << name << " runs but is not catalogued";
+    EXPECT_NE(runner, nullptr) << name;
+  }
+  EXPECT_EQ(catalogued.size(), lab_runners().size());
+  EXPECT_THROW(find_lab_runner("no_such_test"), InputError);
 }
 
 // What a worker sends of a curve: evenly spread rows, the first and the last kept, none twice.
