@@ -92,6 +92,18 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   require_pour(material, "shear_cell");
   const auto s = read_settings<ShearCellSettings>(values, "settings");
   sim::World w = make_material_world(material, options);
+  {
+    // The vessel and floor of the small cell (docs/lab-tests.md, "shear_cell"): a frictionless
+    // vessel, so that the head's torque is the shear plane's and the floor measures the normal
+    // stress on it; a rough floor that holds the bed below the plane.
+    contact::ContactLawSpec vessel = material.wall_law, floor = material.wall_law;
+    vessel.tangential.params["mu_s"] = s.vessel_friction;
+    vessel.rolling = {"none", {}};
+    floor.tangential.params["mu_s"] = s.floor_friction;
+    if (s.floor_rolling > 0.0) floor.rolling = {"cdt", {{"mu_r", s.floor_rolling}}};
+    w.set_wall_law(kWallDie, 0, simulated_law(material, vessel));
+    w.set_wall_law(kWallBottom, 0, simulated_law(material, floor));
+  }
   const auto sizes = material.simulated_sizes();
   const double r_max = particles::max_radius(sizes);
   const double d = 2.0 * r_max;
@@ -114,7 +126,10 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
 
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.0;
-  settle_spec.rest_stress = kShearPreKPa * 1e3 * s.stress_scale;
+  // Settings and metrics are real stresses; the bed feels them x the scaling law's stress factor.
+  const double fs = material.factors().stress;
+  const double real_kpa = 1e3 * fs;  // simulated Pa per real kPa
+  settle_spec.rest_stress = kShearPreKPa * real_kpa * s.stress_scale;
   const PhaseCost settled = settle(w, settle_spec, limits, material.factors().time);
 
   // The head: its disk half a diameter above the bed top, vanes reaching into the bed's top.
@@ -129,7 +144,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   const double r_head = radius - 0.25 * d;
 
   const double area = M_PI * radius * radius;
-  const double sigma_pre = kShearPreKPa * 1e3 * s.stress_scale;
+  const double sigma_pre = kShearPreKPa * real_kpa * s.stress_scale;
   walls::StressServo servo;
   servo.axis = {0, 0, 1};  // the floor pushes the bed up against the head
   servo.area = area;
@@ -174,7 +189,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
     }
     if (ww.step_count % record == 0)
       pre.rows.push_back(
-          {ww.time, floor_stress(ww) / 1e3, shear_stress(ww, r_head) / 1e3, t * s.tip_speed / d});
+          {ww.time, floor_stress(ww) / real_kpa, shear_stress(ww, r_head) / real_kpa, t * s.tip_speed / d});
     if (options.progress) options.progress(0.4 * t / pre_time);
     return true;
   });
@@ -198,7 +213,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   for (std::size_t k = 0; k < kShearNormalKPa.size(); ++k) {
     sim::World v = restart;
     const PhaseClock step_clock(v);
-    const double sigma_x = kShearNormalKPa[k] * 1e3 * s.stress_scale;
+    const double sigma_x = kShearNormalKPa[k] * real_kpa * s.stress_scale;
     servo_run(v, sigma_pre, s.consolidation_time, {});
     servo_run(v, sigma_x, s.consolidation_time, {});
     // Torque control.
@@ -242,10 +257,10 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
                                   angle * r_head >= 1.5 * d),
                   {"yield_locus_slope", "yield_locus_intercept", "ffc", "effective_friction_angle",
                    "mohr_consistent", "unconfined_yield_strength", "major_consolidation_stress"});
-    points.rows.push_back({sigma_x / 1e3, sig_at_max / 1e3, tau_max / 1e3});
+    points.rows.push_back({sigma_x / real_kpa, sig_at_max / real_kpa, tau_max / real_kpa});
     // The locus uses the normal stress measured on the floor at the yield point.
-    xs.push_back(sig_at_max / 1e3);
-    ys.push_back(tau_max / 1e3);
+    xs.push_back(sig_at_max / real_kpa);
+    ys.push_back(tau_max / real_kpa);
     if (options.progress) options.progress(0.4 + 0.6 * (k + 1) / kShearNormalKPa.size());
   }
 
@@ -256,10 +271,10 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
     sx += xs[i], sy += ys[i], sxx += xs[i] * xs[i], sxy += xs[i] * ys[i];
   const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
   const double intercept = (sy - slope * sx) / n;
-  const MohrResult mohr = mohr_evaluation(slope, intercept, sigma_pre / 1e3, tau_pre / 1e3);
+  const MohrResult mohr = mohr_evaluation(slope, intercept, sigma_pre / real_kpa, tau_pre / real_kpa);
 
-  out.metrics["pre_shear_stress"] = tau_pre / 1e3;
-  out.metrics["pre_shear_normal_stress"] = sigma_pre_measured / 1e3;
+  out.metrics["pre_shear_stress"] = tau_pre / real_kpa;
+  out.metrics["pre_shear_normal_stress"] = sigma_pre_measured / real_kpa;
   out.metrics["yield_locus_slope"] = slope;
   out.metrics["yield_locus_intercept"] = intercept;
   out.metrics["mohr_consistent"] = mohr.consistent ? 1.0 : 0.0;

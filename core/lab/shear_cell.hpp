@@ -21,8 +21,11 @@ struct ShearCellSettings {
   double torque_ramp_time;    ///< (s) for the set torque to reach twice the pre-shear torque
   double stress_scale;        ///< multiplies every normal stress (for coarse-grained beds)
   double time_step_safety;
+  double vessel_friction;  ///< mu_s of the vessel wall (docs/lab-tests.md: 0)
+  double floor_friction;   ///< mu_s of the floor (a rough floor holds the bed below the plane)
+  double floor_rolling;    ///< CDT mu_r of the floor; 0: the material's wall law's rolling
 
-  static std::array<contact::ParamInfo<ShearCellSettings>, 9> table() {
+  static std::array<contact::ParamInfo<ShearCellSettings>, 12> table() {
     return {
         {{"particles", "-", 20, 1e7, 500, "number of particles", &ShearCellSettings::particles},
          {"vanes", "-", 2, 36, 8, "vanes of the shear head", &ShearCellSettings::vanes},
@@ -43,7 +46,16 @@ struct ShearCellSettings {
          {"stress_scale", "-", 1e-3, 1e3, 1, "multiplies the normal stresses of seed 000 Table 3",
           &ShearCellSettings::stress_scale},
          {"time_step_safety", "-", 0.01, 1.0, 0.2, "time step as a fraction of the critical one",
-          &ShearCellSettings::time_step_safety}}};
+          &ShearCellSettings::time_step_safety},
+         {"vessel_friction", "-", 0.0, 10.0, 0.0,
+          "mu_s of the vessel wall (0: it carries neither torque nor weight of the bed)",
+          &ShearCellSettings::vessel_friction},
+         {"floor_friction", "-", 0.0, 10.0, 1.0,
+          "mu_s of the floor (rough: the bed below the shear plane is held by it)",
+          &ShearCellSettings::floor_friction},
+         {"floor_rolling", "-", 0.0, 10.0, 0.5,
+          "CDT rolling resistance mu_r of the floor (0: the material's wall law's)",
+          &ShearCellSettings::floor_rolling}}};
   }
   void finalize(const std::string&) {}
 };
