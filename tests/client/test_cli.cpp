@@ -60,8 +60,7 @@ TEST(Cli, DocsHoldTheTablesTheCommandsPrint) {
     ASSERT_EQ(r.exit_code, 0) << r.out;
     ASSERT_NE(r.out.find("| `"), std::string::npos) << args << " printed no table";
     EXPECT_EQ(generated_section(source(doc), std::string("demcal ") + args), r.out)
-        << doc << " differs from `demcal " << args << "`: paste the command's output between "
-        << "its markers";
+        << doc << " differs from `demcal " << args << "`: run scripts/docs-tables";
   }
 }
 
