@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <vector>
 
+#include "core/sim/pair_input.hpp"
+
 namespace demcal::sim {
 namespace {
 
@@ -223,22 +225,8 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
           contact::clear_history<kStride>(h);
           continue;
         }
-        const double dist = std::sqrt(dist2);
-        const double mj = p.mass[j];
-        // R* = ri rj / (ri + rj) and m* = mi mj / (mi + mj) share one division.
-        const double inv_sums = 1.0 / ((ri + rj) * (mi + mj));
-        contact::PairInput in;
-        in.n = d * (1.0 / dist);
-        in.delta = ri + rj - dist;
-        in.r_i = ri;
-        in.r_j = rj;
-        in.r_star = ri * rj * (mi + mj) * inv_sums;
-        in.m_star = mi * mj * (ri + rj) * inv_sums;
-        const Vec3 v_rel = vi - p.v[j];
-        in.vn = dot(v_rel, in.n);
-        in.vt = v_rel - in.n * in.vn + cross(wi * ri + p.omega[j] * rj, in.n);
-        in.w_rel = wi - p.omega[j];
-        in.dt = dt;
+        const contact::PairInput in = particle_pair_input(
+            d, std::sqrt(dist2), ri, rj, mi, p.mass[j], vi, p.v[j], wi, p.omega[j], dt);
         const contact::PairOutput out = law_row[p.material[j]].evaluate(in, h);
         fi += out.force;
         ti += out.torque_i;
