@@ -1,6 +1,7 @@
 #include "core/lab/catalog.hpp"
 
 #include "core/common/error.hpp"
+#include "core/lab/compaction.hpp"
 #include "core/lab/confined_compression.hpp"
 #include "core/lab/hopper.hpp"
 #include "core/lab/packing.hpp"
@@ -129,10 +130,25 @@ LabTestInfo hopper_info() {
       settings_docs<HopperSettings>()};
 }
 
+// compaction: seed 004 §2.3-2.4, §3.1 (runner in compaction.cpp).
+LabTestInfo compaction_info() {
+  return {"compaction",
+          "fully periodic cell filled at random and compacted by shrinking it affinely through "
+          "target solid fractions, held at each; contact stress tensor (Love-Weber) and "
+          "pressure-density curve",
+          "seed 004 §2.3-2.4, §3.1",
+          {{"jamming_fraction", "-",
+            "solid fraction at which the contact pressure of the compression first exceeds 1e-2 of "
+            "the final held pressure"},
+           {"final_pressure", "kPa", "mean contact stress p = tr(sigma) / 3 held at phi_max"},
+           {"final_coordination_number", "-", "contacts per body at phi_max"}},
+          settings_docs<CompactionSettings>()};
+}
+
 const std::vector<LabTestInfo>& lab_catalog() {
   static const std::vector<LabTestInfo> tests = {
       packing_info(),    confined_compression_info(), tensile_info(), wall_friction_info(),
-      shear_cell_info(), rotating_drum_info(),        hopper_info()};
+      shear_cell_info(), rotating_drum_info(),        hopper_info(),  compaction_info()};
   return tests;
 }
 

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "core/common/error.hpp"
+#include "core/lab/compaction.hpp"
 #include "core/lab/confined_compression.hpp"
 #include "core/lab/hopper.hpp"
 #include "core/lab/packing.hpp"
@@ -55,6 +56,7 @@ const std::map<std::string, LabRunner>& lab_runners() {
       {"shear_cell", run_shear_cell},
       {"rotating_drum", run_rotating_drum},
       {"hopper", run_hopper},
+      {"compaction", run_compaction},
   };
   return runners;
 }

@@ -1,0 +1,47 @@
+#pragma once
+// compaction (seed 004 §2.3-2.4, §3.1): a fully periodic cell of particles (spheres or rigid
+// clumps: rods, helices, clusters) compacted by shrinking the cell affinely, the particles
+// remapped with it, through a list of target solid fractions; at each the cell is held and its
+// contact stress tensor (Love-Weber, metrics/stress.hpp) read. No walls: the cheapest
+// representative volume of a bulk.
+#include <array>
+
+#include "core/lab/lab_test.hpp"
+
+namespace demcal::lab {
+
+struct CompactionSettings {
+  static constexpr const char* kName = "compaction";
+  double particles;
+  double phi_start;    ///< solid fraction of the random fill
+  double phi_max;      ///< the last target
+  double points;       ///< targets, evenly spaced above phi_start up to phi_max
+  double strain_rate;  ///< linear strain of the cell per critical time (quasi-static: << 1)
+  double hold;         ///< hold at each target, in critical times
+  double time_step_safety;
+
+  static std::array<contact::ParamInfo<CompactionSettings>, 7> table() {
+    using S = CompactionSettings;
+    return {{{"particles", "-", 20, 1e6, 300, "number of particles (bodies)", &S::particles},
+             {"phi_start", "-", 0.05, 0.3, 0.2, "solid fraction of the random fill",
+              &S::phi_start},
+             {"phi_max", "-", 0.36, 0.9, 0.7, "last target solid fraction", &S::phi_max},
+             {"points", "-", 1, 50, 8,
+              "targets held and read, evenly spaced above phi_start up to phi_max", &S::points},
+             {"strain_rate", "-", 1e-7, 1e-2, 1e-5,
+              "linear strain of the cell per critical time sqrt(m/k) (quasi-static: << 1)",
+              &S::strain_rate},
+             {"hold", "-", 10, 1e5, 200, "hold at each target, in critical times", &S::hold},
+             {"time_step_safety", "-", 0.01, 1.0, 0.2,
+              "time step as a fraction of the critical one", &S::time_step_safety}}};
+  }
+  void finalize(const std::string& where) {
+    if (!(phi_max > phi_start)) throw InputError(where + ".phi_max", "must exceed phi_start");
+  }
+};
+
+LabTestInfo compaction_info();  ///< in catalog.cpp
+LabOutput run_compaction(const MaterialModel& material, const Settings& settings,
+                         const RunOptions& options);
+
+}  // namespace demcal::lab
