@@ -134,14 +134,18 @@ LabTestInfo hopper_info() {
 LabTestInfo compaction_info() {
   return {"compaction",
           "fully periodic cell filled at random and compacted by shrinking it affinely through "
-          "target solid fractions, held at each; contact stress tensor (Love-Weber) and "
-          "pressure-density curve",
+          "target solid fractions, held at each; contact stress tensor (Love-Weber), "
+          "pressure-density curve, and a constant-volume shear probe from the last",
           "seed 004 §2.3-2.4, §3.1",
           {{"jamming_fraction", "-",
             "solid fraction at which the contact pressure of the compression first exceeds 1e-2 of "
             "the final held pressure"},
            {"final_pressure", "kPa", "mean contact stress p = tr(sigma) / 3 held at phi_max"},
-           {"final_coordination_number", "-", "contacts per body at phi_max"}},
+           {"final_coordination_number", "-", "contacts per body at phi_max"},
+           {"peak_stress_ratio", "-",
+            "yield: the largest q / p of the constant-volume axisymmetric shear probe from "
+            "phi_max"},
+           {"steady_stress_ratio", "-", "mean q / p over the last fifth of the probe"}},
           settings_docs<CompactionSettings>()};
 }
 

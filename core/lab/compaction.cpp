@@ -15,21 +15,24 @@
 namespace demcal::lab {
 namespace {
 
-/// Shrinks (s < 1) the periodic cell about its centre by the factor s on every axis and remaps
-/// the particles with it (LIGGGHTS' fix deform with remap x): lone spheres affinely, rigid clumps
-/// by their centres of mass, their members carried along rigidly. Velocities are kept: they are
-/// the particles' motion relative to the cell's affine flow.
-void shrink_cell(sim::World& w, double s) {
+/// Deforms the periodic cell about its centre by the factor s[k] along axis k (< 1 shrinks) and
+/// remaps the particles with it (LIGGGHTS' fix deform with remap x): lone spheres affinely, rigid
+/// clumps by their centres of mass, their members carried along rigidly. Velocities are kept:
+/// they are the particles' motion relative to the cell's affine flow.
+void deform_cell(sim::World& w, const Vec3& s) {
   Domain& d = w.domain;
   const Vec3 c = 0.5 * (d.lo + d.hi);
-  d.lo = c + (d.lo - c) * s;
-  d.hi = c + (d.hi - c) * s;
+  auto map = [&](const Vec3& x) {
+    return Vec3{c.x + (x.x - c.x) * s.x, c.y + (x.y - c.y) * s.y, c.z + (x.z - c.z) * s.z};
+  };
+  d.lo = map(d.lo);
+  d.hi = map(d.hi);
   auto& p = w.particles;
   for (std::size_t i = 0; i < p.size(); ++i)
-    if (p.body[i] < 0) p.x[i] = c + (p.x[i] - c) * s;
+    if (p.body[i] < 0) p.x[i] = map(p.x[i]);
   auto& bodies = p.clumps;
   for (std::size_t b = 0; b < bodies.size(); ++b) {
-    const Vec3 shift = (bodies.x[b] - c) * (s - 1.0);
+    const Vec3 shift = map(bodies.x[b]) - bodies.x[b];
     bodies.x[b] += shift;
     for (std::size_t k = 0; k < bodies.count[b]; ++k) p.x[bodies.first[b] + k] += shift;
   }
@@ -96,7 +99,8 @@ LabOutput run_compaction(const MaterialModel& material, const Settings& values,
       // The last shrink lands on the target: s^3 = phi / target.
       const double to_target = std::cbrt(phi() / target);
       reached = to_target >= 1.0 - rate * w.dt;
-      shrink_cell(w, reached ? to_target : 1.0 - rate * w.dt);
+      const double f = reached ? to_target : 1.0 - rate * w.dt;
+      deform_cell(w, {f, f, f});
       sim::step(w);
       if (++step % sample_every == 0) {
         const auto t = stress();
@@ -149,6 +153,40 @@ LabOutput run_compaction(const MaterialModel& material, const Settings& values,
   PhaseCost jam{"jamming", "contact pressure above 1e-2 of the final before phi_max", 0, 0.0, 0.0,
                 jammed && p_final > 0.0};
   out.add_phase(jam, {"jamming_fraction"});
+  // Probe: axisymmetric shear at constant volume from the state held at phi_max (the cell
+  // shortened along z, widened equally along x and y), its stress ratio q / p read every 0.002
+  // of axial strain up to probe_strain. The yield is the peak ratio; the steady ratio the mean
+  // over the last fifth of the probe (the critical state when probe_strain is large enough).
+  Series probe{{"axial_strain", "pressure_kpa", "deviatoric_kpa", "stress_ratio"}, {}};
+  double peak_ratio = 0.0, steady_sum = 0.0;
+  long steady_reads = 0;
+  if (s.probe_strain > 0.0) {
+    const PhaseClock clock(w);
+    const double h0 = w.domain.length().z;
+    double strain = 0.0;
+    long step = 0;
+    while (strain < s.probe_strain) {
+      const double sz = 1.0 - rate * w.dt, sxy = 1.0 / std::sqrt(sz);
+      deform_cell(w, {sxy, sxy, sz});
+      sim::step(w);
+      strain = 1.0 - w.domain.length().z / h0;
+      if (++step % sample_every != 0) continue;
+      const auto t = stress();
+      const double p = metrics::mean_stress(t), q = metrics::deviatoric_stress(t);
+      const double ratio = p > 0.0 ? q / p : 0.0;
+      probe.rows.push_back({strain, real_kpa(p), real_kpa(q), ratio});
+      peak_ratio = std::max(peak_ratio, ratio);
+      if (strain >= 0.8 * s.probe_strain) {
+        steady_sum += ratio;
+        ++steady_reads;
+      }
+    }
+    out.add_phase(clock.stop(w, "probe", "axial strain of probe_strain at constant volume", true),
+                  {});
+  }
+  out.metrics["peak_stress_ratio"] = peak_ratio;
+  out.metrics["steady_stress_ratio"] = steady_reads ? steady_sum / steady_reads : 0.0;
+  out.series["probe"] = std::move(probe);
   out.metrics["jamming_fraction"] = phi_jam;
   out.metrics["final_pressure"] = real_kpa(p_final);
   out.metrics["final_coordination_number"] = metrics::coordination_number(w);

@@ -18,9 +18,10 @@ struct CompactionSettings {
   double points;       ///< targets, evenly spaced above phi_start up to phi_max
   double strain_rate;  ///< linear strain of the cell per critical time (quasi-static: << 1)
   double hold;         ///< hold at each target, in critical times
+  double probe_strain;  ///< axial strain of the constant-volume shear probe at phi_max; 0: none
   double time_step_safety;
 
-  static std::array<contact::ParamInfo<CompactionSettings>, 7> table() {
+  static std::array<contact::ParamInfo<CompactionSettings>, 8> table() {
     using S = CompactionSettings;
     return {{{"particles", "-", 20, 1e6, 300, "number of particles (bodies)", &S::particles},
              {"phi_start", "-", 0.05, 0.3, 0.2, "solid fraction of the random fill",
@@ -32,6 +33,9 @@ struct CompactionSettings {
               "linear strain of the cell per critical time sqrt(m/k) (quasi-static: << 1)",
               &S::strain_rate},
              {"hold", "-", 10, 1e5, 200, "hold at each target, in critical times", &S::hold},
+             {"probe_strain", "-", 0.0, 0.5, 0.1,
+              "axial strain of the constant-volume shear probe from phi_max (0: no probe)",
+              &S::probe_strain},
              {"time_step_safety", "-", 0.01, 1.0, 0.2,
               "time step as a fraction of the critical one", &S::time_step_safety}}};
   }

@@ -1,8 +1,9 @@
 // compaction (seed 004 §2.3-2.4): the contact stress tensor of two spheres touching across a
 // periodic face against its analytic value; frictionless spheres compacted in a periodic cell
 // jam near random close packing (O'Hern, Silbert, Liu and Nagel, Phys. Rev. E 68 (2003) 011306:
-// phi_J = 0.639 as N grows), frictional ones looser (random loose packing), and the pressure
-// rises steeply past jamming.
+// phi_J = 0.639 as N grows), frictional ones looser (random loose packing), the pressure rises
+// steeply past jamming, and the constant-volume shear probe finds a macroscopic friction that
+// frictionless spheres have too and friction raises.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -54,8 +55,8 @@ MaterialModel spheres(double mu_s) {
   return m;
 }
 
-TEST(Compaction, FrictionlessSpheresJamNearRandomClosePackingAndFrictionalOnesLooser) {
-  double jam[2] = {0, 0};
+TEST(Compaction, JammingAndShearOfFrictionlessAndFrictionalSpheres) {
+  double jam[2] = {0, 0}, steady[2] = {0, 0};
   for (int f = 0; f < 2; ++f)
     for (std::uint64_t seed : {1, 2}) {
       RunOptions o;
@@ -64,6 +65,8 @@ TEST(Compaction, FrictionlessSpheresJamNearRandomClosePackingAndFrictionalOnesLo
                                     {{"particles", 200}}, o);
       EXPECT_TRUE(out.flags.empty());
       jam[f] += 0.5 * out.metrics.at("jamming_fraction");
+      steady[f] += 0.5 * out.metrics.at("steady_stress_ratio");
+      EXPECT_GE(out.metrics.at("peak_stress_ratio"), out.metrics.at("steady_stress_ratio"));
       // Past jamming the held pressure rises steeply: at phi_max it is over 100 times that of
       // the last held state below the jamming fraction.
       const auto& held = out.series.at("held").rows;
@@ -79,6 +82,12 @@ TEST(Compaction, FrictionlessSpheresJamNearRandomClosePackingAndFrictionalOnesLo
   EXPECT_LT(jam[0], 0.66);
   // mu_s 0.5: 0.576 and 0.572 in the same build.
   EXPECT_LT(jam[1], jam[0] - 0.03);
+  // Sheared at constant volume, frictionless spheres keep a macroscopic friction (Peyneau and
+  // Roux, Phys. Rev. E 78 (2008) 011307: tau / p ~ 0.1, i.e. q / p ~ 0.2 in axisymmetric
+  // shear; 0.24 at seed 1), frictional ones far more (0.59 at seed 1).
+  EXPECT_GT(steady[0], 0.1);
+  EXPECT_LT(steady[0], 0.4);
+  EXPECT_GT(steady[1], 1.5 * steady[0]);
 }
 
 }  // namespace
