@@ -68,8 +68,15 @@ LabOutput run_compaction(const MaterialModel& material, const Settings& values,
   // Fill: inside the cell, every sphere clear of its faces, so none overlaps a periodic image.
   const PhaseClock fill_clock;
   Rng rng(options.seed);
-  fill_region(w, material_insert_request(material, particles::BoxRegion{w.domain.lo, w.domain.hi}, n),
-              rng, s.time_step_safety, material.factors().time);
+  try {
+    fill_region(w,
+                material_insert_request(material, particles::BoxRegion{w.domain.lo, w.domain.hi}, n),
+                rng, s.time_step_safety, material.factors().time);
+  } catch (const InputError& e) {
+    throw InputError("settings.phi_start",
+                     "the cell at this solid fraction cannot take the particles at random (" +
+                         e.message() + "); elongated clumps need a lower phi_start, e.g. 0.06");
+  }
   LabOutput out;
   out.add_phase(fill_clock.stop(w, "fill", "all particles inserted", true), {});
 
