@@ -1,5 +1,6 @@
 // compaction (seed 004 §2.3-2.4): the contact stress tensor of two spheres touching across a
-// periodic face against its analytic value; frictionless spheres compacted in a periodic cell
+// periodic face against its analytic value, and of a lattice between walls against the walls'
+// stress; frictionless spheres compacted in a periodic cell
 // jam near random close packing (O'Hern, Silbert, Liu and Nagel, Phys. Rev. E 68 (2003) 011306:
 // phi_J = 0.639 as N grows), frictional ones looser (random loose packing), the pressure rises
 // steeply past jamming, and the constant-volume shear probe finds a macroscopic friction that
@@ -12,6 +13,7 @@
 #include "core/lab/compaction.hpp"
 #include "core/metrics/stress.hpp"
 #include "core/sim/world.hpp"
+#include "core/walls/wall.hpp"
 
 namespace demcal::lab {
 namespace {
@@ -42,6 +44,47 @@ TEST(Compaction, ContactStressOfOnePairAcrossAPeriodicFace) {
       if (a != 0 || b != 0) EXPECT_NEAR(s[a][b], 0.0, 1e-12 * s[0][0]) << a << b;
   EXPECT_DOUBLE_EQ(metrics::mean_stress(s), s[0][0] / 3);
   EXPECT_NEAR(metrics::deviatoric_stress(s), s[0][0], 1e-12 * s[0][0]);  // |sigma_1 - sigma_3|
+}
+
+TEST(Compaction, ContactStressEqualsTheWallStressOfALatticeBetweenWalls) {
+  // A simple cubic lattice of 3 x 3 x 4 spheres, every neighbour pair overlapping by delta,
+  // periodic in x and y, between a floor and a lid that overlap the outer layers by delta: a
+  // static state in which every contact carries kn delta. Over the volume spanned by the centres
+  // (A times the height from the lowest to the highest layer) the tensor's sigma_zz is the walls'
+  // normal stress, and sigma_xx = sigma_yy that of the lateral bonds.
+  const double r = 1e-3, delta = 1e-5, kn = 1e4, a = 2 * r - delta;
+  const int nx = 3, nz = 4;
+  sim::World w;
+  w.gravity = {};
+  w.domain.lo = {0, 0, -1};
+  w.domain.hi = {nx * a, nx * a, 1};
+  w.domain.periodic = {true, true, false};
+  contact::ContactLawSpec spec;
+  spec.normal = {"linear", {{"kn", kn}, {"damping_ratio", 0.0}}};
+  spec.tangential = {"history", {{"mu_s", 0.5}}};
+  const auto law = contact::ContactLaw::from_spec(spec, "law");
+  w.set_pair_law(0, 0, law);
+  w.set_wall_law(0, 0, law);
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < nx; ++j)
+      for (int k = 0; k < nz; ++k)
+        w.particles.add_sphere({(i + 0.5) * a, (j + 0.5) * a, k * a}, r, 2500, 0);
+  w.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, -(r - delta)}, {0, 0, 1}}));
+  w.walls.push_back(
+      walls::make_wall("lid", walls::Plane{{0, 0, (nz - 1) * a + r - delta}, {0, 0, -1}}));
+  w.dt = 1e-8;
+  w.prepare();
+  const double area = nx * a * nx * a;
+  const double wall_stress = -w.walls[0].force.z / area;
+  EXPECT_NEAR(wall_stress, nx * nx * kn * delta / area, 1e-9 * wall_stress);
+  EXPECT_NEAR(w.walls[1].force.z / area, wall_stress, 1e-9 * wall_stress);
+  const auto s = metrics::contact_stress(w, area * (nz - 1) * a);
+  EXPECT_NEAR(s[2][2], wall_stress, 1e-9 * wall_stress);
+  // Lateral: nx^2 nz bonds along x, each kn delta over a, in the same volume.
+  const double lateral = nx * nx * nz * kn * delta * a / (area * (nz - 1) * a);
+  EXPECT_NEAR(s[0][0], lateral, 1e-9 * lateral);
+  EXPECT_NEAR(s[1][1], lateral, 1e-9 * lateral);
+  EXPECT_NEAR(s[0][1], 0.0, 1e-12 * lateral);
 }
 
 MaterialModel spheres(double mu_s) {
