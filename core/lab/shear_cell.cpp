@@ -80,6 +80,58 @@ struct Cell {
   double radius = 0.0, d = 0.0;
 };
 
+/// The vessel and floor of the small cell (docs/lab-tests.md, "shear_cell"): a frictionless
+/// vessel, so that the head's torque is the shear plane's and the floor measures the normal
+/// stress on it; a rough floor that holds the bed below the plane.
+void set_cell_wall_laws(sim::World& w, const MaterialModel& material, const ShearCellSettings& s) {
+  contact::ContactLawSpec vessel = material.wall_law, floor = material.wall_law;
+  vessel.tangential.params["mu_s"] = s.vessel_friction;
+  vessel.rolling = {"none", {}};
+  floor.tangential.params["mu_s"] = s.floor_friction;
+  if (s.floor_rolling > 0.0) floor.rolling = {"cdt", {{"mu_r", s.floor_rolling}}};
+  w.set_wall_law(kWallDie, 0, simulated_law(material, vessel));
+  w.set_wall_law(kWallBottom, 0, simulated_law(material, floor));
+}
+
+struct Line {
+  double slope, intercept;
+};
+
+/// The yield locus: least squares tau = slope sigma + intercept through the yield points (kPa).
+Line least_squares_line(const std::vector<double>& xs, const std::vector<double>& ys) {
+  const double n = static_cast<double>(xs.size());
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < xs.size(); ++i)
+    sx += xs[i], sy += ys[i], sxx += xs[i] * xs[i], sxy += xs[i] * ys[i];
+  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  return {slope, (sy - slope * sx) / n};
+}
+
+/// The locus, its Mohr evaluation and the yield shear stress of every step as metrics (and the
+/// note of an inconsistent pre-shear point).
+void add_locus_metrics(LabOutput& out, const Line& locus, const MohrResult& mohr,
+                       const std::vector<double>& yield_stress) {
+  out.metrics["yield_locus_slope"] = locus.slope;
+  out.metrics["yield_locus_intercept"] = locus.intercept;
+  out.metrics["mohr_consistent"] = mohr.consistent ? 1.0 : 0.0;
+  out.metrics["unconfined_yield_strength"] = mohr.sigma_c;
+  out.metrics["major_consolidation_stress"] = mohr.sigma_1;
+  out.metrics["ffc"] = mohr.ffc;
+  out.metrics["effective_friction_angle"] = mohr.phi_e;
+  for (std::size_t i = 0; i < yield_stress.size(); ++i) {
+    char name[64];
+    std::snprintf(name, sizeof name, "yield_shear_stress_%g", kShearNormalKPa[i]);
+    std::string key = name;
+    std::replace(key.begin(), key.end(), '.', 'p');  // yield_shear_stress_1p75
+    out.metrics[key] = yield_stress[i];
+  }
+  if (!mohr.consistent)
+    out.notes.push_back(
+        "mohr_consistent = 0: the pre-shear point lies above the yield locus (seed 000 Fig. 23b), "
+        "so no Mohr circle through it touches the locus; ffc, major_consolidation_stress and "
+        "effective_friction_angle are 0 (undefined)");
+}
+
 double shear_stress(const sim::World& w, double radius) {
   // Resisting torque of the bed on the head (the head turns about +z), T = (2/3) pi R^3 tau.
   return 3.0 * (-w.walls[kHead].torque.z) / (2.0 * M_PI * radius * radius * radius);
@@ -92,18 +144,7 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   require_pour(material, "shear_cell");
   const auto s = read_settings<ShearCellSettings>(values, "settings");
   sim::World w = make_material_world(material, options);
-  {
-    // The vessel and floor of the small cell (docs/lab-tests.md, "shear_cell"): a frictionless
-    // vessel, so that the head's torque is the shear plane's and the floor measures the normal
-    // stress on it; a rough floor that holds the bed below the plane.
-    contact::ContactLawSpec vessel = material.wall_law, floor = material.wall_law;
-    vessel.tangential.params["mu_s"] = s.vessel_friction;
-    vessel.rolling = {"none", {}};
-    floor.tangential.params["mu_s"] = s.floor_friction;
-    if (s.floor_rolling > 0.0) floor.rolling = {"cdt", {{"mu_r", s.floor_rolling}}};
-    w.set_wall_law(kWallDie, 0, simulated_law(material, vessel));
-    w.set_wall_law(kWallBottom, 0, simulated_law(material, floor));
-  }
+  set_cell_wall_laws(w, material, s);
   const auto sizes = material.simulated_sizes();
   const double r_max = particles::max_radius(sizes);
   const double d = 2.0 * r_max;
@@ -264,36 +305,12 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
     if (options.progress) options.progress(0.4 + 0.6 * (k + 1) / kShearNormalKPa.size());
   }
 
-  // Yield locus: least squares tau = slope sigma + intercept (kPa).
-  const double n = static_cast<double>(xs.size());
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < xs.size(); ++i)
-    sx += xs[i], sy += ys[i], sxx += xs[i] * xs[i], sxy += xs[i] * ys[i];
-  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-  const double intercept = (sy - slope * sx) / n;
-  const MohrResult mohr = mohr_evaluation(slope, intercept, sigma_pre / real_kpa, tau_pre / real_kpa);
-
+  const Line locus = least_squares_line(xs, ys);
+  const MohrResult mohr =
+      mohr_evaluation(locus.slope, locus.intercept, sigma_pre / real_kpa, tau_pre / real_kpa);
   out.metrics["pre_shear_stress"] = tau_pre / real_kpa;
   out.metrics["pre_shear_normal_stress"] = sigma_pre_measured / real_kpa;
-  out.metrics["yield_locus_slope"] = slope;
-  out.metrics["yield_locus_intercept"] = intercept;
-  out.metrics["mohr_consistent"] = mohr.consistent ? 1.0 : 0.0;
-  out.metrics["unconfined_yield_strength"] = mohr.sigma_c;
-  out.metrics["major_consolidation_stress"] = mohr.sigma_1;
-  out.metrics["ffc"] = mohr.ffc;
-  out.metrics["effective_friction_angle"] = mohr.phi_e;
-  for (std::size_t i = 0; i < xs.size(); ++i) {
-    char name[64];
-    std::snprintf(name, sizeof name, "yield_shear_stress_%g", kShearNormalKPa[i]);
-    std::string key = name;
-    std::replace(key.begin(), key.end(), '.', 'p');  // yield_shear_stress_1p75
-    out.metrics[key] = ys[i];
-  }
-  if (!mohr.consistent)
-    out.notes.push_back(
-        "mohr_consistent = 0: the pre-shear point lies above the yield locus (seed 000 Fig. 23b), "
-        "so no Mohr circle through it touches the locus; ffc, major_consolidation_stress and "
-        "effective_friction_angle are 0 (undefined)");
+  add_locus_metrics(out, locus, mohr, ys);
   out.series["pre_shear"] = std::move(pre);
   out.series["yield_points"] = std::move(points);
   out.series["mohr_circles"] = mohr_circles(mohr);
