@@ -350,15 +350,17 @@ double approach_speed(const ServoSettings& s, double target, double stress) {
   return inertial * s.speed_scale * std::sqrt(ref);
 }
 
-/// The phase's simulated time limit: the given one, or (rule) the whole bed height at the
-/// quasi-static speed of the larger of the start and target stresses (no phase compacts a bed by
-/// more than its height), plus 50 hold times. Without an inertial-number scale, the speed limit.
+/// The phase's simulated time limit: the given one, or (rule) twice the time to cross the whole
+/// bed height at the quasi-static speed of the larger of the start and target stresses (no phase
+/// compacts a bed by more than its height; the controller slows as the stress nears its target,
+/// and a loose cohesive first load needed 1.01 times the single crossing), plus 50 hold times.
+/// Without an inertial-number scale, the speed limit.
 double phase_time_limit(const ServoSettings& s, double target, double start) {
   if (s.max_time > 0.0) return s.max_time;
   const double v = s.speed_scale > 0.0 ? s.inertial_number * s.speed_scale *
                                              std::sqrt(std::max(target, std::abs(start)))
                                        : s.max_speed;
-  return s.height / v + 50.0 * s.hold_time;
+  return 2.0 * s.height / v + 50.0 * s.hold_time;
 }
 
 /// Moves the driven wall towards the target until the stress (a running mean over a quarter of
