@@ -96,7 +96,8 @@ nlohmann::json study_json(const lab::StudyResult& r, const std::string& test) {
   j["relative_change"] = r.relative_change;
   j["max_deviation_from_last"] = r.max_deviation_from_last;
   if (r.seeds >= 2) {
-    for (const auto& [name, from] : r.converged_from) j["converged_from"][name] = optional_json(from);
+    for (const auto& [name, from] : r.converged_from)
+      j["converged_from"][name] = optional_json(from);
     j["chosen"] = optional_json(r.chosen);
   }
   return j;
@@ -171,7 +172,8 @@ void list_labs() {
 /// The catalogue as Markdown: per test its metrics and its settings table (docs/lab-tests.md).
 void list_labs_markdown() {
   for (const auto& t : lab::lab_catalog()) {
-    std::cout << "### `" << t.name << "`\n\n" << t.description << " (" << t.source << ").\n\n"
+    std::cout << "### `" << t.name << "`\n\n"
+              << t.description << " (" << t.source << ").\n\n"
               << "| metric | unit | meaning |\n|---|---|---|\n";
     for (const auto& m : t.metrics)
       std::cout << "| `" << m.name << "` | " << m.unit << " | " << m.description << " |\n";
@@ -202,16 +204,18 @@ void add_lab_command(CLI::App& app) {
   study->add_option("spec", sopt->spec, "lab-run YAML")->required()->check(CLI::ExistingFile);
   study->add_option("--scale", sopt->scale, "scale factors, e.g. 1,2,4 (needs material.scaling)");
   study->add_option("--particles", sopt->particles, "particle counts, e.g. 200,400,800");
-  study->add_option("--seeds", sopt->seeds,
-                    "seeds per value (the spec's seed and the next ones); 2 or more: the size "
-                    "from which every metric stays within its seed-to-seed spread")
+  study
+      ->add_option("--seeds", sopt->seeds,
+                   "seeds per value (the spec's seed and the next ones); 2 or more: the size "
+                   "from which every metric stays within its seed-to-seed spread")
       ->check(CLI::Range(1, lab::kMaxStudySeeds));
   study->add_option("--out", sopt->out_dir, "directory for study.json, runs.csv, summary.csv");
   study->add_option("--threads", sopt->threads, "override the spec's thread count");
   study->callback([sopt] { run_lab_study(*sopt); });
   auto markdown = std::make_shared<bool>(false);
   auto* list = lab->add_subcommand("list", "List the lab tests, their metrics and settings");
-  list->add_flag("--markdown", *markdown, "as Markdown tables (the reference in docs/lab-tests.md)");
+  list->add_flag("--markdown", *markdown,
+                 "as Markdown tables (the reference in docs/lab-tests.md)");
   list->callback([markdown] { *markdown ? list_labs_markdown() : list_labs(); });
 }
 

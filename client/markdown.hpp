@@ -13,7 +13,9 @@
 namespace demcal::cli {
 
 /// A bound or default as printed in the tables: six digits, "none" for an unset value.
-inline std::string table_number(double v) { return std::isnan(v) ? "none" : fmt(v, 6); }
+inline std::string table_number(double v) {
+  return std::isnan(v) ? "none" : fmt(v, 6);
+}
 
 /// One row per parameter: name, unit, valid range, default, meaning; `first_column` heads the
 /// names.

@@ -172,8 +172,8 @@ diagnose::Options diagnose_options(const v1::DiagnoseOptions& o, const std::stri
   out.aspect_ratio_max =
       option(o.aspect_ratio_max(), out.aspect_ratio_max, 1.0, 20.0, where + ".aspect_ratio_max");
   out.rolling_max = option(o.rolling_max(), out.rolling_max, 0.0, 10.0, where + ".rolling_max");
-  out.sigma_g_max = option(o.sigma_g_max(), out.sigma_g_max, diagnose::kSigmaGLow, 10.0,
-                           where + ".sigma_g_max");
+  out.sigma_g_max =
+      option(o.sigma_g_max(), out.sigma_g_max, diagnose::kSigmaGLow, 10.0, where + ".sigma_g_max");
   out.fixed_span = option(o.fixed_span(), out.fixed_span, 1.0, 100.0, where + ".fixed_span");
   out.margin = option(o.margin(), out.margin, 0.0, 0.99, where + ".margin");
   return out;

@@ -270,8 +270,9 @@ void fall_at_terminal_velocity(sim::World& w, const MaterialModel& material,
 void require_pour(const MaterialModel& material, const std::string& test) {
   if (pours_only(test) && material.preparation.method != PreparationMethod::kPour)
     throw InputError("material.preparation.method",
-                     "the " + test + " test builds its bed by pouring only: use 'pour' or leave "
-                     "preparation out");
+                     "the " + test +
+                         " test builds its bed by pouring only: use 'pour' or leave "
+                         "preparation out");
 }
 
 PreparedBed prepare_and_settle(sim::World& w, const MaterialModel& material, const BedSpec& spec,
@@ -292,8 +293,8 @@ PreparedBed prepare_and_settle(sim::World& w, const MaterialModel& material, con
       break;
   }
   PreparedBed out;
-  out.prepared = clock.stop(
-      w, "prepare " + preparation_method_name(material.preparation.method), "its fixed time", true);
+  out.prepared = clock.stop(w, "prepare " + preparation_method_name(material.preparation.method),
+                            "its fixed time", true);
   out.settled = settle(w, spec, limits, material.factors().time);
   // The settled bed keeps its contacts' history under the full law.
   if (material.preparation.method != PreparationMethod::kClusters &&

@@ -58,9 +58,8 @@ LabOutput run_compaction(const MaterialModel& material, const Settings& values,
   sim::World w = make_material_world(material, options);
   w.gravity = {0.0, 0.0, 0.0};
   const auto n = static_cast<std::size_t>(s.particles);
-  const double side =
-      std::cbrt(expected_solid_volume(material.simulated_sizes(), s.particles, options.seed) /
-                s.phi_start);
+  const double side = std::cbrt(
+      expected_solid_volume(material.simulated_sizes(), s.particles, options.seed) / s.phi_start);
   w.domain.lo = {0.0, 0.0, 0.0};
   w.domain.hi = {side, side, side};
   w.domain.periodic = {true, true, true};
@@ -69,9 +68,9 @@ LabOutput run_compaction(const MaterialModel& material, const Settings& values,
   const PhaseClock fill_clock;
   Rng rng(options.seed);
   try {
-    fill_region(w,
-                material_insert_request(material, particles::BoxRegion{w.domain.lo, w.domain.hi}, n),
-                rng, s.time_step_safety, material.factors().time);
+    fill_region(
+        w, material_insert_request(material, particles::BoxRegion{w.domain.lo, w.domain.hi}, n),
+        rng, s.time_step_safety, material.factors().time);
   } catch (const InputError& e) {
     throw InputError("settings.phi_start",
                      "the cell at this solid fraction cannot take the particles at random (" +
@@ -157,8 +156,9 @@ LabOutput run_compaction(const MaterialModel& material, const Settings& values,
       phi_jam = before[0] + (row[0] - before[0]) * (threshold - before[1]) / (row[1] - before[1]);
     }
   }
-  PhaseCost jam{"jamming", "contact pressure above 1e-2 of the final before phi_max", 0, 0.0, 0.0,
-                jammed && p_final > 0.0};
+  PhaseCost jam{"jamming", "contact pressure above 1e-2 of the final before phi_max",
+                0,         0.0,
+                0.0,       jammed && p_final > 0.0};
   out.add_phase(jam, {"jamming_fraction"});
   // Probe: axisymmetric shear at constant volume from the state held at phi_max (the cell
   // shortened along z, widened equally along x and y), its stress ratio q / p read every 0.002

@@ -13,19 +13,18 @@ namespace demcal::lab {
 struct CompactionSettings {
   static constexpr const char* kName = "compaction";
   double particles;
-  double phi_start;    ///< solid fraction of the random fill
-  double phi_max;      ///< the last target
-  double points;       ///< targets, evenly spaced above phi_start up to phi_max
-  double strain_rate;  ///< linear strain of the cell per critical time (quasi-static: << 1)
-  double hold;         ///< hold at each target, in critical times
+  double phi_start;     ///< solid fraction of the random fill
+  double phi_max;       ///< the last target
+  double points;        ///< targets, evenly spaced above phi_start up to phi_max
+  double strain_rate;   ///< linear strain of the cell per critical time (quasi-static: << 1)
+  double hold;          ///< hold at each target, in critical times
   double probe_strain;  ///< axial strain of the constant-volume shear probe at phi_max; 0: none
   double time_step_safety;
 
   static std::array<contact::ParamInfo<CompactionSettings>, 8> table() {
     using S = CompactionSettings;
     return {{{"particles", "-", 20, 1e6, 300, "number of particles (bodies)", &S::particles},
-             {"phi_start", "-", 0.05, 0.3, 0.2, "solid fraction of the random fill",
-              &S::phi_start},
+             {"phi_start", "-", 0.05, 0.3, 0.2, "solid fraction of the random fill", &S::phi_start},
              {"phi_max", "-", 0.36, 0.9, 0.7, "last target solid fraction", &S::phi_max},
              {"points", "-", 1, 50, 8,
               "targets held and read, evenly spaced above phi_start up to phi_max", &S::points},

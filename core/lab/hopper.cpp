@@ -26,6 +26,7 @@
 #include <cmath>
 
 #include "core/common/error.hpp"
+#include "core/common/line_fit.hpp"
 #include "core/common/rng.hpp"
 #include "core/io/vtk.hpp"
 #include "core/lab/bed.hpp"
@@ -89,7 +90,8 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
   // 1. Fill, prepare (a lid at the top of the fill region) and settle with the gate closed.
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.5;
-  const PreparedBed built = prepare_and_settle(w, material, settle_spec, limits, h + bin, options.seed);
+  const PreparedBed built =
+      prepare_and_settle(w, material, settle_spec, limits, h + bin, options.seed);
 
   // Bulk density of the settled bed: a box in the middle of the wedge, two diameters from the
   // walls (at its height the wedge is wider than the box).
@@ -166,16 +168,12 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
   // Discharge rate: least-squares slope of the mass-time curve between 15 % and 75 % of the
   // discharged mass (after the start-up, before the hopper runs empty).
   const double m_end = discharged;
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  int n = 0;
+  LineFit fit;
   for (const auto& row : curve.rows)
-    if (row[1] >= 0.15 * m_end && row[1] <= 0.75 * m_end) {
-      sx += row[0], sy += row[1], sxx += row[0] * row[0], sxy += row[0] * row[1];
-      ++n;
-    }
+    if (row[1] >= 0.15 * m_end && row[1] <= 0.75 * m_end) fit.add(row[0], row[1]);
   double rate = 0.0;
-  if (n >= 3 && n * sxx - sx * sx > 0.0)
-    rate = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  if (fit.points() >= 3 && fit.defined())
+    rate = fit.slope();
   else if (curve.rows.size() >= 2 && curve.rows.back()[0] > 0.0)
     rate = m_end / curve.rows.back()[0];
 

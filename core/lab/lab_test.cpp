@@ -47,16 +47,12 @@ void poll_progress() {
 }
 
 const std::map<std::string, LabRunner>& lab_runners() {
-  // One line per lab test; its catalogue entry (name, metrics, settings) is in catalog.cpp.
+  // One entry per lab test; its catalogue entry (name, metrics, settings) is in catalog.cpp.
   static const std::map<std::string, LabRunner> runners{
-      {"packing", run_packing},
-      {"confined_compression", run_confined_compression},
-      {"tensile", run_tensile},
-      {"wall_friction", run_wall_friction},
-      {"shear_cell", run_shear_cell},
-      {"rotating_drum", run_rotating_drum},
-      {"hopper", run_hopper},
-      {"compaction", run_compaction},
+      {"packing", run_packing},       {"confined_compression", run_confined_compression},
+      {"tensile", run_tensile},       {"wall_friction", run_wall_friction},
+      {"shear_cell", run_shear_cell}, {"rotating_drum", run_rotating_drum},
+      {"hopper", run_hopper},         {"compaction", run_compaction},
   };
   return runners;
 }

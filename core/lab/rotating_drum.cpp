@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/common/line_fit.hpp"
 #include "core/common/rng.hpp"
 #include "core/io/vtk.hpp"
 #include "core/lab/bed.hpp"
@@ -119,16 +120,11 @@ double DrumImage::surface_angle() const {
   // half, away from the toe and the shoulder.
   const double lo = points.front().first, hi = points.back().first;
   const double a = lo + 0.25 * (hi - lo), b = lo + 0.75 * (hi - lo);
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  int m = 0;
+  LineFit fit;
   for (const auto& [x, y] : points)
-    if (x >= a && x <= b) {
-      sx += x, sy += y, sxx += x * x, sxy += x * y;
-      ++m;
-    }
-  if (m < 3 || m * sxx - sx * sx <= 0.0) return 0.0;
-  const double slope = (m * sxy - sx * sy) / (m * sxx - sx * sx);
-  return std::atan(std::abs(slope)) * 180.0 / M_PI;
+    if (x >= a && x <= b) fit.add(x, y);
+  if (fit.points() < 3 || !fit.defined()) return 0.0;
+  return std::atan(std::abs(fit.slope())) * 180.0 / M_PI;
 }
 
 LabOutput run_rotating_drum(const MaterialModel& material, const Settings& values,

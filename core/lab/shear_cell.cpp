@@ -25,6 +25,7 @@
 #include <cmath>
 #include <deque>
 
+#include "core/common/line_fit.hpp"
 #include "core/common/rng.hpp"
 #include "core/io/vtk.hpp"
 #include "core/lab/bed.hpp"
@@ -93,26 +94,12 @@ void set_cell_wall_laws(sim::World& w, const MaterialModel& material, const Shea
   w.set_wall_law(kWallBottom, 0, simulated_law(material, floor));
 }
 
-struct Line {
-  double slope, intercept;
-};
-
-/// The yield locus: least squares tau = slope sigma + intercept through the yield points (kPa).
-Line least_squares_line(const std::vector<double>& xs, const std::vector<double>& ys) {
-  const double n = static_cast<double>(xs.size());
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < xs.size(); ++i)
-    sx += xs[i], sy += ys[i], sxx += xs[i] * xs[i], sxy += xs[i] * ys[i];
-  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-  return {slope, (sy - slope * sx) / n};
-}
-
 /// The locus, its Mohr evaluation and the yield shear stress of every step as metrics (and the
 /// note of an inconsistent pre-shear point).
-void add_locus_metrics(LabOutput& out, const Line& locus, const MohrResult& mohr,
+void add_locus_metrics(LabOutput& out, const LineFit& locus, const MohrResult& mohr,
                        const std::vector<double>& yield_stress) {
-  out.metrics["yield_locus_slope"] = locus.slope;
-  out.metrics["yield_locus_intercept"] = locus.intercept;
+  out.metrics["yield_locus_slope"] = locus.slope();
+  out.metrics["yield_locus_intercept"] = locus.intercept();
   out.metrics["mohr_consistent"] = mohr.consistent ? 1.0 : 0.0;
   out.metrics["unconfined_yield_strength"] = mohr.sigma_c;
   out.metrics["major_consolidation_stress"] = mohr.sigma_1;
@@ -229,8 +216,8 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
       ++tau_n;
     }
     if (ww.step_count % record == 0)
-      pre.rows.push_back(
-          {ww.time, floor_stress(ww) / real_kpa, shear_stress(ww, r_head) / real_kpa, t * s.tip_speed / d});
+      pre.rows.push_back({ww.time, floor_stress(ww) / real_kpa, shear_stress(ww, r_head) / real_kpa,
+                          t * s.tip_speed / d});
     if (options.progress) options.progress(0.4 * t / pre_time);
     return true;
   });
@@ -305,9 +292,11 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
     if (options.progress) options.progress(0.4 + 0.6 * (k + 1) / kShearNormalKPa.size());
   }
 
-  const Line locus = least_squares_line(xs, ys);
+  // The yield locus: least squares tau = slope sigma + intercept through the yield points (kPa).
+  LineFit locus;
+  for (std::size_t i = 0; i < xs.size(); ++i) locus.add(xs[i], ys[i]);
   const MohrResult mohr =
-      mohr_evaluation(locus.slope, locus.intercept, sigma_pre / real_kpa, tau_pre / real_kpa);
+      mohr_evaluation(locus.slope(), locus.intercept(), sigma_pre / real_kpa, tau_pre / real_kpa);
   out.metrics["pre_shear_stress"] = tau_pre / real_kpa;
   out.metrics["pre_shear_normal_stress"] = sigma_pre_measured / real_kpa;
   add_locus_metrics(out, locus, mohr, ys);

@@ -106,8 +106,8 @@ StudyResult run_study(const std::string& test, const MaterialModel& material,
       RunOptions o = options;
       o.seed = options.seed + static_cast<std::uint64_t>(k);
       LabOutput out = run_lab_test(test, m, s, o);
-      run.replicates.push_back({o.seed, std::move(out.metrics), std::move(out.flags),
-                                out.cost.wall_seconds});
+      run.replicates.push_back(
+          {o.seed, std::move(out.metrics), std::move(out.flags), out.cost.wall_seconds});
     }
     run.particles = counted ? s["particles"] : run.replicates.front().metrics.at("particles");
     summarise(run);

@@ -8,9 +8,8 @@ namespace demcal::sim {
 /// Pair (i, j) at separation d = x_j - x_i (minimum image) of length dist > 0, with radii, masses,
 /// velocities and spins of both; dt is the time step the tangential spring integrates over.
 inline contact::PairInput particle_pair_input(const Vec3& d, double dist, double ri, double rj,
-                                              double mi, double mj, const Vec3& vi,
-                                              const Vec3& vj, const Vec3& wi, const Vec3& wj,
-                                              double dt) {
+                                              double mi, double mj, const Vec3& vi, const Vec3& vj,
+                                              const Vec3& wi, const Vec3& wj, double dt) {
   // R* = ri rj / (ri + rj) and m* = mi mj / (mi + mj) share one division.
   const double inv_sums = 1.0 / ((ri + rj) * (mi + mj));
   contact::PairInput in;

@@ -1,6 +1,6 @@
 #pragma once
 // Small materials for the lab-test tests: soft Luding spheres of 1 mm radius so that a
-// few hundred particles run in seconds.
+// few hundred particles run in seconds, and cohesionless Hertz spheres.
 #include "core/lab/lab_test.hpp"
 
 namespace demcal::lab::testing {
@@ -21,6 +21,18 @@ inline MaterialModel soft_luding(double youngs = 1e7, double k2_ratio = 5.0, dou
   m.wall_law.tangential.params["mu_s"] = mu_wall;
   m.sizes = particles::Monodisperse{1e-3};
   m.density = 1500.0;
+  return m;
+}
+
+/// Cohesionless Hertz spheres of 1 mm radius with sliding friction mu_s (no rolling resistance).
+inline MaterialModel hertz_spheres(double mu_s) {
+  MaterialModel m;
+  m.particle_law.normal = {
+      "hertz", {{"youngs_modulus", 5e7}, {"poisson_ratio", 0.25}, {"restitution", 0.5}}};
+  m.particle_law.tangential = {"history", {{"mu_s", mu_s}}};
+  m.wall_law = m.particle_law;
+  m.sizes = particles::Monodisperse{1e-3};
+  m.density = 2500.0;
   return m;
 }
 

@@ -14,6 +14,7 @@
 #include "core/metrics/stress.hpp"
 #include "core/sim/world.hpp"
 #include "core/walls/wall.hpp"
+#include "lab_test_util.hpp"
 
 namespace demcal::lab {
 namespace {
@@ -87,24 +88,13 @@ TEST(Compaction, ContactStressEqualsTheWallStressOfALatticeBetweenWalls) {
   EXPECT_NEAR(s[0][1], 0.0, 1e-12 * lateral);
 }
 
-MaterialModel spheres(double mu_s) {
-  MaterialModel m;
-  m.particle_law.normal = {"hertz",
-                           {{"youngs_modulus", 5e7}, {"poisson_ratio", 0.25}, {"restitution", 0.5}}};
-  m.particle_law.tangential = {"history", {{"mu_s", mu_s}}};
-  m.wall_law = m.particle_law;
-  m.sizes = particles::Monodisperse{1e-3};
-  m.density = 2500;
-  return m;
-}
-
 TEST(Compaction, JammingAndShearOfFrictionlessAndFrictionalSpheres) {
   double jam[2] = {0, 0}, steady[2] = {0, 0};
   for (int f = 0; f < 2; ++f)
     for (std::uint64_t seed : {1, 2}) {
       RunOptions o;
       o.seed = seed;
-      const auto out = run_lab_test("compaction", spheres(f == 0 ? 0.0 : 0.5),
+      const auto out = run_lab_test("compaction", testing::hertz_spheres(f == 0 ? 0.0 : 0.5),
                                     {{"particles", 200}}, o);
       EXPECT_TRUE(out.flags.empty());
       jam[f] += 0.5 * out.metrics.at("jamming_fraction");

@@ -28,18 +28,6 @@ TEST(Packing, CohesionlessPouringIsRandomPacking) {
   EXPECT_GT(out.metrics.at("coordination_number"), 4.0);
 }
 
-/// Cohesionless Hertz spheres of 1 mm radius with sliding friction mu_s (no rolling resistance).
-MaterialModel hertz_spheres(double mu_s) {
-  MaterialModel m;
-  m.particle_law.normal = {
-      "hertz", {{"youngs_modulus", 5e7}, {"poisson_ratio", 0.25}, {"restitution", 0.5}}};
-  m.particle_law.tangential = {"history", {{"mu_s", mu_s}}};
-  m.wall_law = m.particle_law;
-  m.sizes = particles::Monodisperse{1e-3};
-  m.density = 2500.0;
-  return m;
-}
-
 // Random close packing of frictionless mono-sized spheres: phi = 0.637 (Scott & Kilgour, J. Phys.
 // D 2 (1969) 863) to 0.64 with the isostatic coordination number 6 (O'Hern et al., Phys. Rev. E
 // 68 (2003) 011306). Friction (mu = 0.5) jams the pour looser, near random loose packing
@@ -48,10 +36,10 @@ MaterialModel hertz_spheres(double mu_s) {
 // particles: 0.644, Z 6.17 and 0.590, Z 4.81).
 TEST(Packing, FrictionlessPouringIsRandomClosePacking) {
   const Settings settings{{"particles", 500}, {"wall_margin", 2}};
-  const auto smooth = run_lab_test("packing", hertz_spheres(0.0), settings, {});
+  const auto smooth = run_lab_test("packing", testing::hertz_spheres(0.0), settings, {});
   EXPECT_NEAR(smooth.metrics.at("solid_fraction"), 0.64, 0.015);
   EXPECT_NEAR(smooth.metrics.at("coordination_number"), 6.0, 0.5);
-  const auto rough = run_lab_test("packing", hertz_spheres(0.5), settings, {});
+  const auto rough = run_lab_test("packing", testing::hertz_spheres(0.5), settings, {});
   EXPECT_NEAR(rough.metrics.at("solid_fraction"), 0.59, 0.02);
   EXPECT_LT(rough.metrics.at("coordination_number"),
             smooth.metrics.at("coordination_number") - 0.5);
@@ -96,8 +84,7 @@ TEST(Packing, VanDerWaalsSolidFractionFallsWithParticleSize) {
     for (std::uint64_t seed : {1, 2}) {
       RunOptions opt;
       opt.seed = seed;
-      sum += run_lab_test("packing", m, {{"particles", 150}}, opt)
-                 .metrics.at("solid_fraction");
+      sum += run_lab_test("packing", m, {{"particles", 150}}, opt).metrics.at("solid_fraction");
     }
     phi.push_back(0.5 * sum);
   }

@@ -122,9 +122,9 @@ TEST(Study, SeedsGiveMeansSpreadsAndTheChosenSize) {
   }
   EXPECT_THROW(run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120}, 0),
                InputError);
-  EXPECT_THROW(run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120},
-                         kMaxStudySeeds + 1),
-               InputError);
+  EXPECT_THROW(
+      run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120}, kMaxStudySeeds + 1),
+      InputError);
 }
 
 TEST(Study, CoarseGrainingAtAFixedCountIsASimilarity) {
