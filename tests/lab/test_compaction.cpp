@@ -46,7 +46,9 @@ TEST(Compaction, ContactStressOfOnePairAcrossAPeriodicFace) {
   EXPECT_NEAR(s[0][0], fn * gap / volume, 1e-9 * fn * gap / volume);
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b)
-      if (a != 0 || b != 0) EXPECT_NEAR(s[a][b], 0.0, 1e-12 * s[0][0]) << a << b;
+      if (a != 0 || b != 0) {
+        EXPECT_NEAR(s[a][b], 0.0, 1e-12 * s[0][0]) << a << b;
+      }
   EXPECT_DOUBLE_EQ(metrics::mean_stress(s), s[0][0] / 3);
   EXPECT_NEAR(metrics::deviatoric_stress(s), s[0][0], 1e-12 * s[0][0]);  // |sigma_1 - sigma_3|
 }
