@@ -103,7 +103,8 @@ metrics::Tensor3 compress(Cell& c, const CompactionSettings& s, const RunOptions
   Series compression{{"solid_fraction", "pressure_kpa", "deviatoric_kpa", "coordination_number"},
                      {}};
   Series held{{"solid_fraction", "pressure_kpa", "deviatoric_kpa", "coordination_number",
-               "s_xx_kpa", "s_yy_kpa", "s_zz_kpa", "s_xy_kpa", "s_xz_kpa", "s_yz_kpa"},
+               "s_xx_kpa", "s_yy_kpa", "s_zz_kpa", "s_xy_kpa", "s_xz_kpa", "s_yz_kpa", "s_yx_kpa",
+               "s_zx_kpa", "s_zy_kpa"},
               {}};
   sim::World& w = c.w;
   const int points = static_cast<int>(std::lround(s.points));
@@ -132,7 +133,8 @@ metrics::Tensor3 compress(Cell& c, const CompactionSettings& s, const RunOptions
     held.rows.push_back({c.phi(), c.kpa(metrics::mean_stress(last)),
                          c.kpa(metrics::deviatoric_stress(last)), metrics::coordination_number(w),
                          c.kpa(last[0][0]), c.kpa(last[1][1]), c.kpa(last[2][2]), c.kpa(last[0][1]),
-                         c.kpa(last[0][2]), c.kpa(last[1][2])});
+                         c.kpa(last[0][2]), c.kpa(last[1][2]), c.kpa(last[1][0]), c.kpa(last[2][0]),
+                         c.kpa(last[2][1])});
     out.add_phase(clock.stop(w, name, "solid fraction reached, then held", true), {});
     if (options.progress) options.progress(static_cast<double>(k) / points);
   }

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "core/contact/contact_law.hpp"
 #include "core/lab/compaction.hpp"
@@ -94,6 +95,55 @@ TEST(Compaction, ContactStressEqualsTheWallStressOfALatticeBetweenWalls) {
   EXPECT_NEAR(s[0][1], 0.0, 1e-12 * lateral);
 }
 
+TEST(Compaction, ContactPressureIsTheEnergyRoutePressureOfARandomPacking) {
+  // 60 spheres (radii 0.8-1.2 mm) at random in a periodic cube at a solid fraction of 0.7, held
+  // by linear springs f = kn delta (elastic energy kn delta^2 / 2 per contact) with fresh
+  // tangential springs. The pressure is -dU/dV under an affine change of the cell (the static
+  // virial theorem), computed here from the overlaps alone, and must equal the trace of the
+  // Love-Weber tensor over 3; with central forces the tensor is symmetric.
+  const double kn = 1e4, side = 1e-2;
+  sim::World w;
+  w.gravity = {};
+  w.domain.lo = {0, 0, 0};
+  w.domain.hi = {side, side, side};
+  w.domain.periodic = {true, true, true};
+  contact::ContactLawSpec spec;
+  spec.normal = {"linear", {{"kn", kn}, {"damping_ratio", 0.0}}};
+  spec.tangential = {"history", {{"mu_s", 0.5}}};
+  w.set_pair_law(0, 0, contact::ContactLaw::from_spec(spec, "law"));
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double solid = 0.0;
+  while (solid < 0.7 * side * side * side) {
+    const double r = 1e-3 * (0.8 + 0.4 * u(rng));
+    w.particles.add_sphere({side * u(rng), side * u(rng), side * u(rng)}, r, 2500, 0);
+    solid += 4.0 / 3.0 * M_PI * r * r * r;
+  }
+  w.dt = 1e-8;
+  w.prepare();
+  const auto& p = w.particles;
+  // U of the cell scaled affinely by f about the origin (minimum images in the scaled cell).
+  auto energy = [&](double f) {
+    double u_sum = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      for (std::size_t j = i + 1; j < p.size(); ++j) {
+        Vec3 d = f * (p.x[j] - p.x[i]);
+        for (double* c : {&d.x, &d.y, &d.z}) *c -= f * side * std::round(*c / (f * side));
+        const double delta = p.radius[i] + p.radius[j] - norm(d);
+        if (delta > 0.0) u_sum += 0.5 * kn * delta * delta;
+      }
+    return u_sum;
+  };
+  const double eps = 1e-6, volume = side * side * side;
+  const double dv = volume * (std::pow(1 + eps, 3) - std::pow(1 - eps, 3));
+  const double p_energy = -(energy(1 + eps) - energy(1 - eps)) / dv;
+  const auto s = metrics::contact_stress(w, volume);
+  ASSERT_GT(p_energy, 0.0);
+  EXPECT_NEAR(metrics::mean_stress(s), p_energy, 1e-6 * p_energy);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < a; ++b) EXPECT_NEAR(s[a][b], s[b][a], 1e-12 * p_energy) << a << b;
+}
+
 TEST(Compaction, ModifiedCamClayFitRecoversTheEllipse) {
   // q^2 = M^2 p (p_c - p) at M = 0.8, p_c = 300, on five pressures.
   std::vector<metrics::YieldPoint> points;
@@ -134,6 +184,10 @@ TEST(Compaction, JammingShearAndYieldOfFrictionlessAndFrictionalSpheres) {
       ASSERT_EQ(yield.size(), 5u);
       EXPECT_EQ(yield.back()[0], 90.0);  // the constant-volume path
       shear_yield[f] += 0.5 * yield.back()[3];
+      // Held at phi_max, the packing is near equilibrium: its tensor symmetric with friction too
+      // (the contacts' torques balance), to 0.2 % of the pressure (0.02 % at seed 1, mu_s 0.5).
+      const auto& last = out.series.at("held").rows.back();  // ..., s_xy, s_xz, s_yz, s_yx, ...
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(last[7 + k], last[10 + k], 0.002 * last[1]) << k;
       if (f == 1) {  // an ellipse whose slope is near the friction line of the shear probe
         EXPECT_GT(out.metrics.at("yield_cap_pressure"), p_final);
         EXPECT_GT(out.metrics.at("yield_slope"), 0.3);
