@@ -25,59 +25,71 @@ struct DiagnoseOptions {
   std::uint64_t seed = 1;
 };
 
-std::string pct(const nlohmann::json& v) {
-  if (!v.is_number()) return "-";
+/// A relative error as a percentage; "-" while it waits for a simulation.
+std::string pct(bool known, double v) {
+  if (!known) return "-";
   std::ostringstream s;
-  s << std::fixed << std::setprecision(1) << 100.0 * v.get<double>() << " %";
+  s << std::fixed << std::setprecision(1) << 100.0 * v << " %";
   return s.str();
 }
 
-std::string num(const nlohmann::json& v) {
-  if (!v.is_number()) return "-";
+std::string num(bool known, double v) {
+  if (!known) return "-";
   std::ostringstream s;
-  s << std::setprecision(4) << v.get<double>();
+  s << std::setprecision(4) << v;
   return s.str();
 }
 
-void print_report(std::ostream& out, const nlohmann::json& r) {
+void print_metrics(std::ostream& out, const v1::DiagnosisReport& r) {
   out << "\nmeasured metrics against the factor box and the best calibration "
          "(seed 000 Tables 10-15)\n";
   out << std::left << std::setw(38) << "metric" << std::right << std::setw(11) << "target"
       << std::setw(11) << "env min" << std::setw(11) << "env max" << std::setw(11) << "predicted"
       << std::setw(11) << "simulated" << std::setw(10) << "error" << std::setw(10) << "curv. p"
       << "\n";
-  for (const auto& m : r["metrics"]) {
-    std::string name = m["response"].get<std::string>() + (m["holdout"] ? " (held out)" : "");
-    out << std::left << std::setw(38) << name << std::right << std::setw(11) << num(m["target"])
-        << std::setw(11) << num(m["envelope_min"]) << std::setw(11) << num(m["envelope_max"])
-        << std::setw(11) << num(m["predicted"]) << std::setw(11) << num(m["simulated"])
-        << std::setw(10) << pct(m["relative_error"]) << std::setw(10) << num(m["curvature_p"])
-        << "\n";
-    if (!m["reachable"]) out << "    " << m["statement"].get<std::string>() << "\n";
+  for (const auto& m : r.metrics()) {
+    const std::string name = m.response() + (m.holdout() ? " (held out)" : "");
+    out << std::left << std::setw(38) << name << std::right << std::setw(11)
+        << num(true, m.target()) << std::setw(11) << num(true, m.envelope_min()) << std::setw(11)
+        << num(true, m.envelope_max()) << std::setw(11) << num(true, m.predicted()) << std::setw(11)
+        << num(m.has_simulated(), m.simulated()) << std::setw(10)
+        << pct(m.has_relative_error(), m.relative_error()) << std::setw(10)
+        << num(m.has_curvature_p(), m.curvature_p()) << "\n";
+    if (!m.reachable()) out << "    " << m.statement() << "\n";
   }
-  const auto& b = r["baseline"];
-  out << "baseline RMS error: predicted " << pct(b["predicted_rms"]) << ", verified "
-      << pct(b["verified_rms"]) << ", held out " << pct(b["holdout_rms"]) << "\n";
-  out << "\nmetrics that pull against each other\n";
-  if (r["conflicts"].empty()) out << "  none (each metric's own best fit keeps the others near)\n";
-  for (const auto& c : r["conflicts"]) out << "  " << c["statement"].get<std::string>() << "\n";
+  const auto& b = r.baseline();
+  out << "baseline RMS error: predicted " << pct(b.has_predicted_rms(), b.predicted_rms())
+      << ", verified " << pct(b.has_verified_rms(), b.verified_rms()) << ", held out "
+      << pct(b.has_holdout_rms(), b.holdout_rms()) << "\n";
+}
+
+void print_candidates(std::ostream& out, const v1::DiagnosisReport& r) {
   out << "\ncandidate causes, each tested by simulation (best first)\n";
   out << std::left << std::setw(14) << "candidate" << std::right << std::setw(6) << "runs"
       << std::setw(13) << "mispredicted" << std::setw(11) << "predicted" << std::setw(10)
       << "verified" << std::setw(8) << "rounds" << std::setw(10) << "held out" << std::setw(10)
       << "explains"
       << "\n";
-  for (const auto& c : r["candidates"]) {
-    out << std::left << std::setw(14) << c["id"].get<std::string>() << std::right << std::setw(6)
-        << c["runs"].get<int>() << std::setw(13) << pct(c["design_misprediction"]) << std::setw(11)
-        << pct(c["predicted_rms"]) << std::setw(10) << pct(c["verified_rms"]) << std::setw(8)
-        << c["rounds"].get<int>() << std::setw(10) << pct(c["holdout_rms"]) << std::setw(10)
-        << (c["explains"] ? "yes" : "no") << "\n";
-    out << "    " << c["cause"].get<std::string>() << " [" << c["state"].get<std::string>() << "]";
-    if (!c["evidence"].get<std::string>().empty()) out << ": " << c["evidence"].get<std::string>();
+  for (const auto& c : r.candidates()) {
+    out << std::left << std::setw(14) << c.id() << std::right << std::setw(6) << c.runs()
+        << std::setw(13) << pct(c.has_design_misprediction(), c.design_misprediction())
+        << std::setw(11) << pct(c.has_predicted_rms(), c.predicted_rms()) << std::setw(10)
+        << pct(c.has_verified_rms(), c.verified_rms()) << std::setw(8) << c.rounds()
+        << std::setw(10) << pct(c.has_holdout_rms(), c.holdout_rms()) << std::setw(10)
+        << (c.explains() ? "yes" : "no") << "\n";
+    out << "    " << c.cause() << " [" << c.state() << "]";
+    if (!c.evidence().empty()) out << ": " << c.evidence();
     out << "\n";
   }
-  out << "\n" << r["conclusion"].get<std::string>() << "\n";
+}
+
+void print_report(std::ostream& out, const v1::DiagnosisReport& r) {
+  print_metrics(out, r);
+  out << "\nmetrics that pull against each other\n";
+  if (r.conflicts().empty()) out << "  none (each metric's own best fit keeps the others near)\n";
+  for (const auto& c : r.conflicts()) out << "  " << c.statement() << "\n";
+  print_candidates(out, r);
+  out << "\n" << r.conclusion() << "\n";
 }
 
 /// Calls Diagnose until it is done, running the campaign's jobs in between (or once, without
@@ -99,20 +111,19 @@ v1::DiagnoseReply drive(v1::CampaignService::Stub& stub, const proto::ChannelOpt
 }
 
 void report(const v1::DiagnoseReply& reply, const std::string& format) {
-  const auto r = nlohmann::json::parse(reply.report_json().empty() ? "{}" : reply.report_json());
   if (format == "json") {
-    std::cout << (r.empty()
-                      ? nlohmann::json{{"state", reply.state()}, {"conclusion", reply.conclusion()}}
-                      : r)
-                     .dump(2)
+    std::cout << (reply.has_report()
+                      ? message_json(reply.report())
+                      : nlohmann::json{{"state", reply.state()}, {"conclusion", reply.conclusion()}}
+                            .dump(2))
               << "\n";
     return;
   }
-  if (r.empty()) {
+  if (!reply.has_report()) {
     std::cout << reply.state() << ": " << reply.conclusion() << "\n";
     return;
   }
-  print_report(std::cout, r);
+  print_report(std::cout, reply.report());
 }
 
 void run(const DiagnoseOptions& o) {

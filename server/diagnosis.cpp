@@ -3,7 +3,6 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
-#include <nlohmann/json.hpp>
 #include <set>
 #include <string_view>
 
@@ -105,61 +104,79 @@ v1::Material switched(const v1::Material& base, const std::map<std::string, std:
   return m;
 }
 
-nlohmann::json finite(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+/// Sets an optional field to v when v is known (a pending value is NaN, diagnosis.hpp).
+template <class Setter>
+void set_known(double v, Setter set) {
+  if (std::isfinite(v)) set(v);
 }
 
-nlohmann::json report_json(const diagnose::Report& r) {
-  nlohmann::json j;
-  j["state"] = r.state;
-  j["named_cause"] = r.named_cause;
-  j["conclusion"] = r.conclusion;
-  for (const auto& m : r.metrics)
-    j["metrics"].push_back({{"response", m.response},
-                            {"target", m.target},
-                            {"holdout", m.holdout},
-                            {"envelope_min", m.envelope_min},
-                            {"envelope_max", m.envelope_max},
-                            {"reachable", m.reachable},
-                            {"statement", m.statement},
-                            {"curvature_p", finite(m.curvature_p)},
-                            {"predicted", m.predicted},
-                            {"simulated", finite(m.simulated)},
-                            {"relative_error", finite(m.relative_error)}});
-  j["baseline"] = {{"proposed", r.baseline_proposed},
-                   {"predicted_rms", finite(r.baseline_predicted_rms)},
-                   {"verified_rms", finite(r.baseline_verified_rms)},
-                   {"holdout_rms", finite(r.baseline_holdout_rms)}};
-  j["conflicts"] = nlohmann::json::array();
-  for (const auto& c : r.conflicts)
-    j["conflicts"].push_back({{"fitted", c.fitted},
-                              {"other", c.other},
-                              {"other_error_alone", c.other_error_alone},
-                              {"other_error_joint", c.other_error_joint},
-                              {"statement", c.statement}});
-  j["candidates"] = nlohmann::json::array();
-  for (const auto& c : r.candidates) {
-    nlohmann::json cj = {{"id", c.id},
-                         {"cause", c.cause},
-                         {"state", c.state},
-                         {"runs", c.runs},
-                         {"proposed", c.proposed},
-                         {"reaches_all", c.reaches_all},
-                         {"predicted_rms", finite(c.predicted_rms)},
-                         {"verified_rms", finite(c.verified_rms)},
-                         {"rounds", c.rounds},
-                         {"design_misprediction", finite(c.design_misprediction)},
-                         {"holdout_rms", finite(c.holdout_rms)},
-                         {"explains", c.explains},
-                         {"evidence", c.evidence}};
-    nlohmann::json sim = nlohmann::json::object();
-    for (const auto& [k, v] : c.simulated) sim[k] = finite(v);
-    cj["simulated"] = sim;
-    for (const auto& f : c.factors)
-      cj["factors"].push_back({{"path", f.path}, {"low", f.factor.low}, {"high", f.factor.high}});
-    j["candidates"].push_back(cj);
+void fill_factors(const std::vector<diagnose::Factor>& factors, v1::DiagnosisCandidate& c) {
+  for (const auto& f : factors) {
+    auto* m = c.add_factors();
+    m->set_path(f.path);
+    m->set_low(f.factor.low);
+    m->set_high(f.factor.high);
   }
-  return j;
+}
+
+v1::DiagnosisMetric metric_message(const diagnose::MetricRow& m) {
+  v1::DiagnosisMetric out;
+  out.set_response(m.response);
+  out.set_target(m.target);
+  out.set_holdout(m.holdout);
+  out.set_envelope_min(m.envelope_min);
+  out.set_envelope_max(m.envelope_max);
+  out.set_reachable(m.reachable);
+  out.set_statement(m.statement);
+  set_known(m.curvature_p, [&](double v) { out.set_curvature_p(v); });
+  out.set_predicted(m.predicted);
+  set_known(m.simulated, [&](double v) { out.set_simulated(v); });
+  set_known(m.relative_error, [&](double v) { out.set_relative_error(v); });
+  return out;
+}
+
+v1::DiagnosisCandidate candidate_message(const diagnose::CandidateOutcome& c) {
+  v1::DiagnosisCandidate out;
+  out.set_id(c.id);
+  out.set_cause(c.cause);
+  out.set_state(c.state);
+  out.set_runs(c.runs);
+  fill_factors(c.factors, out);
+  out.mutable_proposed()->insert(c.proposed.begin(), c.proposed.end());
+  out.set_reaches_all(c.reaches_all);
+  set_known(c.predicted_rms, [&](double v) { out.set_predicted_rms(v); });
+  set_known(c.verified_rms, [&](double v) { out.set_verified_rms(v); });
+  out.set_rounds(c.rounds);
+  set_known(c.design_misprediction, [&](double v) { out.set_design_misprediction(v); });
+  for (const auto& [k, v] : c.simulated)
+    if (std::isfinite(v)) (*out.mutable_simulated())[k] = v;
+  set_known(c.holdout_rms, [&](double v) { out.set_holdout_rms(v); });
+  out.set_explains(c.explains);
+  out.set_evidence(c.evidence);
+  return out;
+}
+
+v1::DiagnosisReport report_message(const diagnose::Report& r) {
+  v1::DiagnosisReport out;
+  out.set_state(r.state);
+  out.set_named_cause(r.named_cause);
+  out.set_conclusion(r.conclusion);
+  for (const auto& m : r.metrics) *out.add_metrics() = metric_message(m);
+  auto* b = out.mutable_baseline();
+  b->mutable_proposed()->insert(r.baseline_proposed.begin(), r.baseline_proposed.end());
+  set_known(r.baseline_predicted_rms, [&](double v) { b->set_predicted_rms(v); });
+  set_known(r.baseline_verified_rms, [&](double v) { b->set_verified_rms(v); });
+  set_known(r.baseline_holdout_rms, [&](double v) { b->set_holdout_rms(v); });
+  for (const auto& c : r.conflicts) {
+    auto* m = out.add_conflicts();
+    m->set_fitted(c.fitted);
+    m->set_other(c.other);
+    m->set_other_error_alone(c.other_error_alone);
+    m->set_other_error_joint(c.other_error_joint);
+    m->set_statement(c.statement);
+  }
+  for (const auto& c : r.candidates) *out.add_candidates() = candidate_message(c);
+  return out;
 }
 
 }  // namespace
@@ -213,7 +230,7 @@ v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::u
   reply.set_state(step.report.state);
   reply.set_named_cause(step.report.named_cause);
   reply.set_conclusion(step.report.conclusion);
-  reply.set_report_json(report_json(step.report).dump());
+  *reply.mutable_report() = report_message(step.report);
   reply.set_jobs_queued(static_cast<int>(fresh.size()));
   return reply;
 }

@@ -16,6 +16,13 @@ namespace {
 
 using nlohmann::json;
 
+/// The options of a call on the page's in-process channel: the page's caller's token.
+proto::ChannelOptions with_token(const std::string& token) {
+  proto::ChannelOptions options;
+  options.token = token;
+  return options;
+}
+
 std::pair<std::string, int> split_address(const std::string& address) {
   const auto colon = address.rfind(':');
   if (colon == std::string::npos) throw std::invalid_argument("--http: expected HOST:PORT");
@@ -134,7 +141,7 @@ void HttpPage::serve_json(const httplib::Request& req, httplib::Response& res, s
     const std::string token = bearer_token(req);
     if (id == 0) {
       auto stub = v1::CampaignService::NewStub(coordinator_);
-      return send_json(res, report::campaign_list(*stub, {.token = token}));
+      return send_json(res, report::campaign_list(*stub, with_token(token)));
     }
     send_json(res, report_of(id, token));
   } catch (const report::ReadError& e) {
@@ -146,7 +153,7 @@ void HttpPage::serve_json(const httplib::Request& req, httplib::Response& res, s
 
 json HttpPage::report_of(std::int64_t id, const std::string& token) {
   auto stub = v1::CampaignService::NewStub(coordinator_);
-  const proto::ChannelOptions channel{.token = token};
+  const proto::ChannelOptions channel = with_token(token);
   v1::GetRequest get;
   get.set_id(id);
   v1::Campaign campaign;

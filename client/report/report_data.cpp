@@ -97,14 +97,11 @@ json read_diagnosis(v1::CampaignService::StubInterface& stub, const proto::Chann
   v1::DiagnoseRequest req;
   req.set_id(id);
   req.set_read_only(true);
-  json d = optional<v1::DiagnoseReply>(
+  return optional<v1::DiagnoseReply>(
       [&](v1::DiagnoseReply& r) {
         return stub.Diagnose(proto::make_context(ch, kDeadlineSeconds).get(), req, &r);
       },
       "diagnosis", notes);
-  if (d.is_object() && d.contains("report_json") && !d["report_json"].get<std::string>().empty())
-    d["report"] = json::parse(d["report_json"].get<std::string>());
-  return d;
 }
 
 }  // namespace

@@ -1031,9 +1031,25 @@ TEST_F(Service, CentrePointsDifferCurvatureIsTestedAndTheCalibrationRoundsAreSho
   ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), read_only, &peek).ok());
   EXPECT_EQ(peek.jobs_queued(), 0);
   EXPECT_EQ(results(id).jobs_size(), jobs_before);
+  // The report is a typed message: the measured metric against its target, the baseline's
+  // calibrated set, and candidates whose runs have not run: their errors are absent, not 0.
+  ASSERT_TRUE(peek.has_report());
+  const v1::DiagnosisReport& report = peek.report();
+  EXPECT_EQ(report.state(), peek.state());
+  ASSERT_GE(report.metrics_size(), 1);
+  EXPECT_FALSE(report.metrics(0).response().empty());
+  EXPECT_FALSE(report.baseline().proposed().empty());
+  EXPECT_GE(report.candidates_size(), 1);
+  for (const auto& c : report.candidates()) {
+    EXPECT_FALSE(c.has_verified_rms()) << c.id();
+    EXPECT_TRUE(c.simulated().empty()) << c.id();
+  }
   const auto diagnosis =
       cli_json(dir_, "diagnose", {"diagnose", ids, "--no-wait", "--format", "json"}, channel_);
   EXPECT_TRUE(diagnosis.is_object() && !diagnosis.empty()) << diagnosis.dump();
+  // --format json prints the report with the proto's field names.
+  EXPECT_TRUE(diagnosis.contains("metrics") && diagnosis.contains("candidates"))
+      << diagnosis.dump();
   EXPECT_GT(results(id).jobs_size(), jobs_before) << "the diagnosis proper queues its runs";
 }
 
