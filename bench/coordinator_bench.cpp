@@ -16,7 +16,7 @@
 #include "client/spec_yaml.hpp"
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
-#include "proto/channel.hpp"
+#include "rpc/channel.hpp"
 #include "server/coordinator.hpp"
 
 namespace {
@@ -45,14 +45,14 @@ design: {type: full_factorial, centre_points: )" +
 }
 
 /// Leases and completes until the queue is empty; returns the jobs completed.
-int fake_worker(const proto::ChannelOptions& channel, const std::string& id) {
-  auto stub = v1::WorkerService::NewStub(proto::make_channel(channel));
+int fake_worker(const rpc::ChannelOptions& channel, const std::string& id) {
+  auto stub = v1::WorkerService::NewStub(rpc::make_channel(channel));
   int done = 0;
   for (;;) {
     v1::LeaseRequest lr;
     lr.set_worker(id);
     v1::LeaseReply lease;
-    if (!stub->Lease(proto::make_context(channel, 30).get(), lr, &lease).ok()) continue;
+    if (!stub->Lease(rpc::make_context(channel, 30).get(), lr, &lease).ok()) continue;
     if (!lease.has_job()) return done;
     v1::CompleteRequest c;
     c.set_job_id(lease.job().job_id());
@@ -62,17 +62,17 @@ int fake_worker(const proto::ChannelOptions& channel, const std::string& id) {
     (*c.mutable_metrics())["solid_fraction"] = 0.55;
     (*c.mutable_metrics())["coordination_number"] = 4.0;
     v1::CompleteReply cr;
-    if (stub->Complete(proto::make_context(channel, 30).get(), c, &cr).ok()) ++done;
+    if (stub->Complete(rpc::make_context(channel, 30).get(), c, &cr).ok()) ++done;
   }
 }
 
 /// Holds a Watch stream until the campaign is no longer running; returns the updates read.
-int watcher(const proto::ChannelOptions& channel, std::int64_t id) {
-  auto stub = v1::CampaignService::NewStub(proto::make_channel(channel));
+int watcher(const rpc::ChannelOptions& channel, std::int64_t id) {
+  auto stub = v1::CampaignService::NewStub(rpc::make_channel(channel));
   v1::WatchRequest req;
   req.set_id(id);
   req.set_interval_seconds(0.1);
-  auto context = proto::make_context(channel, 600);
+  auto context = rpc::make_context(channel, 600);
   auto reader = stub->Watch(context.get(), req);
   v1::Progress p;
   int updates = 0;
@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
   co.db = dir + "/bench.db";
   co.token = "bench-token";
   server::Coordinator coordinator(co);
-  proto::ChannelOptions channel;
+  rpc::ChannelOptions channel;
   channel.address = "127.0.0.1:" + std::to_string(coordinator.port());
   channel.token = co.token;
 
@@ -111,8 +111,8 @@ int main(int argc, char** argv) {
       cli::parse_campaign_spec(spec_text(centre_points, replicates), "bench.yaml").spec;
   v1::SubmitReply sr;
   const auto submit_start = Clock::now();
-  const auto st = v1::CampaignService::NewStub(proto::make_channel(channel))
-                      ->Submit(proto::make_context(channel, 60).get(), sreq, &sr);
+  const auto st = v1::CampaignService::NewStub(rpc::make_channel(channel))
+                      ->Submit(rpc::make_context(channel, 60).get(), sreq, &sr);
   if (!st.ok()) {
     std::cerr << "submit: " << st.error_message() << "\n";
     return 1;

@@ -21,7 +21,7 @@ void print_campaign_row(const v1::Campaign& c) {
 
 void add_campaign_commands(CLI::App& app) {
   struct Options {
-    proto::ChannelOptions channel;
+    rpc::ChannelOptions channel;
     std::int64_t id = 0;
     bool jobs = false;
     std::string format = "table";
@@ -33,7 +33,7 @@ void add_campaign_commands(CLI::App& app) {
   list->callback([o] {
     v1::ListReply reply;
     check(campaign_stub(o->channel)
-              ->List(proto::make_context(o->channel, 30).get(), v1::ListRequest{}, &reply),
+              ->List(rpc::make_context(o->channel, 30).get(), v1::ListRequest{}, &reply),
           "list");
     for (const auto& c : reply.campaigns()) print_campaign_row(c);
   });
@@ -51,9 +51,9 @@ void add_campaign_commands(CLI::App& app) {
     v1::GetRequest req;
     req.set_id(o->id);
     v1::Campaign c;
-    check(stub->Get(proto::make_context(o->channel, 30).get(), req, &c), "status");
+    check(stub->Get(rpc::make_context(o->channel, 30).get(), req, &c), "status");
     v1::ResultsReply r;
-    check(stub->GetResults(proto::make_context(o->channel, 30).get(), req, &r), "results");
+    check(stub->GetResults(rpc::make_context(o->channel, 30).get(), req, &r), "results");
     if (o->format == "json") {
       nlohmann::json doc = nlohmann::json::parse(message_json(c));
       if (o->jobs) doc["jobs"] = nlohmann::json::parse(message_json(r))["jobs"];
@@ -98,7 +98,7 @@ void add_campaign_commands(CLI::App& app) {
     v1::CancelRequest req;
     req.set_id(o->id);
     v1::Campaign c;
-    check(campaign_stub(o->channel)->Cancel(proto::make_context(o->channel, 30).get(), req, &c),
+    check(campaign_stub(o->channel)->Cancel(rpc::make_context(o->channel, 30).get(), req, &c),
           "cancel");
     print_campaign_row(c);
   });

@@ -16,7 +16,7 @@ namespace demcal::cli {
 namespace {
 
 struct DiagnoseOptions {
-  proto::ChannelOptions channel;
+  rpc::ChannelOptions channel;
   std::string campaign;
   std::string workdir;
   LocalWorkers local;
@@ -94,14 +94,14 @@ void print_report(std::ostream& out, const v1::DiagnosisReport& r) {
 
 /// Calls Diagnose until it is done, running the campaign's jobs in between (or once, without
 /// waiting). Returns the last reply.
-v1::DiagnoseReply drive(v1::CampaignService::Stub& stub, const proto::ChannelOptions& channel,
+v1::DiagnoseReply drive(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                         std::int64_t id, const DiagnoseOptions& o) {
   v1::DiagnoseRequest req;
   req.set_id(id);
   req.set_seed(o.seed);
   for (;;) {
     v1::DiagnoseReply reply;
-    check(stub.Diagnose(proto::make_context(channel, 600).get(), req, &reply), "diagnose");
+    check(stub.Diagnose(rpc::make_context(channel, 600).get(), req, &reply), "diagnose");
     if (reply.state() == "done" || !o.wait) return reply;
     std::cerr << "diagnosis: " << reply.conclusion();
     if (reply.jobs_queued()) std::cerr << " (" << reply.jobs_queued() << " jobs queued)";
@@ -128,7 +128,7 @@ void report(const v1::DiagnoseReply& reply, const std::string& format) {
 
 void run(const DiagnoseOptions& o) {
   with_campaign(o.campaign, o.workdir, o.local, o.verbose, o.channel,
-                [&](v1::CampaignService::Stub& stub, const proto::ChannelOptions& channel,
+                [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                     std::int64_t id) { report(drive(stub, channel, id, o), o.format); });
 }
 

@@ -16,16 +16,16 @@ namespace {
 
 /// The spec's fixed parameters, then the calibrated set, as a LIGGGHTS fragment; what it
 /// cannot export exactly is warned about on standard error.
-std::string liggghts_export(v1::CampaignService::Stub& stub, const proto::ChannelOptions& channel,
+std::string liggghts_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                             std::int64_t id) {
   v1::GetRequest get;
   get.set_id(id);
   v1::Campaign campaign;
-  check(stub.Get(proto::make_context(channel, 60).get(), get, &campaign), "campaign");
+  check(stub.Get(rpc::make_context(channel, 60).get(), get, &campaign), "campaign");
   v1::CalibrateRequest req;
   req.set_id(id);
   v1::CalibrateReply cal;
-  check(stub.Calibrate(proto::make_context(channel, 300).get(), req, &cal), "calibrate");
+  check(stub.Calibrate(rpc::make_context(channel, 300).get(), req, &cal), "calibrate");
   std::map<std::string, double> parameters(campaign.spec().fixed().begin(),
                                            campaign.spec().fixed().end());
   for (int i = 0; i < cal.factor_paths_size(); ++i)
@@ -42,7 +42,7 @@ std::string liggghts_export(v1::CampaignService::Stub& stub, const proto::Channe
 
 void add_analysis_commands(CLI::App& app) {
   struct Options {
-    proto::ChannelOptions channel;
+    rpc::ChannelOptions channel;
     std::int64_t id = 0;
     std::string format = "table";
     std::string model = "2fi";
@@ -70,7 +70,7 @@ void add_analysis_commands(CLI::App& app) {
     req.set_alpha(o->alpha);
     v1::EffectsReply reply;
     check(campaign_stub(o->channel)
-              ->GetEffects(proto::make_context(o->channel, 120).get(), req, &reply),
+              ->GetEffects(rpc::make_context(o->channel, 120).get(), req, &reply),
           "effects");
     print_effects(std::cout, reply, o->format);
   });
@@ -97,7 +97,7 @@ void add_analysis_commands(CLI::App& app) {
     if (o->verify && o->wait) {
       reply = drive_calibration(*stub, o->channel, req, std::cerr);
     } else {
-      check(stub->Calibrate(proto::make_context(o->channel, 300).get(), req, &reply), "calibrate");
+      check(stub->Calibrate(rpc::make_context(o->channel, 300).get(), req, &reply), "calibrate");
     }
     print_calibration(std::cout, reply, o->format);
   });

@@ -16,7 +16,7 @@ namespace demcal::cli {
 namespace {
 
 struct ReportOptions {
-  proto::ChannelOptions channel;
+  rpc::ChannelOptions channel;
   std::string campaign;
   std::string out_dir = ".";
   std::string workdir;
@@ -26,7 +26,7 @@ struct ReportOptions {
 };
 
 std::filesystem::path write_report(v1::CampaignService::Stub& stub,
-                                   const proto::ChannelOptions& channel, std::int64_t id,
+                                   const rpc::ChannelOptions& channel, std::int64_t id,
                                    const ReportOptions& o) {
   const nlohmann::json data = report::report_data(stub, channel, id);
   std::filesystem::create_directories(o.out_dir);
@@ -39,7 +39,7 @@ std::filesystem::path write_report(v1::CampaignService::Stub& stub,
 void run(const ReportOptions& o) {
   with_campaign(
       o.campaign, o.workdir, o.local, o.verbose, o.channel,
-      [&](v1::CampaignService::Stub& stub, const proto::ChannelOptions& channel, std::int64_t id) {
+      [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
         const auto html = write_report(stub, channel, id, o);
         std::cout << std::filesystem::absolute(html).string() << "\n";
       });

@@ -44,11 +44,11 @@ void run_embedded(const RunOptions& opt) {
   v1::EffectsRequest ereq;
   ereq.set_id(id);
   v1::EffectsReply effects;
-  check(stub->GetEffects(proto::make_context(channel, 300).get(), ereq, &effects), "effects");
+  check(stub->GetEffects(rpc::make_context(channel, 300).get(), ereq, &effects), "effects");
   v1::GetRequest dreq;
   dreq.set_id(id);
   v1::DesignReply design;
-  check(stub->GetDesign(proto::make_context(channel, 60).get(), dreq, &design), "design");
+  check(stub->GetDesign(rpc::make_context(channel, 60).get(), dreq, &design), "design");
   nlohmann::json doc = {{"campaign", id},
                         {"work_directory", workdir.string()},
                         {"design", nlohmann::json::parse(message_json(design.summary()))},

@@ -12,7 +12,7 @@ namespace demcal::cli {
 
 void add_submit_command(CLI::App& app) {
   struct Options {
-    proto::ChannelOptions channel;
+    rpc::ChannelOptions channel;
     std::string spec;
     bool watch = false;
   };
@@ -27,7 +27,7 @@ void add_submit_command(CLI::App& app) {
     v1::SubmitRequest req;
     *req.mutable_spec() = file.spec;
     v1::SubmitReply reply;
-    const auto s = stub->Submit(proto::make_context(o->channel, 120).get(), req, &reply);
+    const auto s = stub->Submit(rpc::make_context(o->channel, 120).get(), req, &reply);
     if (s.error_code() == grpc::StatusCode::INVALID_ARGUMENT)
       throw InputError("", file.locate(s.error_message()));
     check(s, "submit");

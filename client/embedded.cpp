@@ -26,7 +26,7 @@ std::filesystem::path work_directory(const std::string& spec, const std::string&
 }
 
 void with_campaign(const std::string& campaign, const std::string& workdir,
-                   const LocalWorkers& local, bool verbose, const proto::ChannelOptions& channel,
+                   const LocalWorkers& local, bool verbose, const rpc::ChannelOptions& channel,
                    const CampaignAction& act) {
   if (std::filesystem::is_regular_file(campaign)) {
     const SpecFile file = read_campaign_spec(campaign);
@@ -100,7 +100,7 @@ EmbeddedService::~EmbeddedService() {
 
 std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostream& out) {
   v1::ListReply list;
-  check(stub_->List(proto::make_context(channel_, 30).get(), {}, &list), "list");
+  check(stub_->List(rpc::make_context(channel_, 30).get(), {}, &list), "list");
   std::int64_t id = 0;
   for (const auto& c : list.campaigns())
     if (c.name() == file.spec.name() && c.state() != v1::CANCELLED) id = std::max(id, c.id());
@@ -111,7 +111,7 @@ std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostrea
   v1::SubmitRequest req;
   *req.mutable_spec() = file.spec;
   v1::SubmitReply reply;
-  const auto s = stub_->Submit(proto::make_context(channel_, 120).get(), req, &reply);
+  const auto s = stub_->Submit(rpc::make_context(channel_, 120).get(), req, &reply);
   if (s.error_code() == grpc::StatusCode::INVALID_ARGUMENT)
     throw InputError("", file.locate(s.error_message()));
   check(s, "submit");

@@ -36,7 +36,7 @@ class EmbeddedService {
   EmbeddedService(const EmbeddedService&) = delete;
   EmbeddedService& operator=(const EmbeddedService&) = delete;
 
-  const proto::ChannelOptions& channel() const { return channel_; }
+  const rpc::ChannelOptions& channel() const { return channel_; }
   v1::CampaignService::Stub& stub() { return *stub_; }
   std::string db() const { return db_; }
 
@@ -53,7 +53,7 @@ class EmbeddedService {
   std::string db_;
   std::unique_ptr<server::Coordinator> coordinator_;
   std::unique_ptr<server::HttpPage> http_;
-  proto::ChannelOptions channel_;
+  rpc::ChannelOptions channel_;
   worker::StopFlags flags_;
   std::vector<std::thread> workers_;
   std::unique_ptr<v1::CampaignService::Stub> stub_;
@@ -64,13 +64,13 @@ std::filesystem::path work_directory(const std::string& spec, const std::string&
 
 /// What a command does with a campaign once it is reached: its stub, channel and id.
 using CampaignAction = std::function<void(v1::CampaignService::Stub& stub,
-                                          const proto::ChannelOptions& channel, std::int64_t id)>;
+                                          const rpc::ChannelOptions& channel, std::int64_t id)>;
 
 /// Reaches the campaign a command names and runs `act` on it: a spec YAML file on the embedded
 /// default (submitted or resumed in `workdir`, watched until its jobs end), otherwise a campaign
 /// id on the coordinator of `channel`. CLI::ValidationError for text that is neither.
 void with_campaign(const std::string& campaign, const std::string& workdir,
-                   const LocalWorkers& local, bool verbose, const proto::ChannelOptions& channel,
+                   const LocalWorkers& local, bool verbose, const rpc::ChannelOptions& channel,
                    const CampaignAction& act);
 
 }  // namespace demcal::cli

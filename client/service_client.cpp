@@ -50,7 +50,7 @@ std::string csv_quote(const std::string& s) {
 
 }  // namespace
 
-void add_connection_options(CLI::App& cmd, proto::ChannelOptions& o) {
+void add_connection_options(CLI::App& cmd, rpc::ChannelOptions& o) {
   o.address = "127.0.0.1:7311";
   cmd.add_option("--coordinator", o.address, "host:port of demcal-server")
       ->envname("DEMCAL_COORDINATOR")
@@ -63,7 +63,7 @@ void add_connection_options(CLI::App& cmd, proto::ChannelOptions& o) {
       "--token-file",
       [&o](const std::string& file) {
         try {
-          o.token = proto::read_token_file(file);
+          o.token = rpc::read_token_file(file);
         } catch (const std::exception& e) {
           throw InputError("--token-file", e.what());  // never "no token": exit code 2
         }
@@ -73,18 +73,18 @@ void add_connection_options(CLI::App& cmd, proto::ChannelOptions& o) {
   cmd.add_flag("--insecure", o.insecure, "plain TCP (coordinator started with --insecure)");
 }
 
-std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const proto::ChannelOptions& o) {
-  return v1::CampaignService::NewStub(proto::make_channel(o));
+std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const rpc::ChannelOptions& o) {
+  return v1::CampaignService::NewStub(rpc::make_channel(o));
 }
 
 grpc::Status read_export(v1::CampaignService::StubInterface& stub,
-                         const proto::ChannelOptions& options, std::int64_t id,
+                         const rpc::ChannelOptions& options, std::int64_t id,
                          const std::string& format, std::string& content, bool series) {
   v1::ExportRequest req;
   req.set_id(id);
   req.set_format(format);
   req.set_series(series);
-  const auto context = proto::make_context(options, 600);
+  const auto context = rpc::make_context(options, 600);
   auto reader = stub.Export(context.get(), req);
   content.clear();
   v1::ExportReply piece;
@@ -172,12 +172,12 @@ std::string progress_line(const v1::Progress& p, int width) {
   return s.str();
 }
 
-v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const proto::ChannelOptions& o,
+v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& o,
                             std::int64_t id, std::ostream& out) {
   const bool tty = isatty(STDERR_FILENO) && &out == &std::cerr;
   v1::Progress last;
   for (int reconnects = 0;; ++reconnects) {
-    auto ctx = proto::make_context(o, 7 * 24 * 3600.0);
+    auto ctx = rpc::make_context(o, 7 * 24 * 3600.0);
     v1::WatchRequest req;
     req.set_id(id);
     auto reader = stub.Watch(ctx.get(), req);
@@ -228,7 +228,7 @@ void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::stri
           << (x.active_sme()  ? "** "
               : x.active_me() ? "*  "
                               : "   ")
-          << "  " << x.chain() << "\n";
+          << "  " << x.chain() << (x.in_model() ? "" : " (r)") << "\n";
     out << "  mean " << fmt(m.intercept()) << ", R^2 " << fmt(m.r_squared(), 4);
     out << "\n  noise: ";
     if (m.noise_df() > 0)
@@ -240,7 +240,7 @@ void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::stri
     if (m.curvature_available())
       out << "factorial - centre mean " << fmt(m.curvature_difference())
           << ", t = " << fmt(m.curvature_t(), 3) << " (" << fmt(m.curvature_df(), 3)
-          << " df), p = " << fmt(m.curvature_p(), 3)
+          << " df), p = " << fmt(m.curvature_p(), 3) << " against " << m.curvature_error()
           << (m.curvature_significant() ? " (significant)" : " (not significant)");
     else
       out << "not tested (needs centre points and a noise estimate)";
@@ -300,11 +300,11 @@ void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std
 }
 
 v1::CalibrateReply drive_calibration(v1::CampaignService::Stub& stub,
-                                     const proto::ChannelOptions& channel,
+                                     const rpc::ChannelOptions& channel,
                                      const v1::CalibrateRequest& request, std::ostream& progress) {
   for (;;) {
     v1::CalibrateReply reply;
-    check(stub.Calibrate(proto::make_context(channel, 300).get(), request, &reply), "calibrate");
+    check(stub.Calibrate(rpc::make_context(channel, 300).get(), request, &reply), "calibrate");
     if (!request.verify() || reply.verification_state() != "running") return reply;
     progress << "calibration: " << reply.conclusion() << "\n";
     watch_campaign(stub, channel, request.id(), progress);

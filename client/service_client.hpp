@@ -8,14 +8,14 @@
 #include <string>
 
 #include "demcal/v1/campaign.grpc.pb.h"
-#include "proto/channel.hpp"
+#include "rpc/channel.hpp"
 
 namespace demcal::cli {
 
 /// --coordinator (DEMCAL_COORDINATOR), --token (DEMCAL_TOKEN), --tls-ca, --insecure.
-void add_connection_options(CLI::App& cmd, proto::ChannelOptions& options);
+void add_connection_options(CLI::App& cmd, rpc::ChannelOptions& options);
 
-std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const proto::ChannelOptions& options);
+std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const rpc::ChannelOptions& options);
 
 /// Throws for a failed call: InputError for INVALID_ARGUMENT (the message names the field),
 /// std::runtime_error "<what>: <CODE>: <message>" otherwise.
@@ -25,13 +25,13 @@ void check(const grpc::Status& status, const std::string& what);
 /// read whole from its stream (it may exceed one gRPC message). Returns the stream's status;
 /// `content` is complete only when it is OK.
 grpc::Status read_export(v1::CampaignService::StubInterface& stub,
-                         const proto::ChannelOptions& options, std::int64_t id,
+                         const rpc::ChannelOptions& options, std::int64_t id,
                          const std::string& format, std::string& content, bool series = false);
 
 void print_design_summary(std::ostream& out, const v1::DesignSummary& d);
 std::string progress_line(const v1::Progress& p, int width = 30);
 /// Streams Watch and draws a progress bar on `out` until the campaign is no longer running.
-v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const proto::ChannelOptions& o,
+v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& o,
                             std::int64_t id, std::ostream& out);
 /// table | csv | json
 void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::string& format);
@@ -42,7 +42,7 @@ void print_rounds(std::ostream& out,
 /// Calls Calibrate until the calibration no longer runs (with `request.verify`: the whole
 /// sequential loop), watching the campaign's jobs on `progress` in between.
 v1::CalibrateReply drive_calibration(v1::CampaignService::Stub& stub,
-                                     const proto::ChannelOptions& channel,
+                                     const rpc::ChannelOptions& channel,
                                      const v1::CalibrateRequest& request, std::ostream& progress);
 /// A message as JSON with every field printed (the one document `--format json` writes).
 std::string message_json(const google::protobuf::Message& m);

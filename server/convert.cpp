@@ -12,7 +12,8 @@
 #include "core/doe/alias_structure.hpp"
 #include "core/doe/minimum_aberration.hpp"
 #include "core/lab/catalog.hpp"
-#include "proto/material_convert.hpp"
+#include "rpc/effects_convert.hpp"
+#include "rpc/material_convert.hpp"
 #include "server/calibration.hpp"
 #include "server/diagnosis.hpp"
 
@@ -126,7 +127,7 @@ void check_instance_name(const std::string& name, const std::string& where) {
 lab::MaterialModel instance_model(const v1::CampaignSpec& spec, const v1::LabTest& t,
                                   const std::string& where) {
   try {
-    return proto::to_material_model(instance_material(spec.material(), t), "spec.material");
+    return rpc::to_material_model(instance_material(spec.material(), t), "spec.material");
   } catch (const InputError& e) {
     const std::string base = "spec.material.wall_law";
     if (!t.has_wall_law() || e.where().rfind(base, 0) != 0) throw;
@@ -159,7 +160,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
   CampaignPlan plan;
   if (spec.name().empty()) throw InputError("spec.name", "missing");
   if (!spec.has_material()) throw InputError("spec.material", "missing");
-  lab::MaterialModel model = proto::to_material_model(spec.material(), "spec.material");
+  lab::MaterialModel model = rpc::to_material_model(spec.material(), "spec.material");
 
   if (spec.tests_size() == 0) throw InputError("spec.tests", "a campaign needs at least one test");
   std::set<std::string> seen_tests;
@@ -178,7 +179,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
     if (!seen_tests.insert(name).second)
       throw InputError(where + (t.name().empty() ? ".test" : ".name"),
                        "test '" + name + "' appears twice (give each instance its own `name`)");
-    const lab::Settings settings = proto::to_settings(t.settings());
+    const lab::Settings settings = rpc::to_settings(t.settings());
     lab::validate_settings(*info, settings, where + ".settings");
     if (t.threads() < 0 || t.threads() > kMaxThreads)
       throw InputError(where + ".threads", "must be in [0, " + std::to_string(kMaxThreads) +
@@ -459,53 +460,6 @@ v1::JobResult job_message(const JobRow& job) {
   for (const auto& [k, v] : flags.items()) (*r.mutable_flags())[k] = v.get<std::string>();
   from_json(job.cost_json, *r.mutable_cost());
   return r;
-}
-
-v1::MetricEffects effects_message(const std::string& response, const doe::ResponseAnalysis& a) {
-  v1::MetricEffects m;
-  m.set_metric(response);
-  m.set_runs_used(a.balance.runs_used);
-  m.set_runs_total(a.balance.runs_total);
-  std::vector<const doe::EffectEstimate*> by_size;
-  for (const auto& e : a.effects) by_size.push_back(&e);
-  std::stable_sort(by_size.begin(), by_size.end(),
-                   [](auto x, auto y) { return std::abs(x->effect) > std::abs(y->effect); });
-  for (const auto* e : by_size) {
-    auto* o = m.add_effects();
-    o->set_chain(e->term.name());
-    o->set_effect(e->effect);
-    o->set_active_me(e->active);
-    o->set_active_sme(e->active_simultaneous);
-    o->set_in_model(e->in_model);
-  }
-  if (a.lenth) {
-    m.set_pse(a.lenth->pse);
-    m.set_me(a.lenth->me);
-    m.set_sme(a.lenth->sme);
-    m.set_lenth_df(a.lenth->degrees_of_freedom);
-    m.set_lenth_terms(a.lenth->contrasts);
-  }
-  m.set_noise_sd(a.noise.sd);
-  m.set_noise_df(a.noise.degrees_of_freedom);
-  m.set_noise_source(a.noise.source);
-  m.set_intercept(a.fit.intercept);
-  for (std::size_t i = 0; i < a.fit.terms.size(); ++i) {
-    auto* c = m.add_coefficients();
-    c->set_chain(a.fit.terms[i].name());
-    c->set_coefficient(a.fit.coefficients(Eigen::Index(i)));
-    c->set_standard_error(a.fit.standard_errors.size() ? a.fit.standard_errors(Eigen::Index(i))
-                                                       : std::nan(""));
-  }
-  m.set_r_squared(a.fit.r_squared);
-  m.set_curvature_available(a.curvature.available);
-  m.set_curvature_p(a.curvature.p_value);
-  m.set_curvature_significant(a.curvature.significant);
-  m.set_curvature_difference(a.curvature.difference);
-  m.set_curvature_t(a.curvature.t);
-  m.set_curvature_df(a.curvature.degrees_of_freedom);
-  m.set_curvature_error(a.curvature.error_source);
-  for (const auto& n : a.notes) m.add_notes(n);
-  return m;
 }
 
 std::string series_json(const google::protobuf::RepeatedPtrField<v1::Series>& series) {

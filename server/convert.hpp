@@ -45,7 +45,6 @@ v1::Campaign campaign_message(const CampaignRow& row, const Counts& counts, doub
                               bool with_spec);
 v1::Progress progress_message(const CampaignRow& row, const Counts& counts, double now);
 v1::JobResult job_message(const JobRow& job);
-v1::MetricEffects effects_message(const std::string& response, const doe::ResponseAnalysis& a);
 std::vector<std::string> factor_legend(const CampaignPlan& plan);
 
 std::string to_json(const google::protobuf::Message& message);

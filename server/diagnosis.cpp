@@ -9,7 +9,7 @@
 #include "core/common/error.hpp"
 #include "core/diagnose/diagnosis.hpp"
 #include "core/lab/material.hpp"
-#include "proto/material_convert.hpp"
+#include "rpc/material_convert.hpp"
 #include "server/analysis.hpp"
 #include "server/convert.hpp"
 #include "server/plan.hpp"
@@ -43,7 +43,7 @@ diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan&
       m.particle_law().rolling().model().empty() ? "none" : m.particle_law().rolling().model();
   p.size_kind = m.sizes().has_monodisperse() ? "monodisperse" : "distribution";
   for (const auto& [path, value] : spec.fixed()) p.fixed[path] = value;
-  const auto model = proto::to_material_model(m, "spec.material");
+  const auto model = rpc::to_material_model(m, "spec.material");
   p.cohesion_model = model.particle_law.cohesion.model;
   p.preparation = lab::preparation_method_name(model.preparation.method);
   for (const auto& t : spec.tests()) p.preparable &= !lab::pours_only(t.test());

@@ -8,7 +8,7 @@
 #include "client/report/report_data.hpp"
 #include "client/report/report_html.hpp"
 #include "demcal/v1/campaign.grpc.pb.h"
-#include "proto/channel.hpp"
+#include "rpc/channel.hpp"
 #include "server/auth.hpp"
 
 namespace demcal::server {
@@ -17,8 +17,8 @@ namespace {
 using nlohmann::json;
 
 /// The options of a call on the page's in-process channel: the page's caller's token.
-proto::ChannelOptions with_token(const std::string& token) {
-  proto::ChannelOptions options;
+rpc::ChannelOptions with_token(const std::string& token) {
+  rpc::ChannelOptions options;
   options.token = token;
   return options;
 }
@@ -153,11 +153,11 @@ void HttpPage::serve_json(const httplib::Request& req, httplib::Response& res, s
 
 json HttpPage::report_of(std::int64_t id, const std::string& token) {
   auto stub = v1::CampaignService::NewStub(coordinator_);
-  const proto::ChannelOptions channel = with_token(token);
+  const rpc::ChannelOptions channel = with_token(token);
   v1::GetRequest get;
   get.set_id(id);
   v1::Campaign campaign;
-  const grpc::Status s = stub->Get(proto::make_context(channel, 30).get(), get, &campaign);
+  const grpc::Status s = stub->Get(rpc::make_context(channel, 30).get(), get, &campaign);
   if (!s.ok()) throw report::ReadError(s.error_code(), "campaign: " + s.error_message());
   v1::Progress progress = campaign.progress();  // the job counts, not the clock
   progress.clear_elapsed_seconds();

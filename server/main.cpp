@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <fstream>
 
-#include "proto/channel.hpp"
+#include "rpc/channel.hpp"
 #include "server/coordinator.hpp"
 #include "server/http_page.hpp"
 
@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
     for (auto [file, token] :
          {std::pair{&token_file, &o.token}, std::pair{&worker_token_file, &o.worker_token},
           std::pair{&client_token_file, &o.client_token}})
-      if (!file->empty()) *token = demcal::proto::read_token_file(*file);
+      if (!file->empty()) *token = demcal::rpc::read_token_file(*file);
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
     return 2;

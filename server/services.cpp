@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "core/common/error.hpp"
+#include "rpc/effects_convert.hpp"
 #include "server/analysis.hpp"
 #include "server/auth.hpp"
 #include "server/calibration.hpp"
@@ -240,7 +241,7 @@ grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
       }
       try {
         v1::MetricEffects effects =
-            effects_message(plan.responses[c], analyse(plan, col, kind, alpha));
+            rpc::effects_message(plan.responses[c], analyse(plan, col, kind, alpha));
         auto* m = reply->add_metrics();
         *m = std::move(effects);
         if (const auto f = flagged.find(plan.responses[c]); f != flagged.end()) {

@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (!token_file.empty()) try {
-      o.channel.token = demcal::proto::read_token_file(token_file);
+      o.channel.token = demcal::rpc::read_token_file(token_file);
     } catch (const std::exception& e) {
       spdlog::critical("{}", e.what());
       return 2;

@@ -17,7 +17,7 @@
 #include "core/lab/lab_test.hpp"
 #include "core/lab/run_cancelled.hpp"
 #include "demcal/v1/worker.grpc.pb.h"
-#include "proto/material_convert.hpp"
+#include "rpc/material_convert.hpp"
 
 namespace demcal::worker {
 namespace {
@@ -119,7 +119,7 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
                 const JobStop& stop) {
   Outcome o;
   try {
-    const lab::MaterialModel material = proto::job_material(job);
+    const lab::MaterialModel material = rpc::job_material(job);
     lab::RunOptions ro;
     ro.threads = job_threads(job, threads);
     ro.seed = job.seed() ? job.seed() : 1;
@@ -128,7 +128,7 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
       stop.check();
     };
     const lab::LabOutput out =
-        lab::run_lab_test(job.test(), material, proto::to_settings(job.settings()), ro);
+        lab::run_lab_test(job.test(), material, rpc::to_settings(job.settings()), ro);
     o.ok = true;
     o.metrics = out.metrics;
     o.flags = out.flags;
@@ -158,7 +158,7 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
     gethostname(host, sizeof host - 1);
     return std::string(host) + ":" + std::to_string(getpid());
   }();
-  auto channel = proto::make_channel(opt.channel);
+  auto channel = rpc::make_channel(opt.channel);
   auto stub = v1::WorkerService::NewStub(channel);
   std::mt19937_64 jitter(std::hash<std::string>{}(id));
   double backoff = 0.2;
@@ -178,7 +178,7 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
     f.set_reason(why);
     f.set_retryable(true);
     v1::FailReply fr;
-    const auto s = stub->Fail(proto::make_context(opt.channel, 10).get(), f, &fr);
+    const auto s = stub->Fail(rpc::make_context(opt.channel, 10).get(), f, &fr);
     ++stats.refused_jobs;
     spdlog::warn("job {} refused: {} ({})", job.job_id(), why,
                  s.ok() ? "reported" : s.error_message());
@@ -191,7 +191,7 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
     v1::LeaseRequest lreq;
     lreq.set_worker(id);
     v1::LeaseReply lease;
-    const auto ls = stub->Lease(proto::make_context(opt.channel, 10).get(), lreq, &lease);
+    const auto ls = stub->Lease(rpc::make_context(opt.channel, 10).get(), lreq, &lease);
     if (ls.error_code() == grpc::StatusCode::UNAUTHENTICATED) {
       spdlog::error("coordinator refused the token: {}", ls.error_message());
       stats.unauthenticated = true;
@@ -241,7 +241,7 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
         h.set_worker(id);
         h.set_progress(progress);
         v1::HeartbeatReply hr;
-        const auto s = stub->Heartbeat(proto::make_context(opt.channel, 5).get(), h, &hr);
+        const auto s = stub->Heartbeat(rpc::make_context(opt.channel, 5).get(), h, &hr);
         const bool gone = s.error_code() == grpc::StatusCode::FAILED_PRECONDITION ||
                           s.error_code() == grpc::StatusCode::PERMISSION_DENIED;
         if (gone && !lease_lost) {
@@ -296,7 +296,7 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
       f.set_give_back(true);
       f.set_retryable(true);
       v1::FailReply fr;
-      const auto s = stub->Fail(proto::make_context(opt.channel, 5).get(), f, &fr);
+      const auto s = stub->Fail(rpc::make_context(opt.channel, 5).get(), f, &fr);
       spdlog::info("job {}: lease given back ({})", job.job_id(),
                    s.ok() ? "ok" : s.error_message());
       ++stats.given_back;
@@ -329,7 +329,7 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
         *c.mutable_cost() = out.cost;
         for (const auto& s : out.series) *c.add_series() = s;
         v1::CompleteReply cr;
-        s = stub->Complete(proto::make_context(opt.channel, 10).get(), c, &cr);
+        s = stub->Complete(rpc::make_context(opt.channel, 10).get(), c, &cr);
       } else {
         v1::FailRequest f;
         f.set_job_id(job.job_id());
@@ -338,7 +338,7 @@ WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
         f.set_reason(out.reason);
         f.set_retryable(out.retryable);
         v1::FailReply fr;
-        s = stub->Fail(proto::make_context(opt.channel, 10).get(), f, &fr);
+        s = stub->Fail(rpc::make_context(opt.channel, 10).get(), f, &fr);
       }
       if (s.ok()) {
         if (out.ok) {

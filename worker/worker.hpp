@@ -7,12 +7,12 @@
 #include <cstdint>
 #include <string>
 
-#include "proto/channel.hpp"
+#include "rpc/channel.hpp"
 
 namespace demcal::worker {
 
 struct WorkerOptions {
-  proto::ChannelOptions channel;
+  rpc::ChannelOptions channel;
   int threads = 2;             ///< simulation threads per job, at most (a job may ask for fewer)
   std::string id;              ///< default: host:pid
   double max_backoff = 10.0;   ///< seconds between reconnection attempts, at most

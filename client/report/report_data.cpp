@@ -35,27 +35,27 @@ json optional(const Call& call, const std::string& what, json& notes) {
 }
 
 v1::Campaign read_campaign(v1::CampaignService::StubInterface& stub,
-                           const proto::ChannelOptions& ch, std::int64_t id) {
+                           const rpc::ChannelOptions& ch, std::int64_t id) {
   v1::GetRequest get;
   get.set_id(id);
   v1::Campaign campaign;
-  required([&] { return stub.Get(proto::make_context(ch, 60).get(), get, &campaign); }, "campaign");
+  required([&] { return stub.Get(rpc::make_context(ch, 60).get(), get, &campaign); }, "campaign");
   return campaign;
 }
 
-json read_design(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
+json read_design(v1::CampaignService::StubInterface& stub, const rpc::ChannelOptions& ch,
                  std::int64_t id) {
   v1::GetRequest get;
   get.set_id(id);
   v1::DesignReply design;
-  required([&] { return stub.GetDesign(proto::make_context(ch, 60).get(), get, &design); },
+  required([&] { return stub.GetDesign(rpc::make_context(ch, 60).get(), get, &design); },
            "design");
   return as_json(design);
 }
 
 /// The Export reply's content is itself the JSON document `demcal export --format json --series`
 /// prints.
-json read_export(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
+json read_export(v1::CampaignService::StubInterface& stub, const rpc::ChannelOptions& ch,
                  std::int64_t id) {
   std::string content;
   required([&] { return cli::read_export(stub, ch, id, "json", content, true); }, "export");
@@ -63,25 +63,25 @@ json read_export(v1::CampaignService::StubInterface& stub, const proto::ChannelO
 }
 
 /// The request `demcal effects ID --format json` sends: model 2fi, alpha 0.05 (the defaults).
-json read_effects(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
+json read_effects(v1::CampaignService::StubInterface& stub, const rpc::ChannelOptions& ch,
                   std::int64_t id, json& notes) {
   v1::EffectsRequest req;
   req.set_id(id);
   return optional<v1::EffectsReply>(
       [&](v1::EffectsReply& r) {
-        return stub.GetEffects(proto::make_context(ch, kDeadlineSeconds).get(), req, &r);
+        return stub.GetEffects(rpc::make_context(ch, kDeadlineSeconds).get(), req, &r);
       },
       "effects", notes);
 }
 
 /// Without verify: the proposal and the rounds so far, nothing queued.
-json read_calibration(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
+json read_calibration(v1::CampaignService::StubInterface& stub, const rpc::ChannelOptions& ch,
                       std::int64_t id, json& notes) {
   v1::CalibrateRequest req;
   req.set_id(id);
   return optional<v1::CalibrateReply>(
       [&](v1::CalibrateReply& r) {
-        return stub.Calibrate(proto::make_context(ch, kDeadlineSeconds).get(), req, &r);
+        return stub.Calibrate(rpc::make_context(ch, kDeadlineSeconds).get(), req, &r);
       },
       "calibration", notes);
 }
@@ -92,21 +92,21 @@ bool has_diagnosis_jobs(const json& exported) {
   return false;
 }
 
-json read_diagnosis(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
+json read_diagnosis(v1::CampaignService::StubInterface& stub, const rpc::ChannelOptions& ch,
                     std::int64_t id, json& notes) {
   v1::DiagnoseRequest req;
   req.set_id(id);
   req.set_read_only(true);
   return optional<v1::DiagnoseReply>(
       [&](v1::DiagnoseReply& r) {
-        return stub.Diagnose(proto::make_context(ch, kDeadlineSeconds).get(), req, &r);
+        return stub.Diagnose(rpc::make_context(ch, kDeadlineSeconds).get(), req, &r);
       },
       "diagnosis", notes);
 }
 
 }  // namespace
 
-json report_data(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch,
+json report_data(v1::CampaignService::StubInterface& stub, const rpc::ChannelOptions& ch,
                  std::int64_t id) {
   json doc = {{"id", id}, {"notes", json::object()}};
   json& notes = doc["notes"];
@@ -128,9 +128,9 @@ json report_data(v1::CampaignService::StubInterface& stub, const proto::ChannelO
   return doc;
 }
 
-json campaign_list(v1::CampaignService::StubInterface& stub, const proto::ChannelOptions& ch) {
+json campaign_list(v1::CampaignService::StubInterface& stub, const rpc::ChannelOptions& ch) {
   v1::ListReply list;
-  required([&] { return stub.List(proto::make_context(ch, 60).get(), {}, &list); }, "list");
+  required([&] { return stub.List(rpc::make_context(ch, 60).get(), {}, &list); }, "list");
   json out = as_json(list);
   // The specs are the bulk of a List reply and the index shows names and progress only.
   for (auto& c : out["campaigns"]) c.erase("spec");

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "demcal/v1/campaign.grpc.pb.h"
-#include "proto/channel.hpp"
+#include "rpc/channel.hpp"
 
 namespace demcal::report {
 
@@ -16,11 +16,11 @@ namespace demcal::report {
 /// "notes"). Reads only: nothing is queued. Throws std::runtime_error when the campaign
 /// cannot be read at all (unknown id, wrong token).
 nlohmann::json report_data(v1::CampaignService::StubInterface& stub,
-                           const proto::ChannelOptions& channel, std::int64_t id);
+                           const rpc::ChannelOptions& channel, std::int64_t id);
 
 /// The campaigns the coordinator holds, as the List reply prints (for the live page's index).
 nlohmann::json campaign_list(v1::CampaignService::StubInterface& stub,
-                             const proto::ChannelOptions& channel);
+                             const rpc::ChannelOptions& channel);
 
 /// A call the report cannot do without failed: its gRPC status (mapped onto HTTP statuses).
 class ReadError : public std::runtime_error {

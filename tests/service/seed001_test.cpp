@@ -12,7 +12,7 @@
 #include "client/spec_yaml.hpp"
 #include "core/lab/lab_test.hpp"
 #include "core/lab/rotating_drum.hpp"
-#include "proto/material_convert.hpp"
+#include "rpc/material_convert.hpp"
 #include "server/convert.hpp"
 
 namespace demcal::test {
@@ -66,9 +66,9 @@ TEST(Seed001Example, PlansWithTheSeedsMeasurementsAndOneDrumPerSurface) {
   EXPECT_EQ(ptfe->material().wall_law().tangential().params().at("mu_s"), 0.9);
   EXPECT_EQ(coated->material().wall_law().rolling().params().at("mu_r"), 0.2);
   // At the seed's lambda = 64 each drum holds about the seed's 200,000 granules (§4.2).
-  const auto model = proto::job_material(*coated);
+  const auto model = rpc::job_material(*coated);
   const auto s =
-      lab::read_settings<lab::RotatingDrumSettings>(proto::to_settings(coated->settings()), "s");
+      lab::read_settings<lab::RotatingDrumSettings>(rpc::to_settings(coated->settings()), "s");
   EXPECT_NEAR(double(lab::drum_bed(s, model.simulated_sizes(), "s").particles), 2e5, 2e4);
 }
 
@@ -82,10 +82,10 @@ TEST(Seed001Example, SmallVariantRunsADrumOfTheSeedsGranules) {
   const auto job = find_job(jobs, "drum_coated", 5);  // the centre point
   ASSERT_TRUE(job.has_value());
   EXPECT_NEAR(job->parameters().at("particle_law.tangential.mu_s"), 0.535, 1e-12);
-  const auto model = proto::job_material(*job);
-  const auto out = lab::run_lab_test(job->test(), model, proto::to_settings(job->settings()), {});
+  const auto model = rpc::job_material(*job);
+  const auto out = lab::run_lab_test(job->test(), model, rpc::to_settings(job->settings()), {});
   const auto s =
-      lab::read_settings<lab::RotatingDrumSettings>(proto::to_settings(job->settings()), "s");
+      lab::read_settings<lab::RotatingDrumSettings>(rpc::to_settings(job->settings()), "s");
   const auto bed = lab::drum_bed(s, model.simulated_sizes(), "s");
   EXPECT_EQ(out.metrics.at("particles"), double(bed.particles));
   EXPECT_NEAR(out.metrics.at("drum_diameter_ratio"), 15.4, 0.5);  // 100 mm / (31 x 208 um)

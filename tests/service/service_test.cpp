@@ -21,7 +21,7 @@
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "grpc/reflection/v1alpha/reflection.grpc.pb.h"
-#include "proto/channel.hpp"
+#include "rpc/channel.hpp"
 #include "tests/service/process.hpp"
 
 namespace demcal::test {
@@ -102,8 +102,8 @@ class Service : public ::testing::Test {
     std::ifstream(port_file) >> port_;
     channel_.address = "127.0.0.1:" + std::to_string(port_);
     channel_.token = kToken;
-    campaigns_ = v1::CampaignService::NewStub(proto::make_channel(channel_));
-    workers_stub_ = v1::WorkerService::NewStub(proto::make_channel(channel_));
+    campaigns_ = v1::CampaignService::NewStub(rpc::make_channel(channel_));
+    workers_stub_ = v1::WorkerService::NewStub(rpc::make_channel(channel_));
   }
 
   Process& start_worker(const std::string& id, const std::string& token = kToken,
@@ -139,7 +139,7 @@ class Service : public ::testing::Test {
   }
 
   std::unique_ptr<grpc::ClientContext> ctx(double seconds = 30) {
-    return proto::make_context(channel_, seconds);
+    return rpc::make_context(channel_, seconds);
   }
 
   grpc::Status submit(const std::string& yaml, std::int64_t* id = nullptr) {
@@ -191,7 +191,7 @@ class Service : public ::testing::Test {
 
   fs::path dir_;
   int port_ = 0;
-  proto::ChannelOptions channel_;
+  rpc::ChannelOptions channel_;
   std::unique_ptr<Process> server_;
   std::vector<std::unique_ptr<Process>> workers_;
   std::unique_ptr<v1::CampaignService::Stub> campaigns_;
@@ -200,16 +200,16 @@ class Service : public ::testing::Test {
 
 TEST_F(Service, MissingOrWrongTokenIsUnauthenticated) {
   start_server();
-  proto::ChannelOptions bad = channel_;
+  rpc::ChannelOptions bad = channel_;
   for (const std::string token : {"", "wrong-token"}) {
     bad.token = token;
-    auto stub = v1::CampaignService::NewStub(proto::make_channel(bad));
+    auto stub = v1::CampaignService::NewStub(rpc::make_channel(bad));
     v1::ListReply reply;
-    const auto s = stub->List(proto::make_context(bad, 10).get(), {}, &reply);
+    const auto s = stub->List(rpc::make_context(bad, 10).get(), {}, &reply);
     EXPECT_EQ(s.error_code(), grpc::StatusCode::UNAUTHENTICATED) << token;
-    auto wstub = v1::WorkerService::NewStub(proto::make_channel(bad));
+    auto wstub = v1::WorkerService::NewStub(rpc::make_channel(bad));
     v1::LeaseReply lease;
-    EXPECT_EQ(wstub->Lease(proto::make_context(bad, 10).get(), {}, &lease).error_code(),
+    EXPECT_EQ(wstub->Lease(rpc::make_context(bad, 10).get(), {}, &lease).error_code(),
               grpc::StatusCode::UNAUTHENTICATED);
   }
   v1::ListReply ok;
@@ -228,38 +228,38 @@ TEST_F(Service, AWorkerTokenCannotSubmitOrCancelAndAClientTokenCannotLeaseOrComp
   std::int64_t id = 0;
   ASSERT_TRUE(submit(tiny_spec(30), &id).ok());  // the operator's token opens both
   auto as = [&](const std::string& token) {
-    proto::ChannelOptions o = channel_;
+    rpc::ChannelOptions o = channel_;
     o.token = token;
     return o;
   };
   const auto worker = as("worker-secret"), client = as("client-secret");
-  auto campaigns_as = [&](const proto::ChannelOptions& o) {
-    return v1::CampaignService::NewStub(proto::make_channel(o));
+  auto campaigns_as = [&](const rpc::ChannelOptions& o) {
+    return v1::CampaignService::NewStub(rpc::make_channel(o));
   };
-  auto workers_as = [&](const proto::ChannelOptions& o) {
-    return v1::WorkerService::NewStub(proto::make_channel(o));
+  auto workers_as = [&](const rpc::ChannelOptions& o) {
+    return v1::WorkerService::NewStub(rpc::make_channel(o));
   };
   // The worker token: the worker service only.
   v1::SubmitRequest sreq;
   *sreq.mutable_spec() = cli::parse_campaign_spec(tiny_spec(30), "spec.yaml").spec;
   v1::SubmitReply sr;
-  auto st = campaigns_as(worker)->Submit(proto::make_context(worker, 10).get(), sreq, &sr);
+  auto st = campaigns_as(worker)->Submit(rpc::make_context(worker, 10).get(), sreq, &sr);
   EXPECT_EQ(st.error_code(), grpc::StatusCode::PERMISSION_DENIED) << st.error_message();
   v1::CancelRequest cancel;
   cancel.set_id(id);
   v1::Campaign c;
   EXPECT_EQ(
-      campaigns_as(worker)->Cancel(proto::make_context(worker, 10).get(), cancel, &c).error_code(),
+      campaigns_as(worker)->Cancel(rpc::make_context(worker, 10).get(), cancel, &c).error_code(),
       grpc::StatusCode::PERMISSION_DENIED);
   v1::LeaseRequest lr;
   lr.set_worker("w");
   v1::LeaseReply lease;
-  ASSERT_TRUE(workers_as(worker)->Lease(proto::make_context(worker, 10).get(), lr, &lease).ok());
+  ASSERT_TRUE(workers_as(worker)->Lease(rpc::make_context(worker, 10).get(), lr, &lease).ok());
   ASSERT_TRUE(lease.has_job());
   // The client token: the campaign service only.
   v1::LeaseReply other;
   EXPECT_EQ(
-      workers_as(client)->Lease(proto::make_context(client, 10).get(), lr, &other).error_code(),
+      workers_as(client)->Lease(rpc::make_context(client, 10).get(), lr, &other).error_code(),
       grpc::StatusCode::PERMISSION_DENIED);
   v1::CompleteRequest done;
   done.set_job_id(lease.job().job_id());
@@ -269,13 +269,13 @@ TEST_F(Service, AWorkerTokenCannotSubmitOrCancelAndAClientTokenCannotLeaseOrComp
   (*done.mutable_metrics())["coordination_number"] = 4.0;
   v1::CompleteReply cr;
   EXPECT_EQ(
-      workers_as(client)->Complete(proto::make_context(client, 10).get(), done, &cr).error_code(),
+      workers_as(client)->Complete(rpc::make_context(client, 10).get(), done, &cr).error_code(),
       grpc::StatusCode::PERMISSION_DENIED);
-  EXPECT_TRUE(workers_as(worker)->Complete(proto::make_context(worker, 10).get(), done, &cr).ok());
+  EXPECT_TRUE(workers_as(worker)->Complete(rpc::make_context(worker, 10).get(), done, &cr).ok());
   v1::ListReply list;
-  EXPECT_TRUE(campaigns_as(client)->List(proto::make_context(client, 10).get(), {}, &list).ok());
+  EXPECT_TRUE(campaigns_as(client)->List(rpc::make_context(client, 10).get(), {}, &list).ok());
   EXPECT_EQ(campaigns_as(as("nope"))
-                ->List(proto::make_context(as("nope"), 10).get(), {}, &list)
+                ->List(rpc::make_context(as("nope"), 10).get(), {}, &list)
                 .error_code(),
             grpc::StatusCode::UNAUTHENTICATED);
   // The CLI reads its token from a file (not the command line); a missing file is an error.
@@ -293,10 +293,10 @@ TEST_F(Service, AWorkerTokenCannotSubmitOrCancelAndAClientTokenCannotLeaseOrComp
 
 /// The status of one call to a method by name, with an empty message (for services the test
 /// has no stub of, such as reflection).
-grpc::Status call_by_name(const proto::ChannelOptions& o, const std::string& method) {
-  grpc::GenericStub stub(proto::make_channel(o));
+grpc::Status call_by_name(const rpc::ChannelOptions& o, const std::string& method) {
+  grpc::GenericStub stub(rpc::make_channel(o));
   grpc::CompletionQueue cq;
-  auto context = proto::make_context(o, 10);
+  auto context = rpc::make_context(o, 10);
   grpc::ByteBuffer request, response;
   grpc::Slice empty("");
   request = grpc::ByteBuffer(&empty, 1);
@@ -316,9 +316,9 @@ grpc::Status call_by_name(const proto::ChannelOptions& o, const std::string& met
 /// One request on a reflection stream, as `o` presents itself: the status of the call and the
 /// response (empty unless the call was admitted).
 std::pair<grpc::Status, grpc::reflection::v1alpha::ServerReflectionResponse> reflect(
-    const proto::ChannelOptions& o, const grpc::reflection::v1alpha::ServerReflectionRequest& r) {
-  auto stub = grpc::reflection::v1alpha::ServerReflection::NewStub(proto::make_channel(o));
-  auto context = proto::make_context(o, 10);
+    const rpc::ChannelOptions& o, const grpc::reflection::v1alpha::ServerReflectionRequest& r) {
+  auto stub = grpc::reflection::v1alpha::ServerReflection::NewStub(rpc::make_channel(o));
+  auto context = rpc::make_context(o, 10);
   auto stream = stub->ServerReflectionInfo(context.get());
   grpc::reflection::v1alpha::ServerReflectionResponse response;
   stream->Write(r);
@@ -340,7 +340,7 @@ TEST_F(Service, ReflectionIsServedOnlyWhenAskedForAndOnlyToTheClientToken) {
                {"--reflection", "--worker-token-file", path("worker.token"), "--client-token-file",
                 path("client.token")});
   auto as = [&](const std::string& token) {
-    proto::ChannelOptions o = channel_;
+    rpc::ChannelOptions o = channel_;
     o.token = token;
     return o;
   };
@@ -787,12 +787,12 @@ TEST_F(Service, WorkersRacingNeverShareAJob) {
   std::vector<std::thread> racers;
   for (int t = 0; t < 6; ++t)
     racers.emplace_back([&, t] {
-      auto stub = v1::WorkerService::NewStub(proto::make_channel(channel_));
+      auto stub = v1::WorkerService::NewStub(rpc::make_channel(channel_));
       for (int k = 0; k < 4; ++k) {
         v1::LeaseRequest lr;
         lr.set_worker("racer" + std::to_string(t));
         v1::LeaseReply r;
-        if (stub->Lease(proto::make_context(channel_, 10).get(), lr, &r).ok() && r.has_job()) {
+        if (stub->Lease(rpc::make_context(channel_, 10).get(), lr, &r).ok() && r.has_job()) {
           std::lock_guard lock(m);
           leased.insert(r.job().job_id());
         }
@@ -944,7 +944,7 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
 
 /// Runs the CLI against the test's coordinator; returns its standard output parsed as JSON.
 nlohmann::json cli_json(const std::string& dir, const std::string& name,
-                        const std::vector<std::string>& args, const proto::ChannelOptions& ch) {
+                        const std::vector<std::string>& args, const rpc::ChannelOptions& ch) {
   std::vector<std::string> argv{DEMCAL_CLI_BIN};
   argv.insert(argv.end(), args.begin(), args.end());
   for (const std::string a : {"--coordinator", ch.address.c_str(), "--token", kToken.c_str()})

@@ -9,7 +9,7 @@
 #include <memory>
 #include <string>
 
-namespace demcal::proto {
+namespace demcal::rpc {
 
 struct ChannelOptions {
   std::string address;  ///< host:port
@@ -29,4 +29,4 @@ std::string read_token_file(const std::string& path);
 std::unique_ptr<grpc::ClientContext> make_context(const ChannelOptions& options,
                                                   double deadline_seconds);
 
-}  // namespace demcal::proto
+}  // namespace demcal::rpc

@@ -9,7 +9,7 @@
 #include "core/lab/material.hpp"
 #include "demcal/v1/worker.pb.h"
 
-namespace demcal::proto {
+namespace demcal::rpc {
 
 /// Builds and validates a material model; InputError names the field below `where`
 /// ("spec.material.particle_law.normal.params.k1").
@@ -21,4 +21,4 @@ lab::MaterialModel job_material(const v1::JobSpec& job);
 
 lab::Settings to_settings(const google::protobuf::Map<std::string, double>& settings);
 
-}  // namespace demcal::proto
+}  // namespace demcal::rpc

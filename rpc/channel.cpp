@@ -1,11 +1,11 @@
-#include "proto/channel.hpp"
+#include "rpc/channel.hpp"
 
 #include <cctype>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
-namespace demcal::proto {
+namespace demcal::rpc {
 
 namespace {
 bool loopback(const std::string& a) {
@@ -56,4 +56,4 @@ std::string read_token_file(const std::string& path) {
   return token;
 }
 
-}  // namespace demcal::proto
+}  // namespace demcal::rpc

@@ -1,8 +1,8 @@
-#include "proto/material_convert.hpp"
+#include "rpc/material_convert.hpp"
 
 #include "core/common/error.hpp"
 
-namespace demcal::proto {
+namespace demcal::rpc {
 namespace {
 
 contact::SlotSpec to_slot(const v1::ContactSlot& s, const std::string& fallback_model) {
@@ -83,9 +83,9 @@ lab::MaterialModel to_material_model(const v1::Material& m, const std::string& w
   if (m.has_preparation()) {
     std::map<std::string, double> params(m.preparation().params().begin(),
                                          m.preparation().params().end());
-    model.preparation = lab::make_preparation(
-        m.preparation().method().empty() ? "pour" : m.preparation().method(), params,
-        where + ".preparation.params");
+    model.preparation =
+        lab::make_preparation(m.preparation().method().empty() ? "pour" : m.preparation().method(),
+                              params, where + ".preparation.params");
   }
   try {
     model.validate();
@@ -109,4 +109,4 @@ lab::Settings to_settings(const google::protobuf::Map<std::string, double>& sett
   return lab::Settings(settings.begin(), settings.end());
 }
 
-}  // namespace demcal::proto
+}  // namespace demcal::rpc
