@@ -148,228 +148,277 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
   return o;
 }
 
-}  // namespace
+/// This process's name for the coordinator: --id, or host:pid.
+std::string worker_id(const WorkerOptions& opt) {
+  if (!opt.id.empty()) return opt.id;
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  return std::string(host) + ":" + std::to_string(getpid());
+}
 
-WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
-  WorkerStats stats;
-  const std::string id = [&] {
-    if (!opt.id.empty()) return opt.id;
-    char host[256] = {};
-    gethostname(host, sizeof host - 1);
-    return std::string(host) + ":" + std::to_string(getpid());
-  }();
-  auto channel = rpc::make_channel(opt.channel);
-  auto stub = v1::WorkerService::NewStub(channel);
-  std::mt19937_64 jitter(std::hash<std::string>{}(id));
-  double backoff = 0.2;
-  auto back_off = [&](const grpc::Status& s, const char* what) {
-    spdlog::warn("{}: coordinator {} unavailable ({}); retrying in {:.1f} s", what,
-                 opt.channel.address, s.error_message(), backoff);
-    nap(backoff * (0.75 + 0.5 * std::uniform_real_distribution<>(0, 1)(jitter)), flags);
-    backoff = std::min(opt.max_backoff, backoff * 2);
-  };
-  // A job this worker will not run goes back as a failed attempt with the reason, so that the
-  // coordinator can give it to another worker (and fails it at the attempt cap).
-  auto report_refusal = [&](const v1::JobSpec& job, const std::string& why) {
-    v1::FailRequest f;
-    f.set_job_id(job.job_id());
-    f.set_attempt(job.attempt());
-    f.set_worker(id);
-    f.set_reason(why);
-    f.set_retryable(true);
-    v1::FailReply fr;
-    const auto s = stub->Fail(rpc::make_context(opt.channel, 10).get(), f, &fr);
-    ++stats.refused_jobs;
-    spdlog::warn("job {} refused: {} ({})", job.job_id(), why,
-                 s.ok() ? "reported" : s.error_message());
-  };
-  auto idle_since = Clock::now();
-  spdlog::info("worker {} -> {} ({} threads)", id, opt.channel.address, opt.threads);
+/// Heartbeats of one lease from their own thread, so that a long simulation step never lets the
+/// lease lapse; a reply saying the lease is gone sets `lease_lost`, which stops the simulation.
+class Heartbeat {
+ public:
+  Heartbeat(v1::WorkerService::Stub& stub, const rpc::ChannelOptions& channel,
+            const v1::JobSpec& job, const std::string& worker, double every,
+            const std::atomic<double>& progress, std::atomic<bool>& lease_lost)
+      : thread_([&, job, worker, every] {
+          std::unique_lock lock(mutex_);
+          while (
+              !cv_.wait_for(lock, std::chrono::duration<double>(every), [&] { return stopped_; })) {
+            lock.unlock();
+            beat(stub, channel, job, worker, progress, lease_lost);
+            lock.lock();
+          }
+        }) {}
+  Heartbeat(const Heartbeat&) = delete;
+  Heartbeat& operator=(const Heartbeat&) = delete;
+  ~Heartbeat() { stop(); }
 
-  while (!flags.stop && !flags.abort) {
-    if (opt.max_jobs > 0 && stats.completed + stats.failed >= opt.max_jobs) break;
+  void stop() {
+    {
+      std::lock_guard lock(mutex_);
+      stopped_ = true;
+    }
+    cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  static void beat(v1::WorkerService::Stub& stub, const rpc::ChannelOptions& channel,
+                   const v1::JobSpec& job, const std::string& worker,
+                   const std::atomic<double>& progress, std::atomic<bool>& lease_lost) {
+    v1::HeartbeatRequest h;
+    h.set_job_id(job.job_id());
+    h.set_attempt(job.attempt());
+    h.set_worker(worker);
+    h.set_progress(progress);
+    v1::HeartbeatReply hr;
+    const auto s = stub.Heartbeat(rpc::make_context(channel, 5).get(), h, &hr);
+    const bool gone = s.error_code() == grpc::StatusCode::FAILED_PRECONDITION ||
+                      s.error_code() == grpc::StatusCode::PERMISSION_DENIED;
+    if (gone && !lease_lost) {
+      lease_lost = true;
+      spdlog::warn("job {}: lease {} lost ({}); stopping its simulation", job.job_id(),
+                   job.attempt(), s.error_message());
+    } else if (!s.ok() && !lease_lost) {
+      spdlog::warn("job {}: heartbeat failed: {}", job.job_id(), s.error_message());
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool stopped_ = false;
+  std::thread thread_;  ///< last: started once the members it uses exist
+};
+
+/// The worker's loop: lease, run, report, until stopped. Each job is one pass of step().
+class Worker {
+ public:
+  Worker(const WorkerOptions& opt, StopFlags& flags)
+      : opt_(opt),
+        flags_(flags),
+        id_(worker_id(opt)),
+        stub_(v1::WorkerService::NewStub(rpc::make_channel(opt.channel))),
+        jitter_(std::hash<std::string>{}(id_)) {}
+
+  WorkerStats run() {
+    spdlog::info("worker {} -> {} ({} threads)", id_, opt_.channel.address, opt_.threads);
+    while (!flags_.stop && !flags_.abort) {
+      if (opt_.max_jobs > 0 && stats_.completed + stats_.failed >= opt_.max_jobs) break;
+      if (!step()) break;
+    }
+    spdlog::info(
+        "worker {} stopping: {} done, {} failed, {} refused, {} given back, {} abandoned, {} "
+        "jobs refused",
+        id_, stats_.completed, stats_.failed, stats_.rejected, stats_.given_back, stats_.abandoned,
+        stats_.refused_jobs);
+    return stats_;
+  }
+
+ private:
+  /// One lease and what follows from it; false when the loop must end.
+  bool step() {
     v1::LeaseRequest lreq;
-    lreq.set_worker(id);
+    lreq.set_worker(id_);
     v1::LeaseReply lease;
-    const auto ls = stub->Lease(rpc::make_context(opt.channel, 10).get(), lreq, &lease);
+    const auto ls = stub_->Lease(rpc::make_context(opt_.channel, 10).get(), lreq, &lease);
     if (ls.error_code() == grpc::StatusCode::UNAUTHENTICATED) {
       spdlog::error("coordinator refused the token: {}", ls.error_message());
-      stats.unauthenticated = true;
-      break;
+      stats_.unauthenticated = true;
+      return false;
     }
     if (!ls.ok()) {
       back_off(ls, "lease");
-      continue;
+      return true;
     }
-    backoff = 0.2;
+    backoff_ = kFirstBackoff;
     if (!lease.has_job()) {
-      if (opt.idle_exit > 0 &&
-          std::chrono::duration<double>(Clock::now() - idle_since).count() > opt.idle_exit)
-        break;
-      nap(lease.retry_after_seconds() > 0 ? lease.retry_after_seconds() : 1.0, flags);
-      continue;
+      if (opt_.idle_exit > 0 &&
+          std::chrono::duration<double>(Clock::now() - idle_since_).count() > opt_.idle_exit)
+        return false;
+      nap(lease.retry_after_seconds() > 0 ? lease.retry_after_seconds() : 1.0, flags_);
+      return true;
     }
-    const v1::JobSpec job = lease.job();
-    spdlog::info("job {} attempt {}: {} (campaign {}) on {} thread(s)", job.job_id(), job.attempt(),
-                 job.test(), job.campaign_id(), job_threads(job, opt.threads));
-    const auto started = Clock::now();
-    if (const std::string why = refusal(job, opt.max_particles); !why.empty()) {
-      report_refusal(job, why);
-      continue;
-    }
+    return run_leased(lease);
+  }
 
-    // Heartbeats from their own thread, so a long simulation step never lets the lease lapse.
+  bool run_leased(const v1::LeaseReply& lease) {
+    const v1::JobSpec& job = lease.job();
+    spdlog::info("job {} attempt {}: {} (campaign {}) on {} thread(s)", job.job_id(), job.attempt(),
+                 job.test(), job.campaign_id(), job_threads(job, opt_.threads));
+    const auto started = Clock::now();
+    if (const std::string why = refusal(job, opt_.max_particles); !why.empty()) {
+      // A job this worker will not run goes back as a failed attempt with the reason, so that
+      // the coordinator can give it to another worker (and fails it at the attempt cap).
+      const auto s = fail(job, why, /*retryable=*/true, /*give_back=*/false, 10);
+      ++stats_.refused_jobs;
+      spdlog::warn("job {} refused: {} ({})", job.job_id(), why,
+                   s.ok() ? "reported" : s.error_message());
+      return true;
+    }
     std::atomic<double> progress{0.0};
     JobStop job_stop;
-    job_stop.max_seconds = opt.max_job_seconds;
-    if (opt.max_job_seconds > 0)
+    job_stop.max_seconds = opt_.max_job_seconds;
+    if (opt_.max_job_seconds > 0)
       job_stop.deadline = started + std::chrono::duration_cast<Clock::duration>(
-                                        std::chrono::duration<double>(opt.max_job_seconds));
-    std::atomic<bool>& lease_lost = job_stop.lease_lost;
-    std::mutex hb_mutex;
-    std::condition_variable hb_cv;
-    bool hb_stop = false;
-    const double hb_every = lease.heartbeat_seconds() > 0 ? lease.heartbeat_seconds() : 10.0;
-    std::thread heartbeat([&] {
-      std::unique_lock lock(hb_mutex);
-      while (
-          !hb_cv.wait_for(lock, std::chrono::duration<double>(hb_every), [&] { return hb_stop; })) {
-        lock.unlock();
-        v1::HeartbeatRequest h;
-        h.set_job_id(job.job_id());
-        h.set_attempt(job.attempt());
-        h.set_worker(id);
-        h.set_progress(progress);
-        v1::HeartbeatReply hr;
-        const auto s = stub->Heartbeat(rpc::make_context(opt.channel, 5).get(), h, &hr);
-        const bool gone = s.error_code() == grpc::StatusCode::FAILED_PRECONDITION ||
-                          s.error_code() == grpc::StatusCode::PERMISSION_DENIED;
-        if (gone && !lease_lost) {
-          lease_lost = true;
-          spdlog::warn("job {}: lease {} lost ({}); stopping its simulation", job.job_id(),
-                       job.attempt(), s.error_message());
-        } else if (!s.ok() && !lease_lost) {
-          spdlog::warn("job {}: heartbeat failed: {}", job.job_id(), s.error_message());
-        }
-        lock.lock();
-      }
-    });
-    auto stop_heartbeat = [&] {
-      {
-        std::lock_guard lock(hb_mutex);
-        hb_stop = true;
-      }
-      hb_cv.notify_all();
-      heartbeat.join();
-    };
-
+                                        std::chrono::duration<double>(opt_.max_job_seconds));
+    Heartbeat heartbeat(*stub_, opt_.channel, job, id_,
+                        lease.heartbeat_seconds() > 0 ? lease.heartbeat_seconds() : 10.0, progress,
+                        job_stop.lease_lost);
     // The simulation runs on its own thread so that a stop request can give the lease back.
     // It reads `progress` and `job_stop` only until it returns; a detached simulation (give-back
     // on abort) is followed by the process exiting.
     auto task = std::make_shared<std::packaged_task<Outcome()>>(
-        [job, threads = opt.threads, &progress, &job_stop] {
+        [job, threads = opt_.threads, &progress, &job_stop] {
           return run_job(job, threads, progress, job_stop);
         });
     auto future = task->get_future();
     std::thread sim([task] { (*task)(); });
+    if (must_give_back(future, job)) {
+      sim.detach();  // the process is about to exit; the lease goes back now
+      heartbeat.stop();
+      const auto s = fail(job, "worker " + id_ + " stopping", true, /*give_back=*/true, 5);
+      spdlog::info("job {}: lease given back ({})", job.job_id(),
+                   s.ok() ? "ok" : s.error_message());
+      ++stats_.given_back;
+      return false;
+    }
+    sim.join();
+    const Outcome out = future.get();
+    heartbeat.stop();
+    const double wall = std::chrono::duration<double>(Clock::now() - started).count();
+    if (out.cancelled && job_stop.lease_lost) {
+      // Nobody wants this result any more: the coordinator refuses it and may have given the
+      // job to another worker.
+      ++stats_.abandoned;
+      spdlog::warn("job {}: simulation stopped after {:.2f} s: {}", job.job_id(), wall, out.reason);
+    } else {
+      report(job, out, wall);
+    }
+    idle_since_ = Clock::now();
+    return true;
+  }
+
+  /// Waits for the simulation; true when the lease must go back unfinished: an abort, or a
+  /// stop request that has waited longer than --drain-seconds.
+  bool must_give_back(std::future<Outcome>& future, const v1::JobSpec& job) {
     std::optional<Clock::time_point> stop_seen;
-    bool give_back = false;
     while (future.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
-      if (flags.abort) give_back = true;
-      if (flags.stop && !stop_seen) {
+      if (flags_.abort) return true;
+      if (flags_.stop && !stop_seen) {
         stop_seen = Clock::now();
         spdlog::info("stop requested: finishing job {} first", job.job_id());
       }
-      if (stop_seen && opt.drain_seconds > 0 &&
-          std::chrono::duration<double>(Clock::now() - *stop_seen).count() > opt.drain_seconds)
-        give_back = true;
-      if (give_back) break;
+      if (stop_seen && opt_.drain_seconds > 0 &&
+          std::chrono::duration<double>(Clock::now() - *stop_seen).count() > opt_.drain_seconds)
+        return true;
     }
-    if (give_back) {
-      sim.detach();  // the process is about to exit; the lease goes back now
-      stop_heartbeat();
-      v1::FailRequest f;
-      f.set_job_id(job.job_id());
-      f.set_attempt(job.attempt());
-      f.set_worker(id);
-      f.set_reason("worker " + id + " stopping");
-      f.set_give_back(true);
-      f.set_retryable(true);
-      v1::FailReply fr;
-      const auto s = stub->Fail(rpc::make_context(opt.channel, 5).get(), f, &fr);
-      spdlog::info("job {}: lease given back ({})", job.job_id(),
-                   s.ok() ? "ok" : s.error_message());
-      ++stats.given_back;
-      break;
-    }
-    sim.join();
-    Outcome out = future.get();
-    stop_heartbeat();
-    const double wall = std::chrono::duration<double>(Clock::now() - started).count();
-    if (out.cancelled && lease_lost) {
-      // Nobody wants this result any more: the coordinator refuses it and may have given the
-      // job to another worker.
-      ++stats.abandoned;
-      spdlog::warn("job {}: simulation stopped after {:.2f} s: {}", job.job_id(), wall, out.reason);
-      idle_since = Clock::now();
-      continue;
-    }
+    return false;
+  }
 
-    // Report; retried while the coordinator is away (a restart must not lose a result).
+  /// Reports the outcome; retried while the coordinator is away (a restart must not lose a
+  /// result).
+  void report(const v1::JobSpec& job, const Outcome& out, double wall) {
     for (int tries = 0;; ++tries) {
-      grpc::Status s;
-      if (out.ok) {
-        v1::CompleteRequest c;
-        c.set_job_id(job.job_id());
-        c.set_attempt(job.attempt());
-        c.set_worker(id);
-        c.set_wall_seconds(wall);
-        for (const auto& [k, v] : out.metrics) (*c.mutable_metrics())[k] = v;
-        for (const auto& [k, v] : out.flags) (*c.mutable_flags())[k] = v;
-        *c.mutable_cost() = out.cost;
-        for (const auto& s : out.series) *c.add_series() = s;
-        v1::CompleteReply cr;
-        s = stub->Complete(rpc::make_context(opt.channel, 10).get(), c, &cr);
-      } else {
-        v1::FailRequest f;
-        f.set_job_id(job.job_id());
-        f.set_attempt(job.attempt());
-        f.set_worker(id);
-        f.set_reason(out.reason);
-        f.set_retryable(out.retryable);
-        v1::FailReply fr;
-        s = stub->Fail(rpc::make_context(opt.channel, 10).get(), f, &fr);
-      }
+      const grpc::Status s =
+          out.ok ? complete(job, out, wall) : fail(job, out.reason, out.retryable, false, 10);
       if (s.ok()) {
         if (out.ok) {
-          ++stats.completed;
+          ++stats_.completed;
           spdlog::info("job {} done in {:.2f} s", job.job_id(), wall);
         } else {
-          ++stats.failed;
+          ++stats_.failed;
           spdlog::warn("job {} failed: {}", job.job_id(), out.reason);
         }
-        break;
+        return;
       }
       if (s.error_code() == grpc::StatusCode::FAILED_PRECONDITION) {
-        ++stats.rejected;
+        ++stats_.rejected;
         spdlog::warn("job {}: coordinator refused the report: {}", job.job_id(), s.error_message());
-        break;
+        return;
       }
-      if (s.error_code() == grpc::StatusCode::UNAUTHENTICATED || flags.abort || tries > 200) {
+      if (s.error_code() == grpc::StatusCode::UNAUTHENTICATED || flags_.abort || tries > 200) {
         spdlog::error("job {}: report not delivered: {}", job.job_id(), s.error_message());
-        break;
+        return;
       }
       back_off(s, out.ok ? "complete" : "fail");
-      if (flags.stop) nap(0.5, StopFlags{});  // keep trying while draining
+      if (flags_.stop) nap(0.5, StopFlags{});  // keep trying while draining
     }
-    idle_since = Clock::now();
   }
-  spdlog::info(
-      "worker {} stopping: {} done, {} failed, {} refused, {} given back, {} abandoned, {} jobs "
-      "refused",
-      id, stats.completed, stats.failed, stats.rejected, stats.given_back, stats.abandoned,
-      stats.refused_jobs);
-  return stats;
+
+  grpc::Status complete(const v1::JobSpec& job, const Outcome& out, double wall) {
+    v1::CompleteRequest c;
+    c.set_job_id(job.job_id());
+    c.set_attempt(job.attempt());
+    c.set_worker(id_);
+    c.set_wall_seconds(wall);
+    for (const auto& [k, v] : out.metrics) (*c.mutable_metrics())[k] = v;
+    for (const auto& [k, v] : out.flags) (*c.mutable_flags())[k] = v;
+    *c.mutable_cost() = out.cost;
+    for (const auto& series : out.series) *c.add_series() = series;
+    v1::CompleteReply cr;
+    return stub_->Complete(rpc::make_context(opt_.channel, 10).get(), c, &cr);
+  }
+
+  grpc::Status fail(const v1::JobSpec& job, const std::string& reason, bool retryable,
+                    bool give_back, double deadline_seconds) {
+    v1::FailRequest f;
+    f.set_job_id(job.job_id());
+    f.set_attempt(job.attempt());
+    f.set_worker(id_);
+    f.set_reason(reason);
+    f.set_retryable(retryable);
+    f.set_give_back(give_back);
+    v1::FailReply fr;
+    return stub_->Fail(rpc::make_context(opt_.channel, deadline_seconds).get(), f, &fr);
+  }
+
+  /// Waits before the next call to an unavailable coordinator: doubling up to --max-backoff,
+  /// with +-25 % jitter so that many workers do not return at once.
+  void back_off(const grpc::Status& s, const char* what) {
+    spdlog::warn("{}: coordinator {} unavailable ({}); retrying in {:.1f} s", what,
+                 opt_.channel.address, s.error_message(), backoff_);
+    nap(backoff_ * (0.75 + 0.5 * std::uniform_real_distribution<>(0, 1)(jitter_)), flags_);
+    backoff_ = std::min(opt_.max_backoff, backoff_ * 2);
+  }
+
+  static constexpr double kFirstBackoff = 0.2;
+  const WorkerOptions& opt_;
+  StopFlags& flags_;
+  const std::string id_;
+  std::unique_ptr<v1::WorkerService::Stub> stub_;
+  std::mt19937_64 jitter_;
+  double backoff_ = kFirstBackoff;
+  Clock::time_point idle_since_ = Clock::now();
+  WorkerStats stats_;
+};
+
+}  // namespace
+
+WorkerStats run_worker(const WorkerOptions& opt, StopFlags& flags) {
+  return Worker(opt, flags).run();
 }
 
 }  // namespace demcal::worker
