@@ -156,15 +156,16 @@ void from_json(const std::string& json, google::protobuf::Message& message) {
   if (!status.ok()) throw InputError("", std::string(status.message()));
 }
 
-CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs) {
-  CampaignPlan plan;
-  if (spec.name().empty()) throw InputError("spec.name", "missing");
-  if (!spec.has_material()) throw InputError("spec.material", "missing");
-  lab::MaterialModel model = rpc::to_material_model(spec.material(), "spec.material");
+namespace {
 
+/// A test instance of the spec: its name and material (its own wall law, if it has one).
+using Instances = std::vector<std::pair<std::string, lab::MaterialModel>>;
+
+/// Validates the tests and their settings; the responses "<instance>.<metric>" in order.
+Instances plan_tests(const v1::CampaignSpec& spec, CampaignPlan& plan) {
   if (spec.tests_size() == 0) throw InputError("spec.tests", "a campaign needs at least one test");
-  std::set<std::string> seen_tests;
-  std::vector<std::pair<std::string, lab::MaterialModel>> instances;  // name, model
+  std::set<std::string> seen;
+  Instances instances;
   for (int i = 0; i < spec.tests_size(); ++i) {
     const auto& t = spec.tests(i);
     const std::string where = "spec." + idx("tests", i);
@@ -176,7 +177,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
     }
     const std::string name = instance_name(t);
     if (!t.name().empty()) check_instance_name(t.name(), where + ".name");
-    if (!seen_tests.insert(name).second)
+    if (!seen.insert(name).second)
       throw InputError(where + (t.name().empty() ? ".test" : ".name"),
                        "test '" + name + "' appears twice (give each instance its own `name`)");
     const lab::Settings settings = rpc::to_settings(t.settings());
@@ -190,25 +191,45 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
     plan.tests.push_back(name);
     for (const auto& m : info->metrics) plan.responses.push_back(name + "." + m.name);
   }
+  return instances;
+}
 
-  {
-    std::map<std::string, double> fixed(spec.fixed().begin(), spec.fixed().end());
-    for (const auto& [path, value] : fixed) {
-      const std::string where = "spec.fixed." + path;
-      if (!find_parameter(lab::parameters(model), path))
-        throw InputError(where, "not a parameter of this material model (known: " +
-                                    known_paths(lab::parameters(model)) + ")");
-      check_settable(model, path, value, where);
-      lab::set_parameter(model, path, value);
-      for (auto& [name, instance] : instances) {
-        if (!find_parameter(lab::parameters(instance), path))
-          throw InputError(where,
-                           "not a parameter of test '" + name + "' (its own wall_law lacks it)");
-        lab::set_parameter(instance, path, value);
-      }
+/// Sets the spec's fixed parameters on the material and on every instance.
+void apply_fixed(const v1::CampaignSpec& spec, lab::MaterialModel& model, Instances& instances) {
+  const std::map<std::string, double> fixed(spec.fixed().begin(), spec.fixed().end());
+  for (const auto& [path, value] : fixed) {
+    const std::string where = "spec.fixed." + path;
+    if (!find_parameter(lab::parameters(model), path))
+      throw InputError(where, "not a parameter of this material model (known: " +
+                                  known_paths(lab::parameters(model)) + ")");
+    check_settable(model, path, value, where);
+    lab::set_parameter(model, path, value);
+    for (auto& [name, instance] : instances) {
+      if (!find_parameter(lab::parameters(instance), path))
+        throw InputError(where,
+                         "not a parameter of test '" + name + "' (its own wall_law lacks it)");
+      lab::set_parameter(instance, path, value);
     }
   }
+}
 
+/// A factor's bounds: finite, ordered, inside the parameter's valid range, > 0 on a log scale.
+void check_factor_bounds(const v1::Factor& f, const lab::ParameterInfo& info,
+                         const std::string& where) {
+  if (!std::isfinite(f.low())) throw InputError(where + ".low", "must be finite");
+  if (!std::isfinite(f.high())) throw InputError(where + ".high", "must be finite");
+  if (!(f.low() < f.high()))
+    throw InputError(where + ".high", "must be above low (" + fmt(f.low()) + ")");
+  const std::string range =
+      " the valid range [" + fmt(info.lo) + ", " + fmt(info.hi) + "] " + info.unit;
+  if (f.low() < info.lo) throw InputError(where + ".low", fmt(f.low()) + " is below" + range);
+  if (f.high() > info.hi) throw InputError(where + ".high", fmt(f.high()) + " is above" + range);
+  if (f.scale() == v1::Factor::LOG && !(f.low() > 0))
+    throw InputError(where + ".low", "must be > 0 on a log scale");
+}
+
+void plan_factors(const v1::CampaignSpec& spec, const lab::MaterialModel& model,
+                  const Instances& instances, CampaignPlan& plan) {
   const auto table = lab::parameters(model);
   if (spec.factors_size() == 0) throw InputError("spec.factors", "a campaign needs factors");
   if (spec.factors_size() > doe::kMaxFactors)
@@ -226,20 +247,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
       throw InputError(where + ".path", "'" + f.path() + "' is also in spec.fixed");
     if (!seen.insert(f.path()).second)
       throw InputError(where + ".path", "'" + f.path() + "' is a factor twice");
-    if (!std::isfinite(f.low())) throw InputError(where + ".low", "must be finite");
-    if (!std::isfinite(f.high())) throw InputError(where + ".high", "must be finite");
-    if (!(f.low() < f.high()))
-      throw InputError(where + ".high", "must be above low (" + fmt(f.low()) + ")");
-    if (f.low() < info->lo)
-      throw InputError(where + ".low", fmt(f.low()) + " is below the valid range [" +
-                                           fmt(info->lo) + ", " + fmt(info->hi) + "] " +
-                                           info->unit);
-    if (f.high() > info->hi)
-      throw InputError(where + ".high", fmt(f.high()) + " is above the valid range [" +
-                                            fmt(info->lo) + ", " + fmt(info->hi) + "] " +
-                                            info->unit);
-    const bool log = f.scale() == v1::Factor::LOG;
-    if (log && !(f.low() > 0)) throw InputError(where + ".low", "must be > 0 on a log scale");
+    check_factor_bounds(f, *info, where);
     check_settable(model, f.path(), f.low(), where + ".low");
     check_settable(model, f.path(), f.high(), where + ".high");
     for (const auto& [name, instance] : instances)
@@ -247,12 +255,14 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
         throw InputError(where + ".path", "'" + f.path() + "' is not a parameter of test '" + name +
                                               "' (its own wall_law lacks it)");
     plan.factors.push_back(
-        {f.path(), doe::Factor{f.name().empty() ? f.path() : f.name(), f.low(), f.high(),
-                               log ? doe::Scale::kLog : doe::Scale::kLinear}});
+        {f.path(),
+         doe::Factor{f.name().empty() ? f.path() : f.name(), f.low(), f.high(),
+                     f.scale() == v1::Factor::LOG ? doe::Scale::kLog : doe::Scale::kLinear}});
   }
+}
 
-  const int k = spec.factors_size();
-  const auto& d = spec.design();
+/// The run count the spec's design asks for: a power of two in [k + 1, 2^k].
+int design_runs(const v1::Design& d, int k) {
   const int full = 1 << k;
   int runs = d.runs() ? d.runs() : full;
   if (d.type() == v1::Design::FULL_FACTORIAL) {
@@ -268,6 +278,13 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
     throw InputError("spec.design.runs", std::to_string(runs) + " runs cannot estimate " +
                                              std::to_string(k) + " main effects (need at least " +
                                              std::to_string(k + 1) + ")");
+  return runs;
+}
+
+void plan_design(const v1::CampaignSpec& spec, CampaignPlan& plan) {
+  const int k = spec.factors_size();
+  const auto& d = spec.design();
+  const int runs = design_runs(d, k);
   check_repeats(d, runs, spec.tests_size());
   try {
     if (!d.generators().empty()) {
@@ -276,7 +293,8 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
         throw InputError("", "the generators give " + std::to_string(plan.design.runs()) +
                                  " runs, not " + std::to_string(runs));
     } else {
-      plan.design = runs == full ? doe::full_factorial(k) : doe::minimum_aberration_design(k, runs);
+      plan.design =
+          runs == (1 << k) ? doe::full_factorial(k) : doe::minimum_aberration_design(k, runs);
     }
   } catch (const InputError& e) {
     throw InputError(d.generators().empty() ? "spec.design.runs" : "spec.design.generators",
@@ -287,7 +305,11 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
   doe::add_centre_points(plan.design, d.centre_points());
   doe::replicate_runs(plan.design, d.replicates() ? d.replicates() : 1);
   if (d.seed()) doe::randomise_run_order(plan.design, d.seed());
+}
 
+/// The measurements as calibration targets: each names one response of the campaign.
+void plan_targets(const v1::CampaignSpec& spec, CampaignPlan& plan) {
+  const std::set<std::string> tests(plan.tests.begin(), plan.tests.end());
   for (int i = 0; i < spec.measurements_size(); ++i) {
     const auto& m = spec.measurements(i);
     const std::string where = "spec." + idx("measurements", i);
@@ -297,7 +319,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
       if (r.substr(dot + 1) == m.metric() && (m.test().empty() || r.substr(0, dot) == m.test()))
         matches.push_back(r);
     }
-    if (!m.test().empty() && !seen_tests.count(m.test()))
+    if (!m.test().empty() && !tests.count(m.test()))
       throw InputError(where + ".test", "'" + m.test() + "' is not one of the campaign's tests");
     if (matches.empty())
       throw InputError(where + ".metric", "no test of the campaign reports '" + m.metric() + "'");
@@ -315,7 +337,20 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
     if (m.uncertainty() > 0) t.uncertainty = m.uncertainty();
     plan.targets.push_back(t);
   }
+}
 
+}  // namespace
+
+CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs) {
+  CampaignPlan plan;
+  if (spec.name().empty()) throw InputError("spec.name", "missing");
+  if (!spec.has_material()) throw InputError("spec.material", "missing");
+  lab::MaterialModel model = rpc::to_material_model(spec.material(), "spec.material");
+  Instances instances = plan_tests(spec, plan);
+  apply_fixed(spec, model, instances);
+  plan_factors(spec, model, instances, plan);
+  plan_design(spec, plan);
+  plan_targets(spec, plan);
   // Checked at submission so that a bad calibration or diagnosis block is refused before
   // anything runs.
   (void)calibration_options(spec.calibration(), "spec.calibration");
