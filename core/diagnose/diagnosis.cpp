@@ -18,9 +18,9 @@ namespace {
 struct Plan {
   std::string id, cause;
   std::map<std::string, std::string> switches;
-  std::vector<Factor> factors;  ///< base factors, then the new one (if any)
-  double base_coded = 0.0;      ///< the new factor's coded value in the base runs
-  Eigen::MatrixXd new_rows;     ///< runs to simulate
+  std::vector<Factor> factors;                   ///< base factors, then the new one (if any)
+  double base_coded = 0.0;                       ///< the new factor's coded value in the base runs
+  Eigen::MatrixXd new_rows = Eigen::MatrixXd();  ///< runs to simulate
   doe::ModelKind model = doe::ModelKind::kTwoFactor;
 };
 
@@ -354,28 +354,14 @@ std::map<std::string, double> verified(const std::map<std::string, GroupResults>
   return g->at(1);
 }
 
-}  // namespace
-
-Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups) {
-  Step step;
-  Report& rep = step.report;
-  if (std::none_of(p.measurements.begin(), p.measurements.end(),
-                   [](const Measurement& m) { return !m.holdout; }))
-    throw InputError("measurements",
-                     "the diagnosis needs at least one measurement to calibrate "
-                     "against (not held out)");
-  const auto plans = candidate_plans(p);
-  const int k = static_cast<int>(p.design.cols());
-
-  // 1. Baseline: envelopes, calibration, conflicts, curvature (no new simulation).
-  const Fitted base = calibrate_targets(
-      p, p.factors, fit_targets(p, p.design, p.results, doe::ModelKind::kTwoFactor));
-  rep.baseline_proposed = natural_point(p.factors, base.result.natural);
-  rep.baseline_predicted_rms = std::sqrt(base.result.objective);
+/// Step 1, the baseline: each measured metric against the base box's envelope, the best
+/// calibration's prediction, curvature and (once verified) the simulated value.
+std::vector<MetricRow> baseline_rows(const Problem& p, const Fitted& base,
+                                     const std::map<std::string, double>& base_sim) {
   calib::CalibrationOptions eo;
   eo.starts = p.options.starts;
   eo.seed = p.options.seed;
-  const auto base_sim = verified(groups, "baseline");
+  std::vector<MetricRow> rows;
   for (std::size_t i = 0; i < p.measurements.size(); ++i) {
     const auto& m = p.measurements[i];
     MetricRow row;
@@ -399,89 +385,93 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
       row.simulated = it->second;
       row.relative_error = (it->second - m.value) / std::abs(m.value);
     }
-    rep.metrics.push_back(row);
+    rows.push_back(row);
   }
-  rep.conflicts = conflicts(p, base);
-  RunRequest baseline{"baseline", 1, {}, rep.baseline_proposed};
-  step.requests.push_back(baseline);
-  if (!base_sim.empty()) {
-    rep.baseline_verified_rms = rms_error(p, base.all, base_sim, false);
-    rep.baseline_holdout_rms = rms_error(p, base.all, base_sim, true);
-  }
+  return rows;
+}
 
-  // 2. Candidates: augmented designs, then their calibrations verified.
-  bool all_verified = !base_sim.empty();
-  for (const auto& plan : plans) {
-    CandidateOutcome c;
-    c.id = plan.id;
-    c.cause = plan.cause;
-    c.factors = plan.factors;
-    c.runs = static_cast<int>(plan.new_rows.rows());
-    for (Eigen::Index r = 0; r < plan.new_rows.rows(); ++r) {
-      RunRequest req{plan.id, static_cast<int>(r + 1), plan.switches, {}};
-      for (std::size_t f = 0; f < plan.factors.size(); ++f)
-        req.parameters[plan.factors[f].path] =
-            plan.factors[f].factor.to_natural(plan.new_rows(r, Eigen::Index(f)));
-      step.requests.push_back(std::move(req));
-    }
-    const auto* g = find_group(groups, plan.id);
-    if (!g || static_cast<Eigen::Index>(g->size()) < plan.new_rows.rows()) {
-      c.state = "pending";
-      all_verified = false;
-      rep.candidates.push_back(std::move(c));
-      continue;
-    }
-    // Base runs (with the new factor at its base value) and the new runs, fitted together.
-    const Eigen::Index n0 = p.design.rows(), n1 = plan.new_rows.rows();
-    const Eigen::Index cols = static_cast<Eigen::Index>(plan.factors.size());
-    Eigen::MatrixXd coded(n0 + n1, cols);
-    coded.topLeftCorner(n0, k) = p.design;
-    if (cols > k) coded.block(0, k, n0, 1).setConstant(plan.base_coded);
-    coded.bottomRows(n1) = plan.new_rows;
-    Eigen::MatrixXd y(n0 + n1, p.results.cols());
-    y.topRows(n0) = p.results;
-    y.bottomRows(n1) = group_matrix(p, *g, n1);
-    c.design_misprediction = misprediction(p, base.all, plan.new_rows, y.bottomRows(n1));
-    try {
-      // Calibrate, verify, add the verified run to the data, refit, and again: at most
-      // `rounds` rounds, fewer once a verified error is below `converged`.
-      auto models = fit_targets(p, coded, y, plan.model);
-      for (int round = 1; round <= p.options.rounds; ++round) {
-        const Fitted fit = calibrate_targets(p, plan.factors, models);
-        c.proposed = natural_point(plan.factors, fit.result.natural);
-        c.predicted_rms = std::sqrt(fit.result.objective);
-        c.reaches_all = fit.reaches_all;
-        c.state = "designed";
-        step.requests.push_back({plan.id + "/verify", round, plan.switches, c.proposed});
-        const auto* v = find_group(groups, plan.id + "/verify");
-        if (!v || !v->count(round)) {
-          all_verified = false;
-          break;
-        }
-        c.simulated = v->at(round);
-        c.rounds = round;
-        c.state = "verified";
-        c.verified_rms = rms_error(p, base.all, c.simulated, false);
-        c.holdout_rms = rms_error(p, base.all, c.simulated, true);
-        if (!std::isfinite(c.verified_rms)) {
-          c.state = "failed";
-          break;
-        }
-        if (c.verified_rms <= p.options.converged || round == p.options.rounds) break;
-        coded.conservativeResize(coded.rows() + 1, Eigen::NoChange);
-        coded.bottomRows(1) = fit.result.coded.transpose();
-        y.conservativeResize(y.rows() + 1, Eigen::NoChange);
-        y.bottomRows(1) = group_matrix(p, {{1, c.simulated}}, 1);
-        for (auto& m : models) refit(m.model, coded, y.col(response_column(p, m.name)), n0 + n1);
-      }
-    } catch (const InputError& e) {
+/// Calibrates a candidate on its data, verifies, adds the verified run, refits, and again: at
+/// most `rounds` rounds, fewer once a verified error is below `converged`. Appends the
+/// verification runs it needs; false when one has not finished.
+bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
+                   const std::map<std::string, GroupResults>& groups, Eigen::MatrixXd coded,
+                   Eigen::MatrixXd y, CandidateOutcome& c, std::vector<RunRequest>& requests) {
+  const Eigen::Index fitted_rows = coded.rows();
+  auto models = fit_targets(p, coded, y, plan.model);
+  for (int round = 1; round <= p.options.rounds; ++round) {
+    const Fitted fit = calibrate_targets(p, plan.factors, models);
+    c.proposed = natural_point(plan.factors, fit.result.natural);
+    c.predicted_rms = std::sqrt(fit.result.objective);
+    c.reaches_all = fit.reaches_all;
+    c.state = "designed";
+    requests.push_back({plan.id + "/verify", round, plan.switches, c.proposed});
+    const auto* v = find_group(groups, plan.id + "/verify");
+    if (!v || !v->count(round)) return false;
+    c.simulated = v->at(round);
+    c.rounds = round;
+    c.state = "verified";
+    c.verified_rms = rms_error(p, base.all, c.simulated, false);
+    c.holdout_rms = rms_error(p, base.all, c.simulated, true);
+    if (!std::isfinite(c.verified_rms)) {
       c.state = "failed";
-      c.evidence = std::string("could not be fitted: ") + e.what();
+      return true;
     }
-    rep.candidates.push_back(std::move(c));
+    if (c.verified_rms <= p.options.converged || round == p.options.rounds) return true;
+    coded.conservativeResize(coded.rows() + 1, Eigen::NoChange);
+    coded.bottomRows(1) = fit.result.coded.transpose();
+    y.conservativeResize(y.rows() + 1, Eigen::NoChange);
+    y.bottomRows(1) = group_matrix(p, {{1, c.simulated}}, 1);
+    for (auto& m : models) refit(m.model, coded, y.col(response_column(p, m.name)), fitted_rows);
   }
+  return true;
+}
 
-  // 3. Ranking, evidence and the named cause.
+/// Step 2 for one candidate: its augmented design's runs, then (once they finished) its
+/// calibrations verified. Appends the runs it needs; `finished` false while some are not done.
+CandidateOutcome assess_candidate(const Problem& p, const Plan& plan, const Fitted& base,
+                                  const std::map<std::string, GroupResults>& groups,
+                                  std::vector<RunRequest>& requests, bool& finished) {
+  CandidateOutcome c;
+  c.id = plan.id;
+  c.cause = plan.cause;
+  c.factors = plan.factors;
+  c.runs = static_cast<int>(plan.new_rows.rows());
+  for (Eigen::Index r = 0; r < plan.new_rows.rows(); ++r) {
+    RunRequest req{plan.id, static_cast<int>(r + 1), plan.switches, {}};
+    for (std::size_t f = 0; f < plan.factors.size(); ++f)
+      req.parameters[plan.factors[f].path] =
+          plan.factors[f].factor.to_natural(plan.new_rows(r, Eigen::Index(f)));
+    requests.push_back(std::move(req));
+  }
+  const auto* g = find_group(groups, plan.id);
+  if (!g || static_cast<Eigen::Index>(g->size()) < plan.new_rows.rows()) {
+    c.state = "pending";
+    finished = false;
+    return c;
+  }
+  // Base runs (with the new factor at its base value) and the new runs, fitted together.
+  const Eigen::Index k = p.design.cols(), n0 = p.design.rows(), n1 = plan.new_rows.rows();
+  const Eigen::Index cols = static_cast<Eigen::Index>(plan.factors.size());
+  Eigen::MatrixXd coded(n0 + n1, cols);
+  coded.topLeftCorner(n0, k) = p.design;
+  if (cols > k) coded.block(0, k, n0, 1).setConstant(plan.base_coded);
+  coded.bottomRows(n1) = plan.new_rows;
+  Eigen::MatrixXd y(n0 + n1, p.results.cols());
+  y.topRows(n0) = p.results;
+  y.bottomRows(n1) = group_matrix(p, *g, n1);
+  c.design_misprediction = misprediction(p, base.all, plan.new_rows, y.bottomRows(n1));
+  try {
+    if (!verify_rounds(p, plan, base, groups, coded, y, c, requests)) finished = false;
+  } catch (const InputError& e) {
+    c.state = "failed";
+    c.evidence = std::string("could not be fitted: ") + e.what();
+  }
+  return c;
+}
+
+/// Step 3: candidates ranked by their verified error, each verified one with its evidence and
+/// whether it explains the misfit.
+void rank_candidates(const Problem& p, Report& rep) {
   std::stable_sort(rep.candidates.begin(), rep.candidates.end(),
                    [](const CandidateOutcome& a, const CandidateOutcome& b) {
                      const double x = std::isfinite(a.verified_rms) ? a.verified_rms : 1e300;
@@ -507,7 +497,10 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
     e << (c.reaches_all ? "; its box reaches every target" : "; some target stays out of reach");
     c.evidence = e.str();
   }
-  rep.state = all_verified ? "done" : "running";
+}
+
+/// The named cause and the conclusion, once every candidate is verified.
+void name_cause(const Problem& p, bool all_verified, Report& rep) {
   // Parsimony: when the base box reaches every calibrated target, the misfit is first laid to
   // the design and its response model (an aliased interaction, curvature) before new physics
   // is named; when some target is out of reach, a model extension is looked at first.
@@ -549,9 +542,43 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
     rep.named_cause = named->id;
     rep.conclusion = why + "; named cause: " + named->cause + " (" + named->evidence + ")";
   } else {
-    rep.conclusion = "no candidate cuts the verified error (" + percent(base_rms) + ") by " +
-                     percent(p.options.margin) + " or more: none is named";
+    rep.conclusion = "no candidate cuts the verified error (" + percent(rep.baseline_verified_rms) +
+                     ") by " + percent(p.options.margin) + " or more: none is named";
   }
+}
+
+}  // namespace
+
+Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups) {
+  Step step;
+  Report& rep = step.report;
+  if (std::none_of(p.measurements.begin(), p.measurements.end(),
+                   [](const Measurement& m) { return !m.holdout; }))
+    throw InputError("measurements",
+                     "the diagnosis needs at least one measurement to calibrate "
+                     "against (not held out)");
+  const auto plans = candidate_plans(p);  // an unknown candidate is refused before any fit
+  // 1. Baseline: envelopes, calibration, conflicts, curvature (no new simulation).
+  const Fitted base = calibrate_targets(
+      p, p.factors, fit_targets(p, p.design, p.results, doe::ModelKind::kTwoFactor));
+  rep.baseline_proposed = natural_point(p.factors, base.result.natural);
+  rep.baseline_predicted_rms = std::sqrt(base.result.objective);
+  const auto base_sim = verified(groups, "baseline");
+  rep.metrics = baseline_rows(p, base, base_sim);
+  rep.conflicts = conflicts(p, base);
+  step.requests.push_back({"baseline", 1, {}, rep.baseline_proposed});
+  if (!base_sim.empty()) {
+    rep.baseline_verified_rms = rms_error(p, base.all, base_sim, false);
+    rep.baseline_holdout_rms = rms_error(p, base.all, base_sim, true);
+  }
+  // 2. Candidates: augmented designs, then their calibrations verified.
+  bool all_verified = !base_sim.empty();
+  for (const auto& plan : plans)
+    rep.candidates.push_back(assess_candidate(p, plan, base, groups, step.requests, all_verified));
+  // 3. Ranking, evidence and the named cause.
+  rank_candidates(p, rep);
+  rep.state = all_verified ? "done" : "running";
+  name_cause(p, all_verified, rep);
   return step;
 }
 
