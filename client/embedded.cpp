@@ -125,8 +125,10 @@ std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostrea
 namespace demcal::cli {
 
 std::string EmbeddedService::serve_http(const std::string& address, std::int64_t id) {
-  http_ = std::make_unique<server::HttpPage>(coordinator_->in_process_channel(),
-                                             server::HttpPageOptions{address, channel_.token});
+  server::HttpPageOptions options;
+  options.listen = address;
+  options.token = channel_.token;
+  http_ = std::make_unique<server::HttpPage>(coordinator_->in_process_channel(), options);
   const std::string host = address.substr(0, address.rfind(':'));
   return "http://" + host + ":" + std::to_string(http_->port()) + "/campaigns/" +
          std::to_string(id) + "#token=" + channel_.token;

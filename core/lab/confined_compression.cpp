@@ -15,36 +15,6 @@
 
 namespace demcal::lab {
 
-ServoSettings make_servo(const sim::World& w, double h, double stress_max, const ServoRequest& r) {
-  const auto& p = w.particles;
-  double d = 0.0, rho = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    d += 2.0 * p.radius[i];
-    rho += p.mass[i] / (4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3));
-  }
-  d /= static_cast<double>(p.size());
-  rho /= static_cast<double>(p.size());
-  ServoSettings s;
-  // Quasi-static: inertial number I = (v / h) d sqrt(rho / sigma) (GDR MiDi 2004) at the
-  // largest stress.
-  s.speed_scale = h / (d * std::sqrt(rho));
-  s.height = h;
-  s.bulk_density = 0.6 * rho;  // a settled bed, for the order of the stress-wave transit time
-  s.inertial_number = r.inertial_number;
-  s.approach_inertial_number = r.approach_inertial_number;
-  s.max_speed =
-      r.max_speed > 0.0 ? r.max_speed : r.inertial_number * s.speed_scale * std::sqrt(stress_max);
-  // Full speed at an error of the whole largest stress: slow enough that the loop stays well
-  // behind the bed's elastic wave transit time for usual bulk stiffnesses.
-  s.kp = r.kp > 0.0 ? r.kp : s.max_speed / stress_max;
-  s.ki = r.ki;
-  s.kd = r.kd;
-  s.tolerance = r.tolerance;  // relative; servo_phase callers scale it per target
-  s.hold_time = r.hold_steps * w.dt;
-  s.max_time = r.max_phase_time;
-  return s;
-}
-
 LabOutput run_confined_compression(const MaterialModel& material, const Settings& values,
                                    const RunOptions& options) {
   const auto s = read_settings<ConfinedCompressionSettings>(values, "settings");
@@ -62,7 +32,7 @@ LabOutput run_confined_compression(const MaterialModel& material, const Settings
   add_bed_phases(out, bed, {"compressibility", "confined_modulus"});
   write_snapshot(w, options, "settled", out);
   const double s_max = s.max_stress * fs;
-  ServoSettings servo = make_servo(w, bed.h0, s_max, servo_request(s));
+  ServoSettings servo = make_servo(w, bed.h0, s_max, s);
   Series series{{"time_s", "height_m", "stress_kPa", "phase"}, {}};
   int phase_no = 0;
   // Each phase is recorded with the metrics computed from its end state.

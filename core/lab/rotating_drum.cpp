@@ -50,7 +50,7 @@ bool centrifuging(const sim::World& w, double radius) {
       covered[std::min(kSectors - 1, static_cast<int>(phi / (2.0 * M_PI) * kSectors))] = true;
     }
   }
-  return std::count(covered.begin(), covered.end(), true) >= 0.9 * kSectors;
+  return static_cast<double>(std::count(covered.begin(), covered.end(), true)) >= 0.9 * kSectors;
 }
 
 /// The drum (an inner cylinder about z) and its two end plates, all pivoting about the axis so
@@ -99,7 +99,7 @@ double DrumImage::occupied_percent() const {
       ++drum;
       occupied += at(i, j);
     }
-  return drum ? 100.0 * occupied / drum : 0.0;
+  return drum ? 100.0 * static_cast<double>(occupied) / static_cast<double>(drum) : 0.0;
 }
 
 std::vector<std::pair<double, double>> DrumImage::surface() const {
@@ -233,7 +233,9 @@ LabOutput run_rotating_drum(const MaterialModel& material, const Settings& value
     out.metrics["csa_occupied_" + std::to_string(rpm)] = csa;
     out.metrics["centrifuging_" + std::to_string(rpm)] = centri ? 1.0 : 0.0;
     area.rows.push_back({double(rpm), omega * 60.0 / (2.0 * M_PI), csa, centri ? 1.0 : 0.0});
-    if (options.progress) options.progress(0.4 + 0.6 * (k + 1) / kDrumSpeeds.size());
+    if (options.progress)
+      options.progress(0.4 +
+                       0.6 * static_cast<double>(k + 1) / static_cast<double>(kDrumSpeeds.size()));
   }
   out.metrics["drum_diameter"] = 2.0 * radius;
   out.metrics["drum_diameter_ratio"] = bed.diameter_ratio;

@@ -223,8 +223,8 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
   });
   out.add_phase(pre_clock.stop(w, "pre-shear", "tip travel of pre_shear_travel diameters", true),
                 {});
-  const double tau_pre = tau_n ? tau_sum / tau_n : 0.0;
-  const double sigma_pre_measured = tau_n ? sigma_sum / tau_n : sigma_pre;
+  const double tau_pre = tau_n ? tau_sum / static_cast<double>(tau_n) : 0.0;
+  const double sigma_pre_measured = tau_n ? sigma_sum / static_cast<double>(tau_n) : sigma_pre;
   w.walls[kHead].omega = {};
   if (!options.snapshot_dir.empty()) {
     io::write_particles_vtk(options.snapshot_dir + "/shear_cell_preshear_particles.vtk", w);
@@ -273,9 +273,10 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
         sig_sum -= recent_sig.front();
         recent_sig.pop_front();
       }
-      if (static_cast<long>(recent.size()) == window && recent_sum / window > tau_max) {
-        tau_max = recent_sum / window;
-        sig_at_max = sig_sum / window;
+      const auto span = static_cast<double>(window);
+      if (static_cast<long>(recent.size()) == window && recent_sum / span > tau_max) {
+        tau_max = recent_sum / span;
+        sig_at_max = sig_sum / span;
       }
       return angle * r_head < 1.5 * d;  // yielded: the tips have moved 1.5 diameters
     });
@@ -289,7 +290,9 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
     // The locus uses the normal stress measured on the floor at the yield point.
     xs.push_back(sig_at_max / real_kpa);
     ys.push_back(tau_max / real_kpa);
-    if (options.progress) options.progress(0.4 + 0.6 * (k + 1) / kShearNormalKPa.size());
+    if (options.progress)
+      options.progress(0.4 + 0.6 * static_cast<double>(k + 1) /
+                                 static_cast<double>(kShearNormalKPa.size()));
   }
 
   // The yield locus: least squares tau = slope sigma + intercept through the yield points (kPa).

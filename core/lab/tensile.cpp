@@ -78,7 +78,7 @@ LabOutput run_tensile(const MaterialModel& material, const Settings& values,
   sim::World& w = bed.world;
   LabOutput out;
   add_bed_phases(out, bed, {});
-  const ServoSettings servo = make_servo(w, bed.h0, s.consolidation_stress * fs, servo_request(s));
+  const ServoSettings servo = make_servo(w, bed.h0, s.consolidation_stress * fs, s);
   auto phase = [&](double target_real) {
     ServoSettings ps = servo;
     ps.tolerance = std::max(servo.tolerance * target_real, 2e-3 * s.consolidation_stress) * fs;
@@ -118,7 +118,7 @@ LabOutput run_tensile(const MaterialModel& material, const Settings& values,
     acc += -world.walls[bed.piston].force.z / bed.area;
     ++n_acc;
     if (n_acc == window) {
-      const double sigma = acc / n_acc;
+      const double sigma = acc / static_cast<double>(n_acc);
       if (sigma > peak) {
         peak = sigma;
         peak_strain = (z - h_start) / h_start;

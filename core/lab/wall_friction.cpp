@@ -45,7 +45,7 @@ LabOutput run_wall_friction(const MaterialModel& material, const Settings& value
   add_bed_phases(out, bed, {});
   const auto& stresses = wall_friction_stresses();
   const double s_max = stresses.back() * s.stress_factor * fs;
-  const ServoSettings servo = make_servo(w, bed.h0, s_max, servo_request(s));
+  const ServoSettings servo = make_servo(w, bed.h0, s_max, s);
   double d_mean = 0.0;
   for (double r : w.particles.radius) d_mean += 2.0 * r;
   d_mean /= static_cast<double>(w.particles.size());

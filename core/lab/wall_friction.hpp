@@ -11,16 +11,14 @@
 
 namespace demcal::lab {
 
-struct WallFrictionSettings {
+struct WallFrictionSettings : PistonServoSettings {
   static constexpr const char* kName = "wall_friction";
   double particles, time_step_safety, stress_factor, rim_speed, rotation_diameters,
       wall_stiffness_factor, bottom_friction;
-  double servo_max_speed, servo_kp, servo_ki, servo_kd, servo_tolerance, hold_steps, max_phase_time,
-      servo_inertial_number, approach_inertial_number;
 
   static std::array<contact::ParamInfo<WallFrictionSettings>, 16> table() {
     using S = WallFrictionSettings;
-    return {
+    return with_piston_rows(std::array<contact::ParamInfo<S>, 7>{
         {{"particles", "-", 20, 1e7, 300, "number of particles", &S::particles},
          {"time_step_safety", "-", 0.01, 1.0, 0.2, "time step as a fraction of the critical one",
           &S::time_step_safety},
@@ -38,8 +36,7 @@ struct WallFrictionSettings {
          {"bottom_friction", "-", 0.0, 10.0, 1.0,
           "friction coefficient of the container bottom, which holds the bed against the "
           "turning piston",
-          &S::bottom_friction},
-         DEMCAL_SERVO_SETTINGS(S)}};
+          &S::bottom_friction}}});
   }
   void finalize(const std::string&) {}
 };

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/common/error.hpp"
-#include "core/lab/bed.hpp"
+#include "core/lab/piston.hpp"
 #include "lab_test_util.hpp"
 
 namespace demcal::lab {
