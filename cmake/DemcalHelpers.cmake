@@ -101,3 +101,17 @@ function(demcal_forbid_links target)
     endif()
   endforeach()
 endfunction()
+
+# Fails the configuration when a source or header under `dir` includes a header of one of the
+# folders after FORBIDS (e.g. core/model never includes the lab runners or the engine).
+function(demcal_forbid_includes dir)
+  cmake_parse_arguments(ARG "" "" "FORBIDS" ${ARGN})
+  file(GLOB files ${PROJECT_SOURCE_DIR}/${dir}/*.hpp ${PROJECT_SOURCE_DIR}/${dir}/*.cpp)
+  list(JOIN ARG_FORBIDS "|" alternatives)
+  foreach(f ${files})
+    file(STRINGS ${f} hits REGEX "#include \"(${alternatives})/")
+    if(hits)
+      message(FATAL_ERROR "${f} includes ${hits}: docs/architecture.md forbids it")
+    endif()
+  endforeach()
+endfunction()

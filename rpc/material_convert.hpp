@@ -5,8 +5,8 @@
 #include <map>
 #include <string>
 
-#include "core/lab/catalog.hpp"
-#include "core/lab/material.hpp"
+#include "core/model/catalog.hpp"
+#include "core/model/material.hpp"
 #include "demcal/v1/worker.pb.h"
 
 namespace demcal::rpc {

@@ -11,7 +11,7 @@
 #include "core/common/error.hpp"
 #include "core/doe/alias_structure.hpp"
 #include "core/doe/minimum_aberration.hpp"
-#include "core/lab/catalog.hpp"
+#include "core/model/catalog.hpp"
 #include "rpc/effects_convert.hpp"
 #include "rpc/material_convert.hpp"
 #include "server/calibration.hpp"

@@ -8,7 +8,7 @@
 
 #include "core/common/error.hpp"
 #include "core/diagnose/diagnosis.hpp"
-#include "core/lab/material.hpp"
+#include "core/model/material.hpp"
 #include "rpc/material_convert.hpp"
 #include "server/analysis.hpp"
 #include "server/convert.hpp"

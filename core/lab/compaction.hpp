@@ -7,55 +7,10 @@
 #include <array>
 
 #include "core/lab/lab_test.hpp"
+#include "core/model/compaction_settings.hpp"
 
 namespace demcal::lab {
 
-struct CompactionSettings {
-  static constexpr const char* kName = "compaction";
-  double particles;
-  double phi_start;     ///< solid fraction of the random fill
-  double phi_max;       ///< the last target
-  double points;        ///< targets, evenly spaced above phi_start up to phi_max
-  double strain_rate;   ///< linear strain of the cell per critical time (quasi-static: << 1)
-  double hold;          ///< hold at each target, in critical times
-  double probe_strain;  ///< axial strain of the constant-volume shear probe at phi_max; 0: none
-  double yield_probes;  ///< 1: unload to the reference state and probe yield along five paths
-  double unload_ratio;  ///< the reference state's pressure over the one held at phi_max
-  double yield_strain;  ///< equivalent plastic strain at yield (seed 004 eq. 2.11)
-  double time_step_safety;
-
-  static std::array<contact::ParamInfo<CompactionSettings>, 11> table() {
-    using S = CompactionSettings;
-    return {{{"particles", "-", 20, 1e6, 300, "number of particles (bodies)", &S::particles},
-             {"phi_start", "-", 0.05, 0.3, 0.2, "solid fraction of the random fill", &S::phi_start},
-             {"phi_max", "-", 0.36, 0.9, 0.7, "last target solid fraction", &S::phi_max},
-             {"points", "-", 1, 50, 8,
-              "targets held and read, evenly spaced above phi_start up to phi_max", &S::points},
-             {"strain_rate", "-", 1e-7, 1e-2, 1e-5,
-              "linear strain of the cell per critical time sqrt(m/k) (quasi-static: << 1)",
-              &S::strain_rate},
-             {"hold", "-", 10, 1e5, 200, "hold at each target, in critical times", &S::hold},
-             {"probe_strain", "-", 0.0, 0.5, 0.1,
-              "axial strain of the constant-volume shear probe from phi_max (0: no probe)",
-              &S::probe_strain},
-             {"yield_probes", "-", 0.0, 1.0, 1,
-              "1: unload to the reference state and probe yield along five strain paths; 0: none",
-              &S::yield_probes},
-             {"unload_ratio", "-", 0.01, 0.9, 0.1,
-              "pressure of the reference state over the one held at phi_max", &S::unload_ratio},
-             {"yield_strain", "-", 1e-4, 0.05, 2e-3,
-              "equivalent plastic strain at yield (seed 004 eq. 2.11: 0.002)", &S::yield_strain},
-             {"time_step_safety", "-", 0.01, 1.0, 0.2,
-              "time step as a fraction of the critical one", &S::time_step_safety}}};
-  }
-  void finalize(const std::string& where) {
-    if (!(phi_max > phi_start)) throw InputError(where + ".phi_max", "must exceed phi_start");
-    if (yield_probes != 0.0 && yield_probes != 1.0)
-      throw InputError(where + ".yield_probes", "must be 0 or 1");
-  }
-};
-
-LabTestInfo compaction_info();  ///< in catalog.cpp
 LabOutput run_compaction(const MaterialModel& material, const Settings& settings,
                          const RunOptions& options);
 

@@ -6,37 +6,10 @@
 
 #include "core/lab/lab_test.hpp"
 #include "core/lab/piston.hpp"
+#include "core/model/confined_compression_settings.hpp"
 
 namespace demcal::lab {
 
-struct ConfinedCompressionSettings : PistonServoSettings {
-  static constexpr const char* kName = "confined_compression";
-  double particles, time_step_safety, max_stress, min_stress, final_stress, cycles,
-      wall_stiffness_factor;
-
-  static std::array<contact::ParamInfo<ConfinedCompressionSettings>, 16> table() {
-    using S = ConfinedCompressionSettings;
-    return with_piston_rows(std::array<contact::ParamInfo<S>, 7>{
-        {{"particles", "-", 20, 1e7, 300, "number of particles", &S::particles},
-         {"time_step_safety", "-", 0.01, 1.0, 0.2, "time step as a fraction of the critical one",
-          &S::time_step_safety},
-         {"max_stress", "Pa", 1.0, 1e9, 15000.0, "load stress (real; seed 000: 15 kPa)",
-          &S::max_stress},
-         {"min_stress", "Pa", 0.0, 1e9, 500.0, "unload stress of the cycles (real; 0.5 kPa)",
-          &S::min_stress},
-         {"final_stress", "Pa", 0.0, 1e9, 100.0, "stress of the final unload (real)",
-          &S::final_stress},
-         {"cycles", "-", 1, 50, 5, "unload-reload cycles after the first load", &S::cycles},
-         {"wall_stiffness_factor", "-", 0.01, 1e4, 30.0,
-          "piston and bottom stiffness over the particle stiffness (seed 000: 30)",
-          &S::wall_stiffness_factor}}});
-  }
-  void finalize(const std::string& where) {
-    if (min_stress >= max_stress) throw InputError(where + ".min_stress", "must be < max_stress");
-  }
-};
-
-LabTestInfo confined_compression_info();  ///< in catalog.cpp
 LabOutput run_confined_compression(const MaterialModel& material, const Settings& settings,
                                    const RunOptions& options);
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "core/lab/catalog.hpp"
 #include "core/lab/cost.hpp"
-#include "core/lab/material.hpp"
+#include "core/model/catalog.hpp"
+#include "core/model/material.hpp"
 
 namespace demcal::lab {
 

@@ -5,34 +5,10 @@
 #include <array>
 
 #include "core/lab/lab_test.hpp"
+#include "core/model/packing_settings.hpp"
 
 namespace demcal::lab {
 
-struct PackingSettings {
-  static constexpr const char* kName = "packing";
-  double particles;
-  double time_step_safety;
-  double
-      wall_margin;  ///< sampling volume keeps this many largest diameters from die, floor and top
-  double cut_fraction;       ///< bed cut at this fraction of its height
-
-  static std::array<contact::ParamInfo<PackingSettings>, 4> table() {
-    using S = PackingSettings;
-    return {
-        {{"particles", "-", 20, 1e7, 300, "number of particles", &S::particles},
-         {"time_step_safety", "-", 0.01, 1.0, 0.2, "time step as a fraction of the critical one",
-          &S::time_step_safety},
-         {"wall_margin", "-", 0.0, 10.0, 1.0,
-          "distance of the sampling volume from the walls and the top, in largest diameters",
-          &S::wall_margin},
-         {"cut_fraction", "-", 0.1, 1.0, 1.0,
-          "particles above this fraction of the settled bed height are removed",
-          &S::cut_fraction}}};
-  }
-  void finalize(const std::string&) {}
-};
-
-LabTestInfo packing_info();  ///< in catalog.cpp
 LabOutput run_packing(const MaterialModel& material, const Settings& settings,
                       const RunOptions& options);
 

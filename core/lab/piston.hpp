@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "core/lab/bed.hpp"
-#include "core/lab/piston_settings.hpp"
+#include "core/model/piston_settings.hpp"
 
 namespace demcal::lab {
 

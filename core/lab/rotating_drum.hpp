@@ -7,80 +7,10 @@
 #include <vector>
 
 #include "core/lab/lab_test.hpp"
+#include "core/model/rotating_drum_settings.hpp"
 #include "core/particles/size_distribution.hpp"
 
 namespace demcal::lab {
-
-/// The drum speeds of the area method (seed 001 §3.2.3), rpm of the seed's 100 mm drum.
-inline constexpr std::array<int, 5> kDrumSpeeds = {4, 40, 80, 105, 116};
-
-struct RotatingDrumSettings {
-  static constexpr const char* kName = "rotating_drum";
-  double diameter;        ///< (mm) inner drum diameter D, real (seed 001 §3.2.2: 100 mm)
-  double length;          ///< (mm) drum depth W between the end plates, real (seed: 44 mm)
-  double fill;            ///< filling degree (bulk volume over drum volume; seed: 43 %)
-  double solid_fraction;  ///< solid fraction of the bulk the fill is counted in
-  double rpm;             ///< drum speed of the dynamic angle of repose (seed: 4 rpm)
-  double max_particles;   ///< resource limit on the particle count the geometry asks for
-  double froude_scaling;  ///< 1: speeds keep the Froude number of the seed's 100 mm drum
-  double speed_scale;     ///< multiplies every drum speed
-  double angle_time;      ///< (s) at `rpm` (after the bed has turned to its angle)
-  double area_time;       ///< (s) per speed of the area method
-  double time_step_safety;
-
-  static std::array<contact::ParamInfo<RotatingDrumSettings>, 11> table() {
-    return {
-        {{"diameter", "mm", 1, 5000, 100, "inner drum diameter D (seed 001: 100 mm)",
-          &RotatingDrumSettings::diameter},
-         {"length", "mm", 0.5, 5000, 44, "drum depth W between the end plates (seed 001: 44 mm)",
-          &RotatingDrumSettings::length},
-         {"fill", "-", 0.05, 0.9, 0.43,
-          "filling degree: bulk volume over drum volume "
-          "(seed 001: 43 %)",
-          &RotatingDrumSettings::fill},
-         {"solid_fraction", "-", 0.3, 0.74, 0.6,
-          "solid fraction of the bulk: particles = fill pi D^2/4 W solid_fraction / mean "
-          "particle volume (simulated sizes)",
-          &RotatingDrumSettings::solid_fraction},
-         {"rpm", "rpm", 0.1, 200, 4, "drum speed of the dynamic angle of repose (seed 001: 4 rpm)",
-          &RotatingDrumSettings::rpm},
-         {"max_particles", "-", 20, 1e8, 20000,
-          "resource limit: a geometry asking for more particles is refused",
-          &RotatingDrumSettings::max_particles},
-         {"froude_scaling", "-", 0, 1, 1,
-          "1: scale the rpm to keep the Froude number w^2 D / 2g of the seed's 100 mm drum "
-          "(no change at D = 100 mm); 0: use the rpm as they are",
-          &RotatingDrumSettings::froude_scaling},
-         {"speed_scale", "-", 0.01, 100, 1, "multiplies every drum speed",
-          &RotatingDrumSettings::speed_scale},
-         {"angle_time", "s", 0.05, 100, 1.5,
-          "time at `rpm` for the dynamic angle, after the bed has turned to its angle",
-          &RotatingDrumSettings::angle_time},
-         {"area_time", "s", 0.02, 100, 0.8, "time per speed of the area method",
-          &RotatingDrumSettings::area_time},
-         {"time_step_safety", "-", 0.01, 1.0, 0.2, "time step as a fraction of the critical one",
-          &RotatingDrumSettings::time_step_safety}}};
-  }
-  void finalize(const std::string&) {}
-};
-
-/// The drum and its bed as the geometry decides them: the drum in real units, the particle count
-/// from the fill and the simulated (coarse-grained) size distribution.
-struct DrumBed {
-  double radius = 0.0;          ///< (m)
-  double length = 0.0;          ///< (m)
-  std::size_t particles = 0;    ///< fill pi R^2 W solid_fraction / mean simulated particle volume
-  double mean_diameter = 0.0;   ///< number-mean simulated particle diameter d (m)
-  double diameter_ratio = 0.0;  ///< D / d
-};
-/// Sizes the bed of a drum; InputError naming `where`.max_particles when the count exceeds the
-/// limit, `where`.diameter or `where`.length when the drum is too small for its particles.
-DrumBed drum_bed(const RotatingDrumSettings& s, const particles::SizeDistribution& simulated,
-                 const std::string& where);
-/// The drum speed as written in phase names ("4", "105", "2.5").
-std::string drum_rpm_label(double rpm);
-
-LabTestInfo rotating_drum_info();  ///< in catalog.cpp
 LabOutput run_rotating_drum(const MaterialModel& material, const Settings& settings,
                             const RunOptions& options);
 

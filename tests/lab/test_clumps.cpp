@@ -49,7 +49,7 @@ INSTANTIATE_TEST_SUITE_P(Lab, EveryTest,
                          ::testing::Values("packing", "confined_compression", "tensile",
                                            "wall_friction", "shear_cell", "rotating_drum",
                                            "hopper"),
-                         [](const auto& info) { return std::string(info.param); });
+                         [](const auto& test_info) { return std::string(test_info.param); });
 
 TEST(ClumpPacking, RodsTouchMoreNeighboursThanSpheres) {
   const Settings s{{"particles", 120}};

@@ -1,4 +1,4 @@
-// The material's bed preparation (seed 000 §2.7.1, core/lab/preparation.hpp) as a user writes
+// The material's bed preparation (seed 000 §2.7.1, core/model/preparation.hpp) as a user writes
 // it: read from a lab spec's YAML, its parameters as factor paths of the method chosen only,
 // and every mistake an InputError naming the field (and, from YAML, its line).
 #include <gtest/gtest.h>

@@ -16,6 +16,14 @@
 namespace demcal::server {
 namespace {
 
+/// The page's options without TLS.
+HttpPageOptions page_options(const std::string& listen, const std::string& token) {
+  HttpPageOptions o;
+  o.listen = listen;
+  o.token = token;
+  return o;
+}
+
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
@@ -38,13 +46,13 @@ httplib::Headers bearer(const std::string& token) {
 }
 
 TEST(HttpPage, RefusesToServeBeyondLoopbackWithoutAToken) {
-  EXPECT_THROW(HttpPage(nullptr, HttpPageOptions{"0.0.0.0:0", ""}), std::invalid_argument);
+  EXPECT_THROW(HttpPage(nullptr, page_options("0.0.0.0:0", "")), std::invalid_argument);
 }
 
 TEST(HttpPage, JsonNeedsTheCoordinatorsTokenAndThePagesCarryNoData) {
   const fs::path dir = scratch("plain");
   Coordinator coordinator(coordinator_options(dir));
-  HttpPage page(coordinator.in_process_channel(), HttpPageOptions{"127.0.0.1:0", "secret"});
+  HttpPage page(coordinator.in_process_channel(), page_options("127.0.0.1:0", "secret"));
   httplib::Client c("127.0.0.1", page.port());
   EXPECT_EQ(c.Get("/api/campaigns")->status, 401);
   EXPECT_EQ(c.Get("/api/campaigns", bearer("secreT"))->status, 401);

@@ -1,4 +1,4 @@
-#include "core/lab/preparation.hpp"
+#include "core/model/preparation.hpp"
 
 #include "core/common/error.hpp"
 
@@ -47,8 +47,7 @@ PreparationSpec make_preparation(const std::string& method,
                                  const std::map<std::string, double>& params,
                                  const std::string& where) {
   const PreparationMethod m = parse_preparation_method(method, where + ".method");
-  contact::require_own_params(params, preparation_params(m), where,
-                              "preparation '" + method + "'");
+  contact::require_own_params(params, preparation_params(m), where, "preparation '" + method + "'");
   PreparationSpec s = contact::params_from_map<PreparationSpec>(params, where);
   s.method = m;
   return s;

@@ -17,7 +17,7 @@
 
 #include "core/contact/contact_law.hpp"
 #include "core/contact/scaling.hpp"
-#include "core/lab/preparation.hpp"
+#include "core/model/preparation.hpp"
 #include "core/particles/clump_shape.hpp"
 #include "core/particles/size_distribution.hpp"
 

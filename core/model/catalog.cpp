@@ -1,14 +1,15 @@
-#include "core/lab/catalog.hpp"
+#include "core/model/catalog.hpp"
 
 #include "core/common/error.hpp"
-#include "core/lab/compaction.hpp"
-#include "core/lab/confined_compression.hpp"
-#include "core/lab/hopper.hpp"
-#include "core/lab/packing.hpp"
-#include "core/lab/rotating_drum.hpp"
-#include "core/lab/shear_cell.hpp"
-#include "core/lab/tensile.hpp"
-#include "core/lab/wall_friction.hpp"
+#include "core/model/material.hpp"
+#include "core/model/compaction_settings.hpp"
+#include "core/model/confined_compression_settings.hpp"
+#include "core/model/hopper_settings.hpp"
+#include "core/model/packing_settings.hpp"
+#include "core/model/rotating_drum_settings.hpp"
+#include "core/model/shear_cell_settings.hpp"
+#include "core/model/tensile_settings.hpp"
+#include "core/model/wall_friction_settings.hpp"
 
 namespace demcal::lab {
 

@@ -6,7 +6,7 @@
 
 #include "core/common/error.hpp"
 #include "core/common/rng.hpp"
-#include "core/lab/rotating_drum.hpp"
+#include "core/model/rotating_drum_settings.hpp"
 
 namespace demcal::lab {
 namespace {

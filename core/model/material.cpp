@@ -1,4 +1,4 @@
-#include "core/lab/material.hpp"
+#include "core/model/material.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,43 @@
+#pragma once
+// The settings of the hopper lab test as a campaign names them, and its catalogue entry: metadata
+// the coordinator validates with, no physics (the runner: core/lab/hopper.hpp).
+#include <array>
+#include <cstddef>
+#include <string>
+
+#include "core/model/catalog.hpp"
+
+namespace demcal::lab {
+
+struct HopperSettings {
+  static constexpr const char* kName = "hopper";
+  double particles;
+  double half_angle;  ///< (deg) from the vertical
+  double outlet;      ///< slot width in largest particle diameters
+  double depth;       ///< periodic slice depth in largest particle diameters
+  double arch_time;   ///< (s) without discharge that counts as an arch
+  double max_time;    ///< (s) of discharge simulated at most
+  double time_step_safety;
+
+  static std::array<contact::ParamInfo<HopperSettings>, 7> table() {
+    return {
+        {{"particles", "-", 20, 1e7, 400, "number of particles", &HopperSettings::particles},
+         {"half_angle", "deg", 5, 60, 20, "hopper wall angle from the vertical",
+          &HopperSettings::half_angle},
+         {"outlet", "-", 1, 100, 6, "slot width in largest particle diameters",
+          &HopperSettings::outlet},
+         {"depth", "-", 1, 100, 3, "periodic slice depth in largest particle diameters",
+          &HopperSettings::depth},
+         {"arch_time", "s", 0.01, 10, 0.25,
+          "time without any discharge after which the outlet counts as arched",
+          &HopperSettings::arch_time},
+         {"max_time", "s", 0.05, 100, 3, "longest discharge simulated", &HopperSettings::max_time},
+         {"time_step_safety", "-", 0.01, 1.0, 0.2, "time step as a fraction of the critical one",
+          &HopperSettings::time_step_safety}}};
+  }
+  void finalize(const std::string&) {}
+};
+
+LabTestInfo hopper_info();  ///< in catalog.cpp
+
+}  // namespace demcal::lab

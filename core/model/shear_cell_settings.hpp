@@ -1,0 +1,68 @@
+#pragma once
+// The settings of the shear_cell lab test as a campaign names them, and its catalogue entry:
+// metadata the coordinator validates with, no physics (the runner: core/lab/shear_cell.hpp).
+#include <array>
+#include <cstddef>
+#include <string>
+
+#include "core/model/catalog.hpp"
+
+namespace demcal::lab {
+
+/// Normal stresses of the shear steps, seed 000 Table 3 (kPa); pre-shear at 3 kPa.
+inline constexpr double kShearPreKPa = 3.0;
+inline constexpr std::array<double, 5> kShearNormalKPa = {2.0, 1.75, 1.5, 1.25, 1.0};
+
+struct ShearCellSettings {
+  static constexpr const char* kName = "shear_cell";
+  double particles;
+  double vanes;
+  double vane_height;         ///< in largest particle diameters
+  double tip_speed;           ///< (m/s) of the vane tips in pre-shear; also the shear steps' limit
+  double pre_shear_travel;    ///< tip travel of the pre-shear, in diameters
+  double consolidation_time;  ///< (s) per servo phase (re-consolidate, reduce)
+  double torque_ramp_time;    ///< (s) for the set torque to reach twice the pre-shear torque
+  double stress_scale;        ///< multiplies every normal stress (for coarse-grained beds)
+  double time_step_safety;
+  double vessel_friction;  ///< mu_s of the vessel wall (docs/lab-tests.md: 0)
+  double floor_friction;   ///< mu_s of the floor (a rough floor holds the bed below the plane)
+  double floor_rolling;    ///< CDT mu_r of the floor; 0: the material's wall law's rolling
+
+  static std::array<contact::ParamInfo<ShearCellSettings>, 12> table() {
+    return {
+        {{"particles", "-", 20, 1e7, 500, "number of particles", &ShearCellSettings::particles},
+         {"vanes", "-", 2, 36, 8, "vanes of the shear head", &ShearCellSettings::vanes},
+         {"vane_height", "-", 0.5, 20, 2, "vane height in largest particle diameters",
+          &ShearCellSettings::vane_height},
+         {"tip_speed", "m/s", 1e-4, 1.0, 0.02,
+          "vane tip speed of the pre-shear (and the speed limit of the torque control)",
+          &ShearCellSettings::tip_speed},
+         {"pre_shear_travel", "-", 0.5, 100, 5,
+          "vane tip travel of the pre-shear, in largest particle diameters",
+          &ShearCellSettings::pre_shear_travel},
+         {"consolidation_time", "s", 0.005, 10, 0.05,
+          "duration of each servo phase (re-consolidate at 3 kPa, reduce to sigma_x)",
+          &ShearCellSettings::consolidation_time},
+         {"torque_ramp_time", "s", 0.01, 10, 0.3,
+          "time for the set torque of a shear step to reach twice the pre-shear torque",
+          &ShearCellSettings::torque_ramp_time},
+         {"stress_scale", "-", 1e-3, 1e3, 1, "multiplies the normal stresses of seed 000 Table 3",
+          &ShearCellSettings::stress_scale},
+         {"time_step_safety", "-", 0.01, 1.0, 0.2, "time step as a fraction of the critical one",
+          &ShearCellSettings::time_step_safety},
+         {"vessel_friction", "-", 0.0, 10.0, 0.0,
+          "mu_s of the vessel wall (0: it carries neither torque nor weight of the bed)",
+          &ShearCellSettings::vessel_friction},
+         {"floor_friction", "-", 0.0, 10.0, 1.0,
+          "mu_s of the floor (rough: the bed below the shear plane is held by it)",
+          &ShearCellSettings::floor_friction},
+         {"floor_rolling", "-", 0.0, 10.0, 0.5,
+          "CDT rolling resistance mu_r of the floor (0: the material's wall law's)",
+          &ShearCellSettings::floor_rolling}}};
+  }
+  void finalize(const std::string&) {}
+};
+
+LabTestInfo shear_cell_info();  ///< in catalog.cpp
+
+}  // namespace demcal::lab
