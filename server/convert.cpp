@@ -31,30 +31,6 @@ std::string idx(const std::string& field, int i) {
   return field + "[" + std::to_string(i) + "]";
 }
 
-const lab::ParameterInfo* find_parameter(const std::vector<lab::ParameterInfo>& table,
-                                         const std::string& path) {
-  for (const auto& p : table)
-    if (p.path == path) return &p;
-  return nullptr;
-}
-
-std::string known_paths(const std::vector<lab::ParameterInfo>& table) {
-  std::string s;
-  for (const auto& p : table) s += (s.empty() ? "" : ", ") + p.path;
-  return s;
-}
-
-/// Applies `value` at `path` to a copy of the model and checks the result as a whole.
-void check_settable(lab::MaterialModel model, const std::string& path, double value,
-                    const std::string& where) {
-  try {
-    lab::set_parameter(model, path, value);
-    model.validate();
-  } catch (const InputError& e) {
-    throw InputError(where, e.what());
-  }
-}
-
 std::uint64_t base_seed(const v1::LabTest& t) {
   return t.seed() ? t.seed() : 1;
 }
@@ -199,13 +175,11 @@ void apply_fixed(const v1::CampaignSpec& spec, lab::MaterialModel& model, Instan
   const std::map<std::string, double> fixed(spec.fixed().begin(), spec.fixed().end());
   for (const auto& [path, value] : fixed) {
     const std::string where = "spec.fixed." + path;
-    if (!find_parameter(lab::parameters(model), path))
-      throw InputError(where, "not a parameter of this material model (known: " +
-                                  known_paths(lab::parameters(model)) + ")");
-    check_settable(model, path, value, where);
+    lab::require_parameter(model, path, where);
+    lab::check_parameter_value(model, path, value, where);
     lab::set_parameter(model, path, value);
     for (auto& [name, instance] : instances) {
-      if (!find_parameter(lab::parameters(instance), path))
+      if (!lab::has_parameter(instance, path))
         throw InputError(where,
                          "not a parameter of test '" + name + "' (its own wall_law lacks it)");
       lab::set_parameter(instance, path, value);
@@ -230,7 +204,6 @@ void check_factor_bounds(const v1::Factor& f, const lab::ParameterInfo& info,
 
 void plan_factors(const v1::CampaignSpec& spec, const lab::MaterialModel& model,
                   const Instances& instances, CampaignPlan& plan) {
-  const auto table = lab::parameters(model);
   if (spec.factors_size() == 0) throw InputError("spec.factors", "a campaign needs factors");
   if (spec.factors_size() > doe::kMaxFactors)
     throw InputError("spec.factors", "at most " + std::to_string(doe::kMaxFactors) + " factors");
@@ -238,20 +211,16 @@ void plan_factors(const v1::CampaignSpec& spec, const lab::MaterialModel& model,
   for (int i = 0; i < spec.factors_size(); ++i) {
     const auto& f = spec.factors(i);
     const std::string where = "spec." + idx("factors", i);
-    const auto* info = find_parameter(table, f.path());
-    if (!info)
-      throw InputError(where + ".path", "'" + f.path() +
-                                            "' is not a parameter of this material model (known: " +
-                                            known_paths(table) + ")");
+    const lab::ParameterInfo info = lab::require_parameter(model, f.path(), where + ".path");
     if (spec.fixed().count(f.path()))
       throw InputError(where + ".path", "'" + f.path() + "' is also in spec.fixed");
     if (!seen.insert(f.path()).second)
       throw InputError(where + ".path", "'" + f.path() + "' is a factor twice");
-    check_factor_bounds(f, *info, where);
-    check_settable(model, f.path(), f.low(), where + ".low");
-    check_settable(model, f.path(), f.high(), where + ".high");
+    check_factor_bounds(f, info, where);
+    lab::check_parameter_value(model, f.path(), f.low(), where + ".low");
+    lab::check_parameter_value(model, f.path(), f.high(), where + ".high");
     for (const auto& [name, instance] : instances)
-      if (!find_parameter(lab::parameters(instance), f.path()))
+      if (!lab::has_parameter(instance, f.path()))
         throw InputError(where + ".path", "'" + f.path() + "' is not a parameter of test '" + name +
                                               "' (its own wall_law lacks it)");
     plan.factors.push_back(

@@ -124,64 +124,23 @@ double shear_stress(const sim::World& w, double radius) {
   return 3.0 * (-w.walls[kHead].torque.z) / (2.0 * M_PI * radius * radius * radius);
 }
 
-}  // namespace
-
-LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
-                         const RunOptions& options) {
-  require_pour(material, "shear_cell");
-  const auto s = read_settings<ShearCellSettings>(values, "settings");
-  sim::World w = make_material_world(material, options);
-  set_cell_wall_laws(w, material, s);
-  const auto sizes = material.simulated_sizes();
-  const double r_max = particles::max_radius(sizes);
-  const double d = 2.0 * r_max;
-
-  Rng rng(options.seed);
-  const double solid = expected_solid_volume(sizes, s.particles, options.seed);
-  // A settled bed (~0.6) about as high as the vessel is wide.
-  const double radius = std::max(4.0 * d, std::cbrt(solid / (0.6 * 2.0 * M_PI)));
-  const double h_v = s.vane_height * d;
-  const double fill_h = solid / (0.2 * M_PI * radius * radius);
-  w.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
-  w.walls.push_back(
-      walls::make_wall("vessel", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius}, kWallDie));
-  particles::InsertRequest req =
-      material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, fill_h},
-                              static_cast<std::size_t>(s.particles));
-  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety, material.factors().time);
-  sim::HealthLimits limits = die_limits(w, radius, fill_h + h_v);
-  limits.lo.z = -fill_h;
-
-  BedSpec settle_spec;
-  settle_spec.max_settle_time = 1.0;
-  // Settings and metrics are real stresses; the bed feels them x the scaling law's stress factor.
-  const double fs = material.factors().stress;
-  const double real_kpa = 1e3 * fs;  // simulated Pa per real kPa
-  settle_spec.rest_stress = kShearPreKPa * real_kpa * s.stress_scale;
-  const PhaseCost settled = settle(w, settle_spec, limits, material.factors().time);
-
-  // The head: its disk half a diameter above the bed top, vanes reaching into the bed's top.
-  const double top = metrics::bed_top(w);
-  const double head_z = top + 0.5 * d;
-  auto head = walls::make_wall("head",
-                               walls::make_vane_head({0, 0, head_z}, {0, 0, 1}, radius - 0.25 * d,
-                                                     h_v, static_cast<int>(s.vanes), 32),
-                               kWallPiston);
-  head.pivot = {0, 0, head_z};
-  w.walls.push_back(head);
-  const double r_head = radius - 0.25 * d;
-
-  const double area = M_PI * radius * radius;
-  const double sigma_pre = kShearPreKPa * real_kpa * s.stress_scale;
+/// The vessel, its bed, the head and the servo on the floor: what every phase of the test uses.
+struct ShearCell {
+  sim::World w;
+  sim::HealthLimits limits;
   walls::StressServo servo;
-  servo.axis = {0, 0, 1};  // the floor pushes the bed up against the head
-  servo.area = area;
-  servo.max_speed = 0.5 * s.tip_speed;
-  servo.kp = servo.max_speed / sigma_pre;
-  servo.ki = servo.kp / 0.02;  // removes the steady error of a dilating / compacting bed in ~20 ms
-  auto floor_stress = [&](const sim::World& world) { return servo.stress(world.walls[kFloor]); };
-  auto servo_run = [&](sim::World& world, double target, double seconds,
-                       const std::function<bool(sim::World&)>& each) {
+  double d = 0.0;          ///< largest particle diameter (m, simulated)
+  double radius = 0.0;     ///< vessel (m)
+  double r_head = 0.0;     ///< vane tips (m)
+  double real_kpa = 0.0;   ///< simulated Pa per real kPa
+  double sigma_pre = 0.0;  ///< pre-shear normal stress (Pa, simulated)
+  double omega = 0.0;      ///< head speed of the pre-shear (rad/s)
+
+  double floor_stress(const sim::World& world) const { return servo.stress(world.walls[kFloor]); }
+  /// Runs `world` (the cell or a copy of it) for `seconds` with the floor servo at `target`,
+  /// calling `each` after every step until it returns false.
+  long servo_run(sim::World& world, double target, double seconds,
+                 const std::function<bool(sim::World&)>& each) {
     servo.target = target;
     servo.reset();
     const long steps = std::max<long>(1, std::lround(seconds / world.dt));
@@ -189,124 +148,223 @@ LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
       servo.update(ww.walls[kFloor], ww.dt);
       return each ? each(ww) : true;
     });
-  };
+  }
+};
 
-  LabOutput out;
-  out.add_phase(filled, {});
-  out.add_phase(settled, {});
+/// Fills the vessel, settles the bed and hangs the head over it, its vanes in the bed's top;
+/// records the fill and settle phases.
+ShearCell build_cell(const MaterialModel& material, const ShearCellSettings& s,
+                     const RunOptions& options, LabOutput& out) {
+  ShearCell c;
+  sim::World& w = c.w;
+  w = make_material_world(material, options);
+  set_cell_wall_laws(w, material, s);
+  const auto sizes = material.simulated_sizes();
+  c.d = 2.0 * particles::max_radius(sizes);
+  Rng rng(options.seed);
+  const double solid = expected_solid_volume(sizes, s.particles, options.seed);
+  // A settled bed (~0.6) about as high as the vessel is wide.
+  c.radius = std::max(4.0 * c.d, std::cbrt(solid / (0.6 * 2.0 * M_PI)));
+  const double h_v = s.vane_height * c.d;
+  const double fill_h = solid / (0.2 * M_PI * c.radius * c.radius);
+  w.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
+  w.walls.push_back(
+      walls::make_wall("vessel", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, c.radius}, kWallDie));
+  particles::InsertRequest req =
+      material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, c.radius, 0.0, fill_h},
+                              static_cast<std::size_t>(s.particles));
+  out.add_phase(timed_fill(w, req, rng, s.time_step_safety, material.factors().time), {});
+  c.limits = die_limits(w, c.radius, fill_h + h_v);
+  c.limits.lo.z = -fill_h;
+
+  BedSpec settle_spec;
+  settle_spec.max_settle_time = 1.0;
+  // Settings and metrics are real stresses; the bed feels them x the scaling law's stress factor.
+  c.real_kpa = 1e3 * material.factors().stress;
+  settle_spec.rest_stress = kShearPreKPa * c.real_kpa * s.stress_scale;
+  out.add_phase(settle(w, settle_spec, c.limits, material.factors().time), {});
+
+  // The head: its disk half a diameter above the bed top, vanes reaching into the bed's top.
+  const double head_z = metrics::bed_top(w) + 0.5 * c.d;
+  auto head =
+      walls::make_wall("head",
+                       walls::make_vane_head({0, 0, head_z}, {0, 0, 1}, c.radius - 0.25 * c.d, h_v,
+                                             static_cast<int>(s.vanes), 32),
+                       kWallPiston);
+  head.pivot = {0, 0, head_z};
+  w.walls.push_back(head);
+  c.r_head = c.radius - 0.25 * c.d;
+
+  c.sigma_pre = kShearPreKPa * c.real_kpa * s.stress_scale;
+  c.servo.axis = {0, 0, 1};  // the floor pushes the bed up against the head
+  c.servo.area = M_PI * c.radius * c.radius;
+  c.servo.max_speed = 0.5 * s.tip_speed;
+  c.servo.kp = c.servo.max_speed / c.sigma_pre;
+  // Removes the steady error of a dilating / compacting bed in ~20 ms.
+  c.servo.ki = c.servo.kp / 0.02;
+  c.omega = s.tip_speed / c.r_head;
+  return c;
+}
+
+struct PreShear {
+  double tau = 0.0;    ///< steady shear stress (Pa, simulated)
+  double sigma = 0.0;  ///< normal stress measured on the floor meanwhile (Pa, simulated)
+};
+
+/// Consolidates at sigma_pre with the head at rest (the bed rises into the vanes), then turns the
+/// head at tip_speed until the tips have travelled pre_shear_travel diameters; the steady shear
+/// stress is the mean over the last third.
+PreShear pre_shear(ShearCell& c, const ShearCellSettings& s, const RunOptions& options,
+                   LabOutput& out) {
+  sim::World& w = c.w;
   Series pre{{"time", "normal_stress_kpa", "shear_stress_kpa", "tip_travel"}, {}};
-  // 1. Consolidate at sigma_pre with the head at rest (the bed rises into the vanes).
   const PhaseClock consolidate_clock(w);
-  servo_run(w, sigma_pre, 4.0 * s.consolidation_time, {});
+  c.servo_run(w, c.sigma_pre, 4.0 * s.consolidation_time, {});
   out.add_phase(consolidate_clock.stop(w, "consolidate", "fixed time under the servo", true), {});
-  // 2. Pre-shear at constant tip speed until the tips have travelled pre_shear_travel diameters.
-  const double omega = s.tip_speed / r_head;
-  w.walls[kHead].omega = {0, 0, omega};
-  const double pre_time = s.pre_shear_travel * d / s.tip_speed;
+  w.walls[kHead].omega = {0, 0, c.omega};
+  const double pre_time = s.pre_shear_travel * c.d / s.tip_speed;
   const double t_pre0 = w.time;
   double tau_sum = 0.0, sigma_sum = 0.0;
   long tau_n = 0;
   const long record = std::max<long>(1, std::lround(0.002 / w.dt));
   const PhaseClock pre_clock(w);
-  servo_run(w, sigma_pre, pre_time, [&](sim::World& ww) {
+  c.servo_run(w, c.sigma_pre, pre_time, [&](sim::World& ww) {
     const double t = ww.time - t_pre0;
     if (t > 2.0 / 3.0 * pre_time) {
-      tau_sum += shear_stress(ww, r_head);
-      sigma_sum += floor_stress(ww);
+      tau_sum += shear_stress(ww, c.r_head);
+      sigma_sum += c.floor_stress(ww);
       ++tau_n;
     }
     if (ww.step_count % record == 0)
-      pre.rows.push_back({ww.time, floor_stress(ww) / real_kpa, shear_stress(ww, r_head) / real_kpa,
-                          t * s.tip_speed / d});
+      pre.rows.push_back({ww.time, c.floor_stress(ww) / c.real_kpa,
+                          shear_stress(ww, c.r_head) / c.real_kpa, t * s.tip_speed / c.d});
     if (options.progress) options.progress(0.4 * t / pre_time);
     return true;
   });
   out.add_phase(pre_clock.stop(w, "pre-shear", "tip travel of pre_shear_travel diameters", true),
                 {});
-  const double tau_pre = tau_n ? tau_sum / static_cast<double>(tau_n) : 0.0;
-  const double sigma_pre_measured = tau_n ? sigma_sum / static_cast<double>(tau_n) : sigma_pre;
   w.walls[kHead].omega = {};
+  out.series["pre_shear"] = std::move(pre);
+  return {tau_n ? tau_sum / static_cast<double>(tau_n) : 0.0,
+          tau_n ? sigma_sum / static_cast<double>(tau_n) : c.sigma_pre};
+}
+
+/// The mean of the last `n` values pushed (and of a second quantity alongside).
+class WindowMeans {
+ public:
+  explicit WindowMeans(long n) : n_(n) {}
+  void push(double a, double b) {
+    a_.push_back(a);
+    sum_a_ += a;
+    b_.push_back(b);
+    sum_b_ += b;
+    if (static_cast<long>(a_.size()) > n_) {
+      sum_a_ -= a_.front();
+      a_.pop_front();
+      sum_b_ -= b_.front();
+      b_.pop_front();
+    }
+  }
+  bool full() const { return static_cast<long>(a_.size()) == n_; }
+  double mean_a() const { return sum_a_ / static_cast<double>(n_); }
+  double mean_b() const { return sum_b_ / static_cast<double>(n_); }
+
+ private:
+  long n_;
+  std::deque<double> a_, b_;
+  double sum_a_ = 0.0, sum_b_ = 0.0;
+};
+
+struct YieldStep {
+  double sigma_x = 0.0;  ///< the step's normal stress (Pa, simulated)
+  double sigma = 0.0;    ///< normal stress on the floor at the yield point
+  double tau = 0.0;      ///< yield shear stress: the peak of the windowed mean
+  bool yielded = false;  ///< the tips moved 1.5 diameters within the time
+};
+
+/// One shear step from a copy of the pre-sheared cell: re-consolidated at sigma_pre, reduced to
+/// sigma_x, then sheared under torque control, the set torque ramped to twice the pre-shear
+/// torque; the yield point is the peak of the shear stress averaged over the time the tips need
+/// for 0.5 d at full speed (a shorter mean would pick up contact noise, not the bed's strength).
+YieldStep shear_step(ShearCell& c, const sim::World& restart, double step_kpa,
+                     const ShearCellSettings& s, double tau_pre, LabOutput& out) {
+  sim::World v = restart;
+  const PhaseClock step_clock(v);
+  YieldStep y;
+  y.sigma_x = step_kpa * c.real_kpa * s.stress_scale;
+  c.servo_run(v, c.sigma_pre, s.consolidation_time, {});
+  c.servo_run(v, y.sigma_x, s.consolidation_time, {});
+  const double torque_pre = tau_pre * 2.0 * M_PI * std::pow(c.r_head, 3) / 3.0;
+  const double t0 = v.time;
+  const double t_max = std::max(torque_pre, 1e-12) * 2.0;
+  const double gain = c.omega / (0.05 * std::max(torque_pre, 1e-12));
+  double angle = 0.0;
+  y.sigma = y.sigma_x;
+  WindowMeans window(std::max<long>(1, std::lround(0.5 * c.d / s.tip_speed / v.dt)));
+  c.servo_run(v, y.sigma_x, 2.0 * s.torque_ramp_time + 1.5 * c.d / s.tip_speed,
+              [&](sim::World& ww) {
+                const double t = ww.time - t0;
+                const double t_set = t_max * std::min(1.0, t / s.torque_ramp_time);
+                const double torque = -ww.walls[kHead].torque.z;
+                const double om = std::clamp(gain * (t_set - torque), 0.0, c.omega);
+                ww.walls[kHead].omega = {0, 0, om};
+                angle += om * ww.dt;
+                window.push(shear_stress(ww, c.r_head), c.floor_stress(ww));
+                if (window.full() && window.mean_a() > y.tau) {
+                  y.tau = window.mean_a();
+                  y.sigma = window.mean_b();
+                }
+                return angle * c.r_head < 1.5 * c.d;  // yielded: the tips moved 1.5 diameters
+              });
+  y.yielded = angle * c.r_head >= 1.5 * c.d;
+  char step_name[64];
+  std::snprintf(step_name, sizeof step_name, "shear step %g kPa", step_kpa);
+  out.add_phase(
+      step_clock.stop(v, step_name, "yield: tips moved 1.5 diameters within the time", y.yielded),
+      {"yield_locus_slope", "yield_locus_intercept", "ffc", "effective_friction_angle",
+       "mohr_consistent", "unconfined_yield_strength", "major_consolidation_stress"});
+  return y;
+}
+
+}  // namespace
+
+LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
+                         const RunOptions& options) {
+  require_pour(material, "shear_cell");
+  const auto s = read_settings<ShearCellSettings>(values, "settings");
+  LabOutput out;
+  ShearCell c = build_cell(material, s, options, out);
+  const PreShear pre = pre_shear(c, s, options, out);
   if (!options.snapshot_dir.empty()) {
-    io::write_particles_vtk(options.snapshot_dir + "/shear_cell_preshear_particles.vtk", w);
-    io::write_walls_vtk(options.snapshot_dir + "/shear_cell_walls.vtk", w, radius);
+    io::write_particles_vtk(options.snapshot_dir + "/shear_cell_preshear_particles.vtk", c.w);
+    io::write_walls_vtk(options.snapshot_dir + "/shear_cell_walls.vtk", c.w, c.radius);
     out.snapshots = {options.snapshot_dir + "/shear_cell_preshear_particles.vtk",
                      options.snapshot_dir + "/shear_cell_walls.vtk"};
   }
-
-  // 3. Shear steps, each from the pre-sheared state.
-  const sim::World restart = w;
+  // The shear steps, each from the pre-sheared state; the locus uses the normal stress measured
+  // on the floor at the yield point.
+  const sim::World restart = c.w;
   Series points{{"sigma_x_kpa", "sigma_measured_kpa", "yield_shear_stress_kpa"}, {}};
-  std::vector<double> xs, ys;
-  const double torque_pre = tau_pre * 2.0 * M_PI * std::pow(r_head, 3) / 3.0;
+  LineFit locus;
+  std::vector<double> ys;
   for (std::size_t k = 0; k < kShearNormalKPa.size(); ++k) {
-    sim::World v = restart;
-    const PhaseClock step_clock(v);
-    const double sigma_x = kShearNormalKPa[k] * real_kpa * s.stress_scale;
-    servo_run(v, sigma_pre, s.consolidation_time, {});
-    servo_run(v, sigma_x, s.consolidation_time, {});
-    // Torque control.
-    const double t0 = v.time;
-    const double t_max = std::max(torque_pre, 1e-12) * 2.0;
-    const double gain = omega / (0.05 * std::max(torque_pre, 1e-12));
-    double angle = 0.0, tau_max = 0.0, sig_at_max = sigma_x;
-    // Torque and stress are means over the time the tips need for 0.5 d at full speed: the
-    // peak of a shorter mean would pick up contact noise instead of the bed's strength.
-    const long window = std::max<long>(1, std::lround(0.5 * d / s.tip_speed / v.dt));
-    std::deque<double> recent;
-    double recent_sum = 0.0, sig_sum = 0.0;
-    std::deque<double> recent_sig;
-    servo_run(v, sigma_x, 2.0 * s.torque_ramp_time + 1.5 * d / s.tip_speed, [&](sim::World& ww) {
-      const double t = ww.time - t0;
-      const double t_set = t_max * std::min(1.0, t / s.torque_ramp_time);
-      const double torque = -ww.walls[kHead].torque.z;
-      const double om = std::clamp(gain * (t_set - torque), 0.0, omega);
-      ww.walls[kHead].omega = {0, 0, om};
-      angle += om * ww.dt;
-      const double tau = shear_stress(ww, r_head);
-      recent.push_back(tau);
-      recent_sum += tau;
-      recent_sig.push_back(floor_stress(ww));
-      sig_sum += recent_sig.back();
-      if (static_cast<long>(recent.size()) > window) {
-        recent_sum -= recent.front();
-        recent.pop_front();
-        sig_sum -= recent_sig.front();
-        recent_sig.pop_front();
-      }
-      const auto span = static_cast<double>(window);
-      if (static_cast<long>(recent.size()) == window && recent_sum / span > tau_max) {
-        tau_max = recent_sum / span;
-        sig_at_max = sig_sum / span;
-      }
-      return angle * r_head < 1.5 * d;  // yielded: the tips have moved 1.5 diameters
-    });
-    char step_name[64];
-    std::snprintf(step_name, sizeof step_name, "shear step %g kPa", kShearNormalKPa[k]);
-    out.add_phase(step_clock.stop(v, step_name, "yield: tips moved 1.5 diameters within the time",
-                                  angle * r_head >= 1.5 * d),
-                  {"yield_locus_slope", "yield_locus_intercept", "ffc", "effective_friction_angle",
-                   "mohr_consistent", "unconfined_yield_strength", "major_consolidation_stress"});
-    points.rows.push_back({sigma_x / real_kpa, sig_at_max / real_kpa, tau_max / real_kpa});
-    // The locus uses the normal stress measured on the floor at the yield point.
-    xs.push_back(sig_at_max / real_kpa);
-    ys.push_back(tau_max / real_kpa);
+    const YieldStep y = shear_step(c, restart, kShearNormalKPa[k], s, pre.tau, out);
+    points.rows.push_back({y.sigma_x / c.real_kpa, y.sigma / c.real_kpa, y.tau / c.real_kpa});
+    locus.add(y.sigma / c.real_kpa, y.tau / c.real_kpa);
+    ys.push_back(y.tau / c.real_kpa);
     if (options.progress)
       options.progress(0.4 + 0.6 * static_cast<double>(k + 1) /
                                  static_cast<double>(kShearNormalKPa.size()));
   }
-
   // The yield locus: least squares tau = slope sigma + intercept through the yield points (kPa).
-  LineFit locus;
-  for (std::size_t i = 0; i < xs.size(); ++i) locus.add(xs[i], ys[i]);
-  const MohrResult mohr =
-      mohr_evaluation(locus.slope(), locus.intercept(), sigma_pre / real_kpa, tau_pre / real_kpa);
-  out.metrics["pre_shear_stress"] = tau_pre / real_kpa;
-  out.metrics["pre_shear_normal_stress"] = sigma_pre_measured / real_kpa;
+  const MohrResult mohr = mohr_evaluation(locus.slope(), locus.intercept(),
+                                          c.sigma_pre / c.real_kpa, pre.tau / c.real_kpa);
+  out.metrics["pre_shear_stress"] = pre.tau / c.real_kpa;
+  out.metrics["pre_shear_normal_stress"] = pre.sigma / c.real_kpa;
   add_locus_metrics(out, locus, mohr, ys);
-  out.series["pre_shear"] = std::move(pre);
   out.series["yield_points"] = std::move(points);
   out.series["mohr_circles"] = mohr_circles(mohr);
-  out.cost.close(w);
+  out.cost.close(c.w);
   return out;
 }
 

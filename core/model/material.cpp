@@ -158,6 +158,35 @@ double default_agitation_time(const MaterialModel& model) {
   return 3.0 * std::sqrt(d / kG);
 }
 
+bool has_parameter(const MaterialModel& model, const std::string& path) {
+  for (const auto& p : parameters(model))
+    if (p.path == path) return true;
+  return false;
+}
+
+ParameterInfo require_parameter(const MaterialModel& model, const std::string& path,
+                                const std::string& where) {
+  const auto table = parameters(model);
+  std::string known;
+  for (const auto& p : table) {
+    if (p.path == path) return p;
+    known += (known.empty() ? "" : ", ") + p.path;
+  }
+  throw InputError(
+      where, "'" + path + "' is not a parameter of this material model (known: " + known + ")");
+}
+
+void check_parameter_value(const MaterialModel& model, const std::string& path, double value,
+                           const std::string& where) {
+  MaterialModel copy = model;
+  try {
+    set_parameter(copy, path, value);
+    copy.validate();
+  } catch (const InputError& e) {
+    throw InputError(where, e.what());
+  }
+}
+
 void set_parameter(MaterialModel& model, const std::string& path, double value) {
   for (const auto& info : parameters(model))
     if (info.path == path) {

@@ -62,6 +62,16 @@ std::vector<ParameterInfo> parameters(const MaterialModel& model);
 /// The agitation time of the clusters preparation by default for this material's largest
 /// simulated particles: 3 diameters at sqrt(g d), i.e. 3 sqrt(d / g), g = 9.81 m/s^2 (s).
 double default_agitation_time(const MaterialModel& model);
+/// Whether the model has a parameter at `path` (a path of parameters(model)).
+bool has_parameter(const MaterialModel& model, const std::string& path);
+/// The parameter at `path`: its unit and valid range; InputError naming `where` and the known
+/// paths when the model has none there.
+ParameterInfo require_parameter(const MaterialModel& model, const std::string& path,
+                                const std::string& where);
+/// Checks that the model with `value` at `path` is valid as a whole (the model itself is not
+/// changed); InputError naming `where`.
+void check_parameter_value(const MaterialModel& model, const std::string& path, double value,
+                           const std::string& where);
 /// Sets one parameter by path; throws InputError naming the path if unknown or out of range.
 void set_parameter(MaterialModel& model, const std::string& path, double value);
 double get_parameter(const MaterialModel& model, const std::string& path);
