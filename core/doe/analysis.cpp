@@ -203,8 +203,10 @@ CurvatureTest curvature_test(const Eigen::VectorXd& y, const std::vector<int>& t
 
 }  // namespace
 
-ResponseAnalysis analyse_response(const Eigen::MatrixXd& coded, const Eigen::VectorXd& y,
-                                  const AnalysisOptions& options) {
+namespace {
+
+void check_inputs(const Eigen::MatrixXd& coded, const Eigen::VectorXd& y,
+                  const AnalysisOptions& options) {
   if (coded.rows() != y.size()) {
     throw InputError("response", std::to_string(y.size()) + " values for " +
                                      std::to_string(coded.rows()) + " runs");
@@ -217,15 +219,19 @@ ResponseAnalysis analyse_response(const Eigen::MatrixXd& coded, const Eigen::Vec
     throw InputError("factors", std::to_string(options.factors.size()) + " natural ranges for " +
                                     std::to_string(coded.cols()) + " design columns");
   }
-  ResponseAnalysis out;
-  out.alpha = options.alpha;
-  const auto k = coded.cols();
+}
 
-  // Failed runs: what is left, and what the loss costs.
-  BalanceReport& bal = out.balance;
+/// The rows of the runs that did not fail.
+struct UsedRows {
+  std::vector<int> two_level, centre;
+};
+
+/// Failed runs: what is left (the level counts of each factor) and where.
+UsedRows count_runs(const Eigen::MatrixXd& coded, const Eigen::VectorXd& y, BalanceReport& bal) {
+  const auto k = coded.cols();
   bal.runs_total = static_cast<int>(coded.rows());
   bal.level_counts.assign(std::size_t(k), {0, 0, 0});
-  std::vector<int> two_level_rows, centre_rows;
+  UsedRows used;
   for (Eigen::Index r = 0; r < coded.rows(); ++r) {
     if (!std::isfinite(y(r))) {
       bal.missing_rows.push_back(static_cast<int>(r));
@@ -236,107 +242,123 @@ ResponseAnalysis analyse_response(const Eigen::MatrixXd& coded, const Eigen::Vec
       const double v = coded(r, c);
       ++bal.level_counts[std::size_t(c)][v < 0.0 ? 0 : (v > 0.0 ? 2 : 1)];
     }
-    if (is_two_level(coded, r)) two_level_rows.push_back(static_cast<int>(r));
-    if (is_centre(coded, r)) centre_rows.push_back(static_cast<int>(r));
+    if (is_two_level(coded, r)) used.two_level.push_back(static_cast<int>(r));
+    if (is_centre(coded, r)) used.centre.push_back(static_cast<int>(r));
   }
+  return used;
+}
 
+/// What the failed runs cost: the terms a complete design would estimate that this one cannot,
+/// and the notes saying so.
+void note_lost_terms(const Eigen::MatrixXd& coded, ModelKind model, ResponseAnalysis& out) {
+  BalanceReport& bal = out.balance;
+  const ModelFit complete = fit_model(coded, Eigen::VectorXd::Zero(coded.rows()), model);
+  std::set<std::string> estimable_now;
+  for (const auto& t : out.fit.terms) {
+    for (const auto& m : t.chain) estimable_now.insert(word_name(m.word) + (t.squared ? "^2" : ""));
+  }
+  for (const auto& t : complete.terms) {
+    for (const auto& m : t.chain) {
+      const std::string name = word_name(m.word) + (t.squared ? "^2" : "");
+      if (!estimable_now.count(name)) bal.lost_terms.push_back(name);
+    }
+  }
+  out.notes.push_back(std::to_string(bal.missing_rows.size()) +
+                      " run(s) failed or missing: the design is no longer balanced; largest "
+                      "|correlation| between estimated terms is " +
+                      format(bal.max_abs_correlation));
+  if (!bal.lost_terms.empty()) {
+    out.notes.push_back(std::to_string(bal.lost_terms.size()) +
+                        " effect(s) no longer estimable and left out of the fit");
+  }
+}
+
+/// ANOVA with sequential sums of squares (equal to the partial ones on an orthogonal design):
+/// one row per model term, curvature from the centre runs when the model has no squares, lack of
+/// fit against pure error when there are repeated points; empty without an error estimate.
+std::vector<AnovaRow> anova_table(const Eigen::MatrixXd& coded, const Eigen::VectorXd& y,
+                                  const ModelFit& fit, const AnalysisOptions& options,
+                                  bool has_centre, double ss_pe, double df_pe) {
+  if (fit.residual_df <= 0) return {};
+  const auto n = static_cast<Eigen::Index>(fit.rows_used.size());
+  Eigen::MatrixXd x(n, coded.cols());
+  Eigen::VectorXd yy(n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    x.row(r) = coded.row(fit.rows_used[std::size_t(r)]);
+    yy(r) = y(fit.rows_used[std::size_t(r)]);
+  }
+  const auto p = static_cast<Eigen::Index>(fit.terms.size()) + 1;
+  Eigen::MatrixXd design(n, p);
+  design.col(0).setOnes();
+  for (Eigen::Index t = 1; t < p; ++t)
+    design.col(t) = term_column(fit.terms[std::size_t(t - 1)], x);
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(design);
+  const Eigen::VectorXd qty = qr.householderQ().transpose() * yy;
+  std::vector<AnovaRow> rows;
+  for (Eigen::Index t = 1; t < p; ++t) {
+    rows.push_back({fit.terms[std::size_t(t - 1)].name(), 1.0, qty(t) * qty(t), 0.0, {}, {}});
+  }
+  double resid_ss = fit.sse, resid_df = fit.residual_df;
+  if (options.model != ModelKind::kQuadratic && has_centre) {
+    Eigen::VectorXd v(n);
+    for (Eigen::Index r = 0; r < n; ++r) v(r) = is_centre(x, r) ? 1.0 : 0.0;
+    const Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(n, p);
+    v -= q * (q.transpose() * v);
+    if (v.norm() > 1e-9 && resid_df >= 1.0) {
+      const double ss = std::pow(v.dot(yy), 2) / v.squaredNorm();
+      rows.push_back({"curvature", 1.0, ss, 0.0, {}, {}});
+      resid_ss -= ss;
+      resid_df -= 1.0;
+    }
+  }
+  double error_ss = resid_ss, error_df = resid_df;
+  std::string error_name = "residual";
+  if (df_pe > 0.0 && resid_df - df_pe > 0.5) {
+    rows.push_back({"lack of fit", resid_df - df_pe, std::max(0.0, resid_ss - ss_pe), 0.0, {}, {}});
+    error_ss = ss_pe;
+    error_df = df_pe;
+    error_name = "pure error";
+  } else if (df_pe > 0.0 && std::abs(resid_df - df_pe) < 0.5) {
+    error_name = "pure error";
+  }
+  if (!(error_df > 0.0)) return {};
+  const double ms_error = error_ss / error_df;
+  for (auto& row : rows) {
+    row.ms = row.ss / row.df;
+    if (ms_error > 0.0) {
+      row.f = row.ms / ms_error;
+      row.p = f_survival(*row.f, row.df, error_df);
+    }
+  }
+  rows.push_back({error_name, error_df, error_ss, ms_error, {}, {}});
+  rows.push_back({"total (corrected)", double(n - 1), fit.sst, 0.0, {}, {}});
+  return rows;
+}
+
+}  // namespace
+
+ResponseAnalysis analyse_response(const Eigen::MatrixXd& coded, const Eigen::VectorXd& y,
+                                  const AnalysisOptions& options) {
+  check_inputs(coded, y, options);
+  ResponseAnalysis out;
+  out.alpha = options.alpha;
+  const UsedRows used = count_runs(coded, y, out.balance);
   out.fit = fit_model(coded, y, options.model);
-  bal.max_abs_correlation = max_abs_correlation(coded, out.fit.rows_used, out.fit.terms);
-  if (!bal.balanced()) {
-    const ModelFit complete = fit_model(coded, Eigen::VectorXd::Zero(coded.rows()), options.model);
-    std::set<std::string> estimable_now;
-    for (const auto& t : out.fit.terms) {
-      for (const auto& m : t.chain)
-        estimable_now.insert(word_name(m.word) + (t.squared ? "^2" : ""));
-    }
-    for (const auto& t : complete.terms) {
-      for (const auto& m : t.chain) {
-        const std::string name = word_name(m.word) + (t.squared ? "^2" : "");
-        if (!estimable_now.count(name)) bal.lost_terms.push_back(name);
-      }
-    }
-    out.notes.push_back(std::to_string(bal.missing_rows.size()) +
-                        " run(s) failed or missing: the design is no longer balanced; largest "
-                        "|correlation| between estimated terms is " +
-                        format(bal.max_abs_correlation));
-    if (!bal.lost_terms.empty()) {
-      out.notes.push_back(std::to_string(bal.lost_terms.size()) +
-                          " effect(s) no longer estimable and left out of the fit");
-    }
-  }
+  out.balance.max_abs_correlation = max_abs_correlation(coded, out.fit.rows_used, out.fit.terms);
+  if (!out.balance.balanced()) note_lost_terms(coded, options.model, out);
 
-  if (two_level_rows.size() >= 4) {
-    estimate_effects(coded, y, two_level_rows, options, out);
+  if (used.two_level.size() >= 4) {
+    estimate_effects(coded, y, used.two_level, options, out);
   } else {
     out.notes.push_back("fewer than 4 two-level runs: no effects or Lenth test");
   }
-
   const auto [ss_pe, df_pe] = pure_error(coded, y, out.fit.rows_used);
   out.pure_error_df = df_pe;
-  out.noise = noise_estimate(ss_pe, df_pe, out.lenth, static_cast<int>(two_level_rows.size()));
-  if (!centre_rows.empty() && two_level_rows.size() >= 2) {
-    out.curvature = curvature_test(y, two_level_rows, centre_rows, out.noise, options.alpha);
+  out.noise = noise_estimate(ss_pe, df_pe, out.lenth, static_cast<int>(used.two_level.size()));
+  if (!used.centre.empty() && used.two_level.size() >= 2) {
+    out.curvature = curvature_test(y, used.two_level, used.centre, out.noise, options.alpha);
   }
-
-  // ANOVA with sequential sums of squares (equal to the partial ones on an orthogonal design).
-  const ModelFit& fit = out.fit;
-  if (fit.residual_df > 0) {
-    const auto n = static_cast<Eigen::Index>(fit.rows_used.size());
-    Eigen::MatrixXd x(n, k);
-    Eigen::VectorXd yy(n);
-    for (Eigen::Index r = 0; r < n; ++r) {
-      x.row(r) = coded.row(fit.rows_used[std::size_t(r)]);
-      yy(r) = y(fit.rows_used[std::size_t(r)]);
-    }
-    const auto p = static_cast<Eigen::Index>(fit.terms.size()) + 1;
-    Eigen::MatrixXd design(n, p);
-    design.col(0).setOnes();
-    for (Eigen::Index t = 1; t < p; ++t)
-      design.col(t) = term_column(fit.terms[std::size_t(t - 1)], x);
-    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(design);
-    const Eigen::VectorXd qty = qr.householderQ().transpose() * yy;
-    std::vector<AnovaRow> rows;
-    for (Eigen::Index t = 1; t < p; ++t) {
-      rows.push_back({fit.terms[std::size_t(t - 1)].name(), 1.0, qty(t) * qty(t), 0.0, {}, {}});
-    }
-    double resid_ss = fit.sse, resid_df = fit.residual_df;
-    if (options.model != ModelKind::kQuadratic && !centre_rows.empty()) {
-      Eigen::VectorXd v(n);
-      for (Eigen::Index r = 0; r < n; ++r) v(r) = is_centre(x, r) ? 1.0 : 0.0;
-      const Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(n, p);
-      v -= q * (q.transpose() * v);
-      if (v.norm() > 1e-9 && resid_df >= 1.0) {
-        const double ss = std::pow(v.dot(yy), 2) / v.squaredNorm();
-        rows.push_back({"curvature", 1.0, ss, 0.0, {}, {}});
-        resid_ss -= ss;
-        resid_df -= 1.0;
-      }
-    }
-    double error_ss = resid_ss, error_df = resid_df;
-    std::string error_name = "residual";
-    if (df_pe > 0.0 && resid_df - df_pe > 0.5) {
-      rows.push_back(
-          {"lack of fit", resid_df - df_pe, std::max(0.0, resid_ss - ss_pe), 0.0, {}, {}});
-      error_ss = ss_pe;
-      error_df = df_pe;
-      error_name = "pure error";
-    } else if (df_pe > 0.0 && std::abs(resid_df - df_pe) < 0.5) {
-      error_name = "pure error";
-    }
-    if (error_df > 0.0) {
-      const double ms_error = error_ss / error_df;
-      for (auto& row : rows) {
-        row.ms = row.ss / row.df;
-        if (ms_error > 0.0) {
-          row.f = row.ms / ms_error;
-          row.p = f_survival(*row.f, row.df, error_df);
-        }
-      }
-      rows.push_back({error_name, error_df, error_ss, ms_error, {}, {}});
-      rows.push_back({"total (corrected)", double(n - 1), fit.sst, 0.0, {}, {}});
-      out.anova = rows;
-    }
-  }
+  out.anova = anova_table(coded, y, out.fit, options, !used.centre.empty(), ss_pe, df_pe);
 
   // Seed 000 Table 9: fit errors of the models with and without interactions.
   out.prediction_errors.push_back(
@@ -344,7 +366,7 @@ ResponseAnalysis analyse_response(const Eigen::MatrixXd& coded, const Eigen::Vec
   out.prediction_errors.push_back(
       prediction_error(fit_model(coded, y, ModelKind::kTwoFactor), y, "with interactions"));
   if (options.model == ModelKind::kQuadratic) {
-    out.prediction_errors.push_back(prediction_error(fit, y, "quadratic"));
+    out.prediction_errors.push_back(prediction_error(out.fit, y, "quadratic"));
   }
   return out;
 }
