@@ -47,89 +47,104 @@ double rose_tanaka_factor(double half_angle) {
   return std::pow(std::tan(half_angle) * std::tan(kStagnantZoneAngle), -0.35);
 }
 
-LabOutput run_hopper(const MaterialModel& material, const Settings& values,
-                     const RunOptions& options) {
-  const auto s = read_settings<HopperSettings>(values, "settings");
-  sim::World w = make_material_world(material, options);
-  const auto sizes = material.simulated_sizes();
-  const double density = material.simulated_density();
-  const double r_max = particles::max_radius(sizes);
-  const double d = 2.0 * r_max;
-  const double b = s.outlet * d, depth = s.depth * d;
-  const double theta = s.half_angle * M_PI / 180.0;
+namespace {
 
-  // Size the hopper for the bed: the wedge of height h holds (b + h tan) h depth of bulk; the
-  // particles (solid fraction ~0.6) should fill the wedge and a little of the bin above.
+/// The wedge sized for its bed, filled, prepared and settled on the closed gate.
+struct Hopper {
+  sim::World w;
+  sim::HealthLimits limits;
+  double r_max = 0.0, d = 0.0;  ///< largest simulated particle radius and diameter (m)
+  double b = 0.0, depth = 0.0;  ///< slot width and periodic slice depth (m)
+  double theta = 0.0;           ///< wall angle from the vertical (rad)
+  double h = 0.0, bin = 0.0;    ///< wedge height and the bin above it (m)
+  double top = 0.0;             ///< width at the top of the wedge (m)
+  double rho_b = 0.0;           ///< bulk density of the settled bed (kg/m^3)
+};
+
+/// Sizes the hopper for the bed (the wedge of height h holds (b + h tan) h depth of bulk; the
+/// particles, solid fraction ~0.6, fill the wedge and a little of the bin above), fills,
+/// prepares (a lid at the top of the fill region) and settles with the gate closed, and reads
+/// the bulk density in a box in the middle of the wedge, two diameters from the walls.
+Hopper build_hopper(const MaterialModel& material, const HopperSettings& s,
+                    const RunOptions& options, LabOutput& out) {
+  Hopper hp;
+  sim::World& w = hp.w;
+  w = make_material_world(material, options);
+  const auto sizes = material.simulated_sizes();
+  hp.r_max = particles::max_radius(sizes);
+  hp.d = 2.0 * hp.r_max;
+  const double d = hp.d;
+  hp.b = s.outlet * d;
+  hp.depth = s.depth * d;
+  hp.theta = s.half_angle * M_PI / 180.0;
   Rng rng(options.seed);
   const double solid = expected_solid_volume(sizes, s.particles, options.seed);
-  const double area = solid / (0.6 * depth);  // x-z area of the settled bed
-  const double t = std::tan(theta);
+  const double area = solid / (0.6 * hp.depth);  // x-z area of the settled bed
+  const double t = std::tan(hp.theta);
   // (b + h t) h = area  ->  h = (-b + sqrt(b^2 + 4 t area)) / (2 t)
-  const double h = std::max(4.0 * d, (-b + std::sqrt(b * b + 4.0 * t * area)) / (2.0 * t));
-  const double top = b + 2.0 * h * t;             // width at the top of the wedge
-  const double bin = 3.0 * area / top + 4.0 * d;  // room for the loose insertion
+  hp.h = std::max(4.0 * d, (-hp.b + std::sqrt(hp.b * hp.b + 4.0 * t * area)) / (2.0 * t));
+  hp.top = hp.b + 2.0 * hp.h * t;
+  hp.bin = 3.0 * area / hp.top + 4.0 * d;  // room for the loose insertion
   w.domain.lo = {-1e3, 0.0, -1e3};
-  w.domain.hi = {1e3, depth, 1e3};
+  w.domain.hi = {1e3, hp.depth, 1e3};
   w.domain.periodic = {false, true, false};
   w.walls.push_back(walls::make_wall(
-      "hopper", walls::make_wedge_hopper(theta, b, h, bin, -2.0 * d, depth + 2.0 * d), kWallDie));
+      "hopper",
+      walls::make_wedge_hopper(hp.theta, hp.b, hp.h, hp.bin, -2.0 * d, hp.depth + 2.0 * d),
+      kWallDie));
   w.walls.push_back(walls::make_wall("gate", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
-
   particles::InsertRequest req = material_insert_request(
-      material, particles::BoxRegion{{-0.5 * top, 0.0, h}, {0.5 * top, depth, h + bin}},
+      material,
+      particles::BoxRegion{{-0.5 * hp.top, 0.0, hp.h}, {0.5 * hp.top, hp.depth, hp.h + hp.bin}},
       static_cast<std::size_t>(s.particles));
   // Spheres stay inside the region, so none overlaps a periodic image across y = 0 / depth.
   const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety, material.factors().time);
-
-  sim::HealthLimits limits;
-  limits.lo = {-top - bin, -1e3, -(h + bin) * 4.0 - 1.0};
-  limits.hi = {top + bin, 1e3, 2.0 * (h + bin)};
-  limits.max_kinetic_energy =
-      1e3 * w.particles.total_mass() * std::max(norm(w.gravity), 1.0) * (h + bin);
-
-  // 1. Fill, prepare (a lid at the top of the fill region) and settle with the gate closed.
+  hp.limits.lo = {-hp.top - hp.bin, -1e3, -(hp.h + hp.bin) * 4.0 - 1.0};
+  hp.limits.hi = {hp.top + hp.bin, 1e3, 2.0 * (hp.h + hp.bin)};
+  hp.limits.max_kinetic_energy =
+      1e3 * w.particles.total_mass() * std::max(norm(w.gravity), 1.0) * (hp.h + hp.bin);
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.5;
   const PreparedBed built =
-      prepare_and_settle(w, material, settle_spec, limits, h + bin, options.seed);
-
-  // Bulk density of the settled bed: a box in the middle of the wedge, two diameters from the
-  // walls (at its height the wedge is wider than the box).
-  const double z0 = 0.3 * h, z1 = std::min(0.9 * h, metrics::bed_top(w) - 2.0 * d);
-  const double half = 0.5 * (b + 2.0 * z0 * t) - 2.0 * d;
+      prepare_and_settle(w, material, settle_spec, hp.limits, hp.h + hp.bin, options.seed);
+  const double z0 = 0.3 * hp.h, z1 = std::min(0.9 * hp.h, metrics::bed_top(w) - 2.0 * d);
+  const double half = 0.5 * (hp.b + 2.0 * z0 * t) - 2.0 * d;
   double phi = 0.6;
   if (half > d && z1 > z0 + d)
-    phi = metrics::solid_fraction(w, {-half, 0.0, z0}, {half, depth, z1});
-  const double rho_b = phi * density;
-
-  LabOutput out;
+    phi = metrics::solid_fraction(w, {-half, 0.0, z0}, {half, hp.depth, z1});
+  hp.rho_b = phi * material.simulated_density();
   out.add_phase(filled, {});
   if (built.prepared.steps > 0) out.add_phase(built.prepared, {});
   out.add_phase(built.settled, {"bulk_density", "beverloo_ratio"});
-  if (!options.snapshot_dir.empty()) {
-    io::write_particles_vtk(options.snapshot_dir + "/hopper_settled_particles.vtk", w);
-    io::write_walls_vtk(options.snapshot_dir + "/hopper_walls.vtk", w, top);
-    out.snapshots = {options.snapshot_dir + "/hopper_settled_particles.vtk",
-                     options.snapshot_dir + "/hopper_walls.vtk"};
-  }
+  return hp;
+}
 
-  // 2. Open the gate (moved far away: no wall is removed, so the bed keeps its contact history).
+struct Discharge {
+  Series curve{{"time", "discharged_mass"}, {{0.0, 0.0}}};
+  double discharged = 0.0;  ///< (kg)
+  double total = 0.0;       ///< the bed's mass (kg)
+  bool arched = false;
+};
+
+/// Opens the gate (moved far away: no wall is removed, so the bed keeps its contact history) and
+/// runs until the hopper is empty, arched or max_time has passed. Discharged particles (centre
+/// below z = -2 d) are parked, kinematic, on a lattice under the hopper, so they neither fall
+/// for ever nor touch anything.
+Discharge discharge(Hopper& hp, const HopperSettings& s, const RunOptions& options,
+                    LabOutput& out) {
+  sim::World& w = hp.w;
   std::get<walls::Plane>(w.walls[1].shape).point = {0, 0, -1e3};
   w.walls[1].pivot = {0, 0, -1e3};
-
-  // Discharged particles (centre below z = -2 d) are parked, kinematic, on a lattice under the
-  // hopper, so they neither fall for ever nor touch anything.
-  const double total_mass = w.particles.total_mass();
-  const double park_z = -(h + bin) * 2.0;
-  const int per_row = std::max(1, static_cast<int>(top / (3.0 * r_max)));
-  const int per_col = std::max(1, static_cast<int>(depth / (3.0 * r_max)));
+  Discharge dis;
+  dis.total = w.particles.total_mass();
+  const double r_max = hp.r_max, d = hp.d;
+  const double park_z = -(hp.h + hp.bin) * 2.0;
+  const int per_row = std::max(1, static_cast<int>(hp.top / (3.0 * r_max)));
+  const int per_col = std::max(1, static_cast<int>(hp.depth / (3.0 * r_max)));
   int parked = 0;
   std::vector<char> gone(w.particles.size(), 0);
-  double discharged = 0.0, last_discharge = 0.0;
+  double last_discharge = 0.0;
   const double t0 = w.time;
-  Series curve{{"time", "discharged_mass"}, {}};
-  curve.rows.push_back({0.0, 0.0});
-  bool arched = false;
   const long check = std::max<long>(1, std::lround(0.002 / w.dt));
   auto each = [&](sim::World& world) {
     if (world.step_count % check != 0) return true;
@@ -139,57 +154,75 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
       if (gone[i] || p.x[i].z > -2.0 * d) continue;
       any = true;
       const int k = parked++;
-      discharged += p.park(i,
-                           {-0.5 * top + 3.0 * r_max * (k % per_row + 0.5),
-                            3.0 * r_max * ((k / per_row) % per_col + 0.5),
-                            park_z - 3.0 * r_max * (k / (per_row * per_col))},
-                           gone);
+      dis.discharged += p.park(i,
+                               {-0.5 * hp.top + 3.0 * r_max * (k % per_row + 0.5),
+                                3.0 * r_max * ((k / per_row) % per_col + 0.5),
+                                park_z - 3.0 * r_max * (k / (per_row * per_col))},
+                               gone);
     }
     const double tt = world.time - t0;
     if (any) {
       last_discharge = tt;
-      curve.rows.push_back({tt, discharged});
+      dis.curve.rows.push_back({tt, dis.discharged});
     }
-    if (discharged >= 0.999 * total_mass) return false;
+    if (dis.discharged >= 0.999 * dis.total) return false;
     if (tt - last_discharge > s.arch_time) {
-      arched = true;
+      dis.arched = true;
       return false;
     }
     if (options.progress) options.progress(std::min(1.0, tt / s.max_time));
     return tt < s.max_time;
   };
-  limits.lo.z = park_z - 3.0 * r_max * (s.particles / (per_row * per_col) + 2) - 1.0;
+  hp.limits.lo.z = park_z - 3.0 * r_max * (s.particles / (per_row * per_col) + 2) - 1.0;
   const PhaseClock discharge_clock(w);
-  run_checked(w, std::lround(s.max_time / w.dt) + 1, limits, each);
+  run_checked(w, std::lround(s.max_time / w.dt) + 1, hp.limits, each);
   out.add_phase(discharge_clock.stop(w, "discharge", "hopper empty or arched within max_time",
-                                     arched || discharged >= 0.999 * total_mass),
+                                     dis.arched || dis.discharged >= 0.999 * dis.total),
                 {"discharge_rate", "beverloo_ratio", "arched", "discharged_fraction"});
+  return dis;
+}
 
-  // Discharge rate: least-squares slope of the mass-time curve between 15 % and 75 % of the
-  // discharged mass (after the start-up, before the hopper runs empty).
-  const double m_end = discharged;
+/// Least-squares slope of the mass-time curve between 15 % and 75 % of the discharged mass
+/// (after the start-up, before the hopper runs empty); the mean rate when too few points.
+double discharge_rate(const Discharge& dis) {
+  const double m_end = dis.discharged;
   LineFit fit;
-  for (const auto& row : curve.rows)
+  for (const auto& row : dis.curve.rows)
     if (row[1] >= 0.15 * m_end && row[1] <= 0.75 * m_end) fit.add(row[0], row[1]);
-  double rate = 0.0;
-  if (fit.points() >= 3 && fit.defined())
-    rate = fit.slope();
-  else if (curve.rows.size() >= 2 && curve.rows.back()[0] > 0.0)
-    rate = m_end / curve.rows.back()[0];
+  if (fit.points() >= 3 && fit.defined()) return fit.slope();
+  if (dis.curve.rows.size() >= 2 && dis.curve.rows.back()[0] > 0.0)
+    return m_end / dis.curve.rows.back()[0];
+  return 0.0;
+}
 
+}  // namespace
+
+LabOutput run_hopper(const MaterialModel& material, const Settings& values,
+                     const RunOptions& options) {
+  const auto s = read_settings<HopperSettings>(values, "settings");
+  LabOutput out;
+  Hopper hp = build_hopper(material, s, options, out);
+  if (!options.snapshot_dir.empty()) {
+    io::write_particles_vtk(options.snapshot_dir + "/hopper_settled_particles.vtk", hp.w);
+    io::write_walls_vtk(options.snapshot_dir + "/hopper_walls.vtk", hp.w, hp.top);
+    out.snapshots = {options.snapshot_dir + "/hopper_settled_particles.vtk",
+                     options.snapshot_dir + "/hopper_walls.vtk"};
+  }
+  const Discharge dis = discharge(hp, s, options, out);
+  const double rate = discharge_rate(dis);
   // Beverloo slot form with the hopper's wall factor (header comment).
-  const double g = norm(w.gravity);
-  const double opening = std::max(0.0, b - kBeverlooK * d);
-  const double beverloo = 4.0 * std::sqrt(2.0) / M_PI * kBeverlooC * rho_b * std::sqrt(g) * depth *
-                          std::pow(opening, 1.5) * rose_tanaka_factor(theta);
+  const double g = norm(hp.w.gravity);
+  const double opening = std::max(0.0, hp.b - kBeverlooK * hp.d);
+  const double beverloo = 4.0 * std::sqrt(2.0) / M_PI * kBeverlooC * hp.rho_b * std::sqrt(g) *
+                          hp.depth * std::pow(opening, 1.5) * rose_tanaka_factor(hp.theta);
   out.metrics["discharge_rate"] = rate;
-  out.metrics["arched"] = arched ? 1.0 : 0.0;
+  out.metrics["arched"] = dis.arched ? 1.0 : 0.0;
   out.metrics["beverloo_rate"] = beverloo;
   out.metrics["beverloo_ratio"] = beverloo > 0.0 ? rate / beverloo : 0.0;
-  out.metrics["discharged_fraction"] = m_end / total_mass;
-  out.metrics["bulk_density"] = rho_b;
-  out.series["discharge"] = std::move(curve);
-  out.cost.close(w);
+  out.metrics["discharged_fraction"] = dis.discharged / dis.total;
+  out.metrics["bulk_density"] = hp.rho_b;
+  out.series["discharge"] = dis.curve;
+  out.cost.close(hp.w);
   return out;
 }
 
