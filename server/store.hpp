@@ -98,7 +98,7 @@ struct StoreLimits {
   double restart_grace_seconds = 0.0;
   /// The monotonic clock that measures how long the lock is held (empty: steady_seconds);
   /// tests give a fake one.
-  std::function<double()> clock;
+  std::function<double()> clock = {};
   /// synchronous=FULL instead of NORMAL: every commit survives a power cut (see the top).
   bool fsync_every_commit = false;
 };

@@ -34,8 +34,8 @@ json optional(const Call& call, const std::string& what, json& notes) {
   return nullptr;
 }
 
-v1::Campaign read_campaign(v1::CampaignService::StubInterface& stub,
-                           const rpc::ChannelOptions& ch, std::int64_t id) {
+v1::Campaign read_campaign(v1::CampaignService::StubInterface& stub, const rpc::ChannelOptions& ch,
+                           std::int64_t id) {
   v1::GetRequest get;
   get.set_id(id);
   v1::Campaign campaign;
@@ -48,8 +48,7 @@ json read_design(v1::CampaignService::StubInterface& stub, const rpc::ChannelOpt
   v1::GetRequest get;
   get.set_id(id);
   v1::DesignReply design;
-  required([&] { return stub.GetDesign(rpc::make_context(ch, 60).get(), get, &design); },
-           "design");
+  required([&] { return stub.GetDesign(rpc::make_context(ch, 60).get(), get, &design); }, "design");
   return as_json(design);
 }
 

@@ -1,10 +1,10 @@
 #include "core/model/catalog.hpp"
 
 #include "core/common/error.hpp"
-#include "core/model/material.hpp"
 #include "core/model/compaction_settings.hpp"
 #include "core/model/confined_compression_settings.hpp"
 #include "core/model/hopper_settings.hpp"
+#include "core/model/material.hpp"
 #include "core/model/packing_settings.hpp"
 #include "core/model/rotating_drum_settings.hpp"
 #include "core/model/shear_cell_settings.hpp"

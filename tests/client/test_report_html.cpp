@@ -1,10 +1,10 @@
 // The report page's assembly: libraries and data inline, JSON safe inside <script>, the
 // template's markers replaced once and only in the template.
-#include "client/report/report_html.hpp"
-
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+
+#include "client/report/report_html.hpp"
 
 namespace demcal::report {
 namespace {

@@ -2,13 +2,12 @@
 // control character or has a key that is not a name: an InputError naming the file and line,
 // never another exception (each found by fuzz_campaign_yaml; the inputs are kept in
 // tests/fuzz/regressions/campaign_yaml).
-#include "client/spec_yaml.hpp"
-
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <sstream>
 
+#include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
 
 namespace demcal::cli {

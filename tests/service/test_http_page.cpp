@@ -1,8 +1,6 @@
 // The live page's HTTP side in process: a coordinator with its page; the token checked on the
 // JSON endpoints (401 without or with a wrong one), the pages themselves carry no data, the
 // page refuses to serve beyond loopback without a token, and serves HTTPS with a certificate.
-#include "server/http_page.hpp"
-
 #include <gtest/gtest.h>
 #include <httplib.h>
 #include <unistd.h>
@@ -12,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "server/coordinator.hpp"
+#include "server/http_page.hpp"
 
 namespace demcal::server {
 namespace {

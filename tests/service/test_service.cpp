@@ -258,9 +258,8 @@ TEST_F(Service, AWorkerTokenCannotSubmitOrCancelAndAClientTokenCannotLeaseOrComp
   ASSERT_TRUE(lease.has_job());
   // The client token: the campaign service only.
   v1::LeaseReply other;
-  EXPECT_EQ(
-      workers_as(client)->Lease(rpc::make_context(client, 10).get(), lr, &other).error_code(),
-      grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_EQ(workers_as(client)->Lease(rpc::make_context(client, 10).get(), lr, &other).error_code(),
+            grpc::StatusCode::PERMISSION_DENIED);
   v1::CompleteRequest done;
   done.set_job_id(lease.job().job_id());
   done.set_attempt(lease.job().attempt());

@@ -1,8 +1,6 @@
 // The coordinator's store on :memory: and on a real file: migrations, WAL, the lease state
 // machine, exactly-once results, the retry cap, give-back and cancellation. Lease times are
 // seconds of a fake monotonic clock passed in as `now`.
-#include "server/store.hpp"
-
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 #include <unistd.h>
@@ -10,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+
+#include "server/store.hpp"
 
 namespace demcal::server {
 namespace {
