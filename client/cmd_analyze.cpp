@@ -161,22 +161,22 @@ std::vector<std::string> factor_legend(const std::vector<doe::Factor>& factors) 
   return legend;
 }
 
-nlohmann::json optional_json(bool known, double v) {
-  return known ? nlohmann::json(v) : nlohmann::json(nullptr);
+/// A value, or null where there is none.
+nlohmann::json or_null(std::optional<double> v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
 
-nlohmann::json effects_json(const doe::ResponseAnalysis& res) {
+/// The effects largest first (in the order `demcal effects` prints them), Lenth's test, the
+/// half-normal plot and the seed's constants.
+nlohmann::json effects_json(const std::string& response, const doe::ResponseAnalysis& res) {
   nlohmann::json j;
-  std::vector<const doe::EffectEstimate*> by_size;
-  for (const auto& e : res.effects) by_size.push_back(&e);
-  std::stable_sort(by_size.begin(), by_size.end(),
-                   [](auto a, auto b) { return std::abs(a->effect) > std::abs(b->effect); });
-  for (const auto* e : by_size)
-    j["effects"].push_back({{"chain", e->term.name()},
-                            {"effect", e->effect},
-                            {"in_model", e->in_model},
-                            {"active_me", e->active},
-                            {"active_sme", e->active_simultaneous}});
+  const v1::MetricEffects effects = rpc::effects_message(response, res);
+  for (const auto& e : effects.effects())
+    j["effects"].push_back({{"chain", e.chain()},
+                            {"effect", e.effect()},
+                            {"in_model", e.in_model()},
+                            {"active_me", e.active_me()},
+                            {"active_sme", e.active_sme()}});
   if (res.lenth)
     j["lenth"] = {{"m", res.lenth->contrasts},
                   {"df", res.lenth->degrees_of_freedom},
@@ -213,8 +213,8 @@ nlohmann::json fit_json(const doe::ModelFit& fit) {
         {{"chain", fit.terms[i].name()},
          {"coefficient", fit.coefficients(Eigen::Index(i))},
          {"standard_error",
-          optional_json(fit.standard_errors.size() > 0,
-                        fit.standard_errors.size() ? fit.standard_errors(Eigen::Index(i)) : 0.0)}});
+          or_null(fit.standard_errors.size() ? std::optional(fit.standard_errors(Eigen::Index(i)))
+                                             : std::nullopt)}});
   return j;
 }
 
@@ -237,8 +237,8 @@ void add_checks_json(const doe::ResponseAnalysis& res, nlohmann::json& j) {
                           {"df", a.df},
                           {"ss", a.ss},
                           {"ms", a.ms},
-                          {"F", optional_json(a.f.has_value(), a.f.value_or(0.0))},
-                          {"p", optional_json(a.p.has_value(), a.p.value_or(0.0))}});
+                          {"F", or_null(a.f)},
+                          {"p", or_null(a.p)}});
   for (const auto& p : res.prediction_errors)
     j["prediction_errors"].push_back(
         {{"model", p.model},
@@ -246,12 +246,13 @@ void add_checks_json(const doe::ResponseAnalysis& res, nlohmann::json& j) {
          {"mean_abs_percent", p.mean_abs_percent},
          {"max_abs_percent", p.max_abs_percent},
          {"loo_mean_abs_percent",
-          optional_json(std::isfinite(p.loo_mean_abs_percent), p.loo_mean_abs_percent)}});
+          or_null(std::isfinite(p.loo_mean_abs_percent) ? std::optional(p.loo_mean_abs_percent)
+                                                        : std::nullopt)}});
 }
 
 nlohmann::json analysis_json(const AnalyzeOptions& opt, const Design& d,
                              const doe::ResponseAnalysis& res) {
-  nlohmann::json j = effects_json(res);
+  nlohmann::json j = effects_json(opt.response, res);
   j["response"] = opt.response;
   j["factors"] = factor_legend(d.factors);
   j["ignored_columns"] = d.ignored;

@@ -104,20 +104,8 @@ v1::Material switched(const v1::Material& base, const std::map<std::string, std:
   return m;
 }
 
-/// Sets an optional field to v when v is known (a pending value is NaN, diagnosis.hpp).
-template <class Setter>
-void set_known(double v, Setter set) {
-  if (std::isfinite(v)) set(v);
-}
-
-void fill_factors(const std::vector<diagnose::Factor>& factors, v1::DiagnosisCandidate& c) {
-  for (const auto& f : factors) {
-    auto* m = c.add_factors();
-    m->set_path(f.path);
-    m->set_low(f.factor.low);
-    m->set_high(f.factor.high);
-  }
-}
+// A value the diagnosis does not know yet is NaN (diagnosis.hpp, kPending): its optional field
+// stays absent.
 
 v1::DiagnosisMetric metric_message(const diagnose::MetricRow& m) {
   v1::DiagnosisMetric out;
@@ -128,10 +116,10 @@ v1::DiagnosisMetric metric_message(const diagnose::MetricRow& m) {
   out.set_envelope_max(m.envelope_max);
   out.set_reachable(m.reachable);
   out.set_statement(m.statement);
-  set_known(m.curvature_p, [&](double v) { out.set_curvature_p(v); });
+  if (std::isfinite(m.curvature_p)) out.set_curvature_p(m.curvature_p);
   out.set_predicted(m.predicted);
-  set_known(m.simulated, [&](double v) { out.set_simulated(v); });
-  set_known(m.relative_error, [&](double v) { out.set_relative_error(v); });
+  if (std::isfinite(m.simulated)) out.set_simulated(m.simulated);
+  if (std::isfinite(m.relative_error)) out.set_relative_error(m.relative_error);
   return out;
 }
 
@@ -141,16 +129,21 @@ v1::DiagnosisCandidate candidate_message(const diagnose::CandidateOutcome& c) {
   out.set_cause(c.cause);
   out.set_state(c.state);
   out.set_runs(c.runs);
-  fill_factors(c.factors, out);
+  for (const auto& f : c.factors) {
+    auto* m = out.add_factors();
+    m->set_path(f.path);
+    m->set_low(f.factor.low);
+    m->set_high(f.factor.high);
+  }
   out.mutable_proposed()->insert(c.proposed.begin(), c.proposed.end());
   out.set_reaches_all(c.reaches_all);
-  set_known(c.predicted_rms, [&](double v) { out.set_predicted_rms(v); });
-  set_known(c.verified_rms, [&](double v) { out.set_verified_rms(v); });
+  if (std::isfinite(c.predicted_rms)) out.set_predicted_rms(c.predicted_rms);
+  if (std::isfinite(c.verified_rms)) out.set_verified_rms(c.verified_rms);
   out.set_rounds(c.rounds);
-  set_known(c.design_misprediction, [&](double v) { out.set_design_misprediction(v); });
-  for (const auto& [k, v] : c.simulated)
+  if (std::isfinite(c.design_misprediction)) out.set_design_misprediction(c.design_misprediction);
+  for (const auto& [k, v] : c.simulated)  // a run that failed has no value
     if (std::isfinite(v)) (*out.mutable_simulated())[k] = v;
-  set_known(c.holdout_rms, [&](double v) { out.set_holdout_rms(v); });
+  if (std::isfinite(c.holdout_rms)) out.set_holdout_rms(c.holdout_rms);
   out.set_explains(c.explains);
   out.set_evidence(c.evidence);
   return out;
@@ -164,9 +157,9 @@ v1::DiagnosisReport report_message(const diagnose::Report& r) {
   for (const auto& m : r.metrics) *out.add_metrics() = metric_message(m);
   auto* b = out.mutable_baseline();
   b->mutable_proposed()->insert(r.baseline_proposed.begin(), r.baseline_proposed.end());
-  set_known(r.baseline_predicted_rms, [&](double v) { b->set_predicted_rms(v); });
-  set_known(r.baseline_verified_rms, [&](double v) { b->set_verified_rms(v); });
-  set_known(r.baseline_holdout_rms, [&](double v) { b->set_holdout_rms(v); });
+  if (std::isfinite(r.baseline_predicted_rms)) b->set_predicted_rms(r.baseline_predicted_rms);
+  if (std::isfinite(r.baseline_verified_rms)) b->set_verified_rms(r.baseline_verified_rms);
+  if (std::isfinite(r.baseline_holdout_rms)) b->set_holdout_rms(r.baseline_holdout_rms);
   for (const auto& c : r.conflicts) {
     auto* m = out.add_conflicts();
     m->set_fitted(c.fitted);

@@ -98,7 +98,7 @@ metrics::Tensor3 hold(const Cell& c) {
 
 /// Shrinks the cell isotropically through the targets above phi_start up to phi_max, holding at
 /// each; fills the `compression` and `held` series and returns the tensor held at phi_max.
-metrics::Tensor3 compress(Cell& c, const CompactionSettings& s, const RunOptions& options,
+metrics::Tensor3 compress(const Cell& c, const CompactionSettings& s, const RunOptions& options,
                           LabOutput& out) {
   Series compression{{"solid_fraction", "pressure_kpa", "deviatoric_kpa", "coordination_number"},
                      {}};
@@ -363,11 +363,10 @@ LabOutput run_compaction(const MaterialModel& material, const Settings& values,
                   rate,
                   std::max<long>(1, std::lround(0.002 / (rate * w.dt))),
                   std::max<long>(2, std::lround(s.hold * t_c / w.dt))};
-  Cell c = cell;
-  const metrics::Tensor3 held = compress(c, s, options, out);
+  const metrics::Tensor3 held = compress(cell, s, options, out);
   const double p_held = metrics::mean_stress(held);
-  jamming(c.kpa(p_held), s.phi_max, out);
-  out.metrics["final_pressure"] = c.kpa(p_held);
+  jamming(cell.kpa(p_held), s.phi_max, out);
+  out.metrics["final_pressure"] = cell.kpa(p_held);
   out.metrics["final_coordination_number"] = metrics::coordination_number(w);
   if (!options.snapshot_dir.empty()) {  // the state held at phi_max; no walls to draw
     out.snapshots.push_back(options.snapshot_dir + "/compaction_particles.vtk");

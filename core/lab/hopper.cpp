@@ -208,7 +208,7 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
     out.snapshots = {options.snapshot_dir + "/hopper_settled_particles.vtk",
                      options.snapshot_dir + "/hopper_walls.vtk"};
   }
-  const Discharge dis = discharge(hp, s, options, out);
+  Discharge dis = discharge(hp, s, options, out);
   const double rate = discharge_rate(dis);
   // Beverloo slot form with the hopper's wall factor (header comment).
   const double g = norm(hp.w.gravity);
@@ -221,7 +221,7 @@ LabOutput run_hopper(const MaterialModel& material, const Settings& values,
   out.metrics["beverloo_ratio"] = beverloo > 0.0 ? rate / beverloo : 0.0;
   out.metrics["discharged_fraction"] = dis.discharged / dis.total;
   out.metrics["bulk_density"] = hp.rho_b;
-  out.series["discharge"] = dis.curve;
+  out.series["discharge"] = std::move(dis.curve);
   out.cost.close(hp.w);
   return out;
 }

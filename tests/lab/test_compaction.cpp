@@ -24,20 +24,31 @@
 namespace demcal::lab {
 namespace {
 
-TEST(Compaction, ContactStressOfOnePairAcrossAPeriodicFace) {
-  // Two spheres of radius r at x = 0.45 r and x = L - 1.45 r in a periodic cube of side L: their
-  // minimum images are 1.9 r apart along x, across the face x = 0. A linear spring: the force
-  // kn (2 r - 1.9 r) along x, the branch vector 1.9 r along x.
-  const double r = 1e-3, side = 10 * r, kn = 1e4;
+/// Undamped linear springs f = kn delta with tangential history (mu_s 0.5).
+contact::ContactLaw linear_springs(double kn) {
+  contact::ContactLawSpec spec;
+  spec.normal = {"linear", {{"kn", kn}, {"damping_ratio", 0.0}}};
+  spec.tangential = {"history", {{"mu_s", 0.5}}};
+  return contact::ContactLaw::from_spec(spec, "law");
+}
+
+/// An empty fully periodic cube of side `side` without gravity, its pairs on linear_springs(kn).
+sim::World periodic_cube(double side, double kn) {
   sim::World w;
   w.gravity = {};
   w.domain.lo = {0, 0, 0};
   w.domain.hi = {side, side, side};
   w.domain.periodic = {true, true, true};
-  contact::ContactLawSpec spec;
-  spec.normal = {"linear", {{"kn", kn}, {"damping_ratio", 0.0}}};
-  spec.tangential = {"history", {{"mu_s", 0.5}}};
-  w.set_pair_law(0, 0, contact::ContactLaw::from_spec(spec, "law"));
+  w.set_pair_law(0, 0, linear_springs(kn));
+  return w;
+}
+
+TEST(Compaction, ContactStressOfOnePairAcrossAPeriodicFace) {
+  // Two spheres of radius r at x = 0.45 r and x = L - 1.45 r in a periodic cube of side L: their
+  // minimum images are 1.9 r apart along x, across the face x = 0. A linear spring: the force
+  // kn (2 r - 1.9 r) along x, the branch vector 1.9 r along x.
+  const double r = 1e-3, side = 10 * r, kn = 1e4;
+  sim::World w = periodic_cube(side, kn);
   w.particles.add_sphere({0.45 * r, 5 * r, 5 * r}, r, 2500, 0);
   w.particles.add_sphere({side - 1.45 * r, 5 * r, 5 * r}, r, 2500, 0);
   w.dt = 1e-7;
@@ -67,10 +78,7 @@ TEST(Compaction, ContactStressEqualsTheWallStressOfALatticeBetweenWalls) {
   w.domain.lo = {0, 0, -1};
   w.domain.hi = {nx * a, nx * a, 1};
   w.domain.periodic = {true, true, false};
-  contact::ContactLawSpec spec;
-  spec.normal = {"linear", {{"kn", kn}, {"damping_ratio", 0.0}}};
-  spec.tangential = {"history", {{"mu_s", 0.5}}};
-  const auto law = contact::ContactLaw::from_spec(spec, "law");
+  const auto law = linear_springs(kn);
   w.set_pair_law(0, 0, law);
   w.set_wall_law(0, 0, law);
   for (int i = 0; i < nx; ++i)
@@ -102,15 +110,7 @@ TEST(Compaction, ContactPressureIsTheEnergyRoutePressureOfARandomPacking) {
   // virial theorem), computed here from the overlaps alone, and must equal the trace of the
   // Love-Weber tensor over 3; with central forces the tensor is symmetric.
   const double kn = 1e4, side = 1e-2;
-  sim::World w;
-  w.gravity = {};
-  w.domain.lo = {0, 0, 0};
-  w.domain.hi = {side, side, side};
-  w.domain.periodic = {true, true, true};
-  contact::ContactLawSpec spec;
-  spec.normal = {"linear", {{"kn", kn}, {"damping_ratio", 0.0}}};
-  spec.tangential = {"history", {{"mu_s", 0.5}}};
-  w.set_pair_law(0, 0, contact::ContactLaw::from_spec(spec, "law"));
+  sim::World w = periodic_cube(side, kn);
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   double solid = 0.0;

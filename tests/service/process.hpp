@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -87,6 +88,20 @@ inline bool wait_until(const std::function<bool()>& done, double seconds, double
     std::this_thread::sleep_for(std::chrono::duration<double>(poll));
   }
   return done();
+}
+
+/// `spec_text` written to `dir`/spec.yaml (`dir` made afresh) and run by the embedded default,
+/// `cli run` with two one-thread workers and the work directory `dir`/work; its standard output
+/// and error go to `dir`/run.log. The caller waits for it.
+inline Process embedded_run(const std::string& cli, const std::filesystem::path& dir,
+                            const std::string& spec_text) {
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string spec = (dir / "spec.yaml").string();
+  std::ofstream(spec) << spec_text;
+  return Process(
+      {cli, "run", spec, "--workdir", (dir / "work").string(), "--workers", "2", "--threads", "1"},
+      (dir / "run.log").string());
 }
 
 }  // namespace demcal::test

@@ -70,13 +70,7 @@ double effect(const std::string& log, const std::string& metric, const std::stri
 TEST(CompactionCampaign, EmbeddedRunFindsTheFrictionEffectOnJamming) {
   const fs::path dir =
       fs::temp_directory_path() / ("demcal_compaction_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string spec = (dir / "compaction.yaml").string();
-  std::ofstream(spec) << kSpec;
-  Process run({DEMCAL_CLI_BIN, "run", spec, "--workdir", (dir / "work").string(), "--workers", "2",
-               "--threads", "1"},
-              (dir / "run.log").string());
+  Process run = embedded_run(DEMCAL_CLI_BIN, dir, kSpec);
   ASSERT_EQ(run.wait_exit(200), 0) << run.log();
   const std::string out = run.log();
   EXPECT_NE(out.find("== compaction.yield_slope (4 of 4 runs) =="), std::string::npos) << out;

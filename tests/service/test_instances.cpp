@@ -150,13 +150,7 @@ TEST(TestInstances, BadInstancesAreRefusedNamingTheField) {
 
 TEST(TestInstances, EmbeddedRunReportsEachInstanceAsItsOwnMetric) {
   const fs::path dir = fs::temp_directory_path() / ("demcal_instances_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string spec = (dir / "drums.yaml").string();
-  std::ofstream(spec) << drums_spec();
-  Process run({DEMCAL_CLI_BIN, "run", spec, "--workdir", (dir / "work").string(), "--workers", "2",
-               "--threads", "1"},
-              (dir / "run.log").string());
+  Process run = embedded_run(DEMCAL_CLI_BIN, dir, drums_spec());
   ASSERT_EQ(run.wait_exit(200), 0) << run.log();
   const std::string out = run.log();
   for (const char* header : {"== drum_ptfe.dynamic_angle_of_repose (4 of 4 runs) ==",
