@@ -67,14 +67,15 @@ void print_candidates(std::ostream& out, const v1::DiagnosisReport& r) {
   out << "\ncandidate causes, each tested by simulation (best first)\n";
   out << std::left << std::setw(14) << "candidate" << std::right << std::setw(6) << "runs"
       << std::setw(13) << "mispredicted" << std::setw(11) << "predicted" << std::setw(10)
-      << "verified" << std::setw(8) << "rounds" << std::setw(10) << "held out" << std::setw(10)
+      << "verified" << std::setw(8) << "round" << std::setw(10) << "held out" << std::setw(10)
       << "explains"
       << "\n";
   for (const auto& c : r.candidates()) {
     out << std::left << std::setw(14) << c.id() << std::right << std::setw(6) << c.runs()
         << std::setw(13) << pct(c.has_design_misprediction(), c.design_misprediction())
         << std::setw(11) << pct(c.has_predicted_rms(), c.predicted_rms()) << std::setw(10)
-        << pct(c.has_verified_rms(), c.verified_rms()) << std::setw(8) << c.rounds()
+        << pct(c.has_verified_rms(), c.verified_rms()) << std::setw(8)
+        << (std::to_string(c.best_round()) + "/" + std::to_string(c.rounds()))
         << std::setw(10) << pct(c.has_holdout_rms(), c.holdout_rms()) << std::setw(10)
         << (c.explains() ? "yes" : "no") << "\n";
     out << "    " << c.cause() << " [" << c.state() << "]";

@@ -140,6 +140,7 @@ v1::DiagnosisCandidate candidate_message(const diagnose::CandidateOutcome& c) {
   if (std::isfinite(c.predicted_rms)) out.set_predicted_rms(c.predicted_rms);
   if (std::isfinite(c.verified_rms)) out.set_verified_rms(c.verified_rms);
   out.set_rounds(c.rounds);
+  out.set_best_round(c.best_round);
   if (std::isfinite(c.design_misprediction)) out.set_design_misprediction(c.design_misprediction);
   for (const auto& [k, v] : c.simulated)  // a run that failed has no value
     if (std::isfinite(v)) (*out.mutable_simulated())[k] = v;

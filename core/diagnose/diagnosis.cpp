@@ -390,6 +390,29 @@ std::vector<MetricRow> baseline_rows(const Problem& p, const Fitted& base,
   return rows;
 }
 
+/// One verified calibration of a candidate: where it was simulated, what the surrogate predicted
+/// there and what the simulation gave.
+struct VerifiedPoint {
+  std::map<std::string, double> proposed, simulated;
+  double predicted_rms = kPending, verified_rms = kPending, holdout_rms = kPending;
+  bool reaches_all = false;
+};
+
+/// The candidate's outcome is its best verified round (lowest verified error on the calibrated
+/// metrics; the held-out ones never choose): a later round's surrogate, refitted on a miss, may
+/// propose a worse point than an earlier one, and the simulated point is what the candidate
+/// has shown it can do (as the sequential calibration keeps its best simulated point).
+void keep_if_best(const VerifiedPoint& point, int round, CandidateOutcome& c) {
+  if (c.best_round > 0 && !(point.verified_rms < c.verified_rms)) return;
+  c.best_round = round;
+  c.proposed = point.proposed;
+  c.simulated = point.simulated;
+  c.predicted_rms = point.predicted_rms;
+  c.verified_rms = point.verified_rms;
+  c.holdout_rms = point.holdout_rms;
+  c.reaches_all = point.reaches_all;
+}
+
 /// Calibrates a candidate on its data, verifies, adds the verified run, refits, and again: at
 /// most `rounds` rounds, fewer once a verified error is below `converged`. Appends the
 /// verification runs it needs; false when one has not finished.
@@ -400,27 +423,35 @@ bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
   auto models = fit_targets(p, coded, y, plan.model);
   for (int round = 1; round <= p.options.rounds; ++round) {
     const Fitted fit = calibrate_targets(p, plan.factors, models);
-    c.proposed = natural_point(plan.factors, fit.result.natural);
-    c.predicted_rms = std::sqrt(fit.result.objective);
-    c.reaches_all = fit.reaches_all;
-    c.state = "designed";
-    requests.push_back({plan.id + "/verify", round, plan.switches, c.proposed});
+    VerifiedPoint point{natural_point(plan.factors, fit.result.natural), {},
+                        std::sqrt(fit.result.objective)};
+    point.reaches_all = fit.reaches_all;
+    requests.push_back({plan.id + "/verify", round, plan.switches, point.proposed});
     const auto* v = find_group(groups, plan.id + "/verify");
-    if (!v || !v->count(round)) return false;
-    c.simulated = v->at(round);
+    if (!v || !v->count(round)) {
+      if (c.best_round == 0) {  // nothing verified yet: show what is being verified
+        c.proposed = point.proposed;
+        c.predicted_rms = point.predicted_rms;
+        c.reaches_all = point.reaches_all;
+        c.state = "designed";
+      }
+      return false;
+    }
+    point.simulated = v->at(round);
+    point.verified_rms = rms_error(p, base.all, point.simulated, false);
+    point.holdout_rms = rms_error(p, base.all, point.simulated, true);
     c.rounds = round;
-    c.state = "verified";
-    c.verified_rms = rms_error(p, base.all, c.simulated, false);
-    c.holdout_rms = rms_error(p, base.all, c.simulated, true);
-    if (!std::isfinite(c.verified_rms)) {
-      c.state = "failed";
+    if (!std::isfinite(point.verified_rms)) {  // a failed run ends the rounds
+      if (c.best_round == 0) c.state = "failed";
       return true;
     }
-    if (c.verified_rms <= p.options.converged || round == p.options.rounds) return true;
+    keep_if_best(point, round, c);
+    c.state = "verified";
+    if (point.verified_rms <= p.options.converged || round == p.options.rounds) return true;
     coded.conservativeResize(coded.rows() + 1, Eigen::NoChange);
     coded.bottomRows(1) = fit.result.coded.transpose();
     y.conservativeResize(y.rows() + 1, Eigen::NoChange);
-    y.bottomRows(1) = group_matrix(p, {{1, c.simulated}}, 1);
+    y.bottomRows(1) = group_matrix(p, {{1, point.simulated}}, 1);
     for (auto& m : models) refit(m.model, coded, y.col(response_column(p, m.name)), fitted_rows);
   }
   return true;
@@ -485,7 +516,8 @@ void rank_candidates(const Problem& p, Report& rep) {
     std::ostringstream e;
     e << "verified RMS error " << percent(c.verified_rms) << " against " << percent(base_rms)
       << " for the baseline (predicted " << percent(c.predicted_rms) << ", " << c.rounds
-      << " verification round" << (c.rounds == 1 ? "" : "s") << "); the base model mispredicted "
+      << " verification round" << (c.rounds == 1 ? "" : "s") << ", the best is round "
+      << c.best_round << "); the base model mispredicted "
       << "its runs by " << percent(c.design_misprediction);
     if (std::isfinite(c.holdout_rms))
       e << "; held-out " << percent(c.holdout_rms) << " against "

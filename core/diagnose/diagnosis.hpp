@@ -140,8 +140,12 @@ struct CandidateOutcome {
   std::vector<Factor> factors;             ///< the extended factor box
   std::map<std::string, double> proposed;  ///< its calibrated set (natural)
   bool reaches_all = false;                ///< every calibrated target inside its envelopes
-  double predicted_rms = kPending, verified_rms = kPending;  ///< of the last round
-  int rounds = 0;                                            ///< verification rounds done
+  int rounds = 0;                          ///< verification rounds done
+  /// The verified round with the lowest calibrated error; proposed, predicted_rms,
+  /// verified_rms, simulated, holdout_rms and reaches_all are that round's (0: none verified,
+  /// proposed and predicted_rms are the round being verified).
+  int best_round = 0;
+  double predicted_rms = kPending, verified_rms = kPending;
   /// Relative RMS misprediction of its augmented runs by the base model: what the base design
   /// did not see (ranks the remedies: an aliased interaction shows in the fold-over runs,
   /// curvature in the axial runs).
