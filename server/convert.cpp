@@ -172,18 +172,17 @@ Instances plan_tests(const v1::CampaignSpec& spec, CampaignPlan& plan) {
 
 /// Sets the spec's fixed parameters on the material and on every instance.
 void apply_fixed(const v1::CampaignSpec& spec, lab::MaterialModel& model, Instances& instances) {
-  const std::map<std::string, double> fixed(spec.fixed().begin(), spec.fixed().end());
-  for (const auto& [path, value] : fixed) {
-    const std::string where = "spec.fixed." + path;
-    lab::require_parameter(model, path, where);
-    lab::check_parameter_value(model, path, value, where);
-    lab::set_parameter(model, path, value);
-    for (auto& [name, instance] : instances) {
-      if (!lab::has_parameter(instance, path))
-        throw InputError(where,
+  std::vector<lab::ParameterValue> fixed;
+  for (const auto& [path, value] :
+       std::map<std::string, double>(spec.fixed().begin(), spec.fixed().end()))
+    fixed.push_back({path, value, "spec.fixed." + path});
+  model = lab::with_parameters(std::move(model), fixed);
+  for (auto& [name, instance] : instances) {
+    for (const auto& f : fixed)
+      if (!lab::has_parameter(instance, f.path))
+        throw InputError(f.where,
                          "not a parameter of test '" + name + "' (its own wall_law lacks it)");
-      lab::set_parameter(instance, path, value);
-    }
+    instance = lab::with_parameters(std::move(instance), fixed);
   }
 }
 
@@ -217,8 +216,8 @@ void plan_factors(const v1::CampaignSpec& spec, const lab::MaterialModel& model,
     if (!seen.insert(f.path()).second)
       throw InputError(where + ".path", "'" + f.path() + "' is a factor twice");
     check_factor_bounds(f, info, where);
-    lab::check_parameter_value(model, f.path(), f.low(), where + ".low");
-    lab::check_parameter_value(model, f.path(), f.high(), where + ".high");
+    lab::with_parameters(model, {{f.path(), f.low(), where + ".low"}});
+    lab::with_parameters(model, {{f.path(), f.high(), where + ".high"}});
     for (const auto& [name, instance] : instances)
       if (!lab::has_parameter(instance, f.path()))
         throw InputError(where + ".path", "'" + f.path() + "' is not a parameter of test '" + name +

@@ -1,16 +1,19 @@
-// compaction (seed 004 §2.3-2.4, §3.1): a fully periodic cell compacted by shrinking it affinely
-// through target solid fractions, its contact stress read at each after a hold.
-#include "core/lab/compaction.hpp"
-
+// compaction (seed 004 §2.3-2.4, §3.1): a fully periodic cell of particles (spheres or rigid
+// clumps: rods, helices, clusters) compacted by shrinking the cell affinely, the particles
+// remapped with it, through a list of target solid fractions; at each the cell is held and its
+// contact stress tensor (Love-Weber, metrics/stress.hpp) read. No walls: the cheapest
+// representative volume of a bulk.
 #include <cmath>
 #include <numbers>
 
 #include "core/common/rng.hpp"
 #include "core/io/vtk.hpp"
 #include "core/lab/bed.hpp"
+#include "core/lab/lab_test.hpp"
 #include "core/metrics/bulk.hpp"
 #include "core/metrics/stress.hpp"
 #include "core/metrics/yield_surface.hpp"
+#include "core/model/compaction_settings.hpp"
 #include "core/sim/step.hpp"
 #include "core/sim/time_step.hpp"
 
@@ -328,8 +331,8 @@ void probe_yield(const Cell& compacted, double held_pressure, const CompactionSe
 
 }  // namespace
 
-LabOutput run_compaction(const MaterialModel& material, const Settings& values,
-                         const RunOptions& options) {
+LabOutput CompactionTest::run(const MaterialModel& material, const Settings& values,
+                              const RunOptions& options) {
   const auto s = read_settings<CompactionSettings>(values, "settings");
   sim::World w = make_material_world(material, options);
   w.gravity = {0.0, 0.0, 0.0};

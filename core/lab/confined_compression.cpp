@@ -5,18 +5,19 @@
 // (seed 000 §2.7.2: k_l,wall = 30 k_l, so that particles do not escape past the piston).
 // Stresses given and reported are real; the simulation runs at sigma_sim = sigma_real *
 // ScaleFactors::stress (seed 000 eq. 30 / seed 001 §2.3).
-#include "core/lab/confined_compression.hpp"
-
 #include <algorithm>
 #include <cmath>
 
+#include "core/lab/lab_test.hpp"
+#include "core/lab/piston.hpp"
 #include "core/metrics/bulk.hpp"
+#include "core/model/confined_compression_settings.hpp"
 #include "core/sim/time_step.hpp"
 
 namespace demcal::lab {
 
-LabOutput run_confined_compression(const MaterialModel& material, const Settings& values,
-                                   const RunOptions& options) {
+LabOutput ConfinedCompressionTest::run(const MaterialModel& material, const Settings& values,
+                                       const RunOptions& options) {
   const auto s = read_settings<ConfinedCompressionSettings>(values, "settings");
   const double fs = material.factors().stress;
   const auto stiff_wall =

@@ -197,8 +197,8 @@ double discharge_rate(const Discharge& dis) {
 
 }  // namespace
 
-LabOutput run_hopper(const MaterialModel& material, const Settings& values,
-                     const RunOptions& options) {
+LabOutput HopperTest::run(const MaterialModel& material, const Settings& values,
+                          const RunOptions& options) {
   const auto s = read_settings<HopperSettings>(values, "settings");
   LabOutput out;
   Hopper hp = build_hopper(material, s, options, out);

@@ -11,7 +11,4 @@ namespace demcal::lab {
 /// (tan theta tan 45 deg)^-0.35 below 45 deg, 1 above (hopper.cpp).
 double rose_tanaka_factor(double half_angle);
 
-LabOutput run_hopper(const MaterialModel& material, const Settings& settings,
-                     const RunOptions& options);
-
 }  // namespace demcal::lab

@@ -3,15 +3,8 @@
 #include <chrono>
 
 #include "core/common/error.hpp"
-#include "core/lab/compaction.hpp"
-#include "core/lab/confined_compression.hpp"
-#include "core/lab/hopper.hpp"
-#include "core/lab/packing.hpp"
-#include "core/lab/rotating_drum.hpp"
 #include "core/lab/run_cancelled.hpp"
-#include "core/lab/shear_cell.hpp"
-#include "core/lab/tensile.hpp"
-#include "core/lab/wall_friction.hpp"
+#include "core/model/lab_tests.hpp"
 
 namespace demcal::lab {
 
@@ -39,29 +32,25 @@ class ProgressScope {
   ProgressHook saved_;
 };
 
+using LabRunner = LabOutput (*)(const MaterialModel&, const Settings&, const RunOptions&);
+
+/// The runner of a catalogued test: the registry (core/model/lab_tests.hpp) lists each test's
+/// catalogue entry and runner together, so every entry has one.
+LabRunner runner_of(const std::string& name) {
+  static const std::map<std::string, LabRunner> runners = std::apply(
+      [](auto... test) {
+        return std::map<std::string, LabRunner>{
+            {decltype(test)::info().name, &decltype(test)::run}...};
+      },
+      LabTests{});
+  return runners.at(name);
+}
+
 }  // namespace
 
 void poll_progress() {
   if (current_progress.report && *current_progress.report)
     (*current_progress.report)(current_progress.last);
-}
-
-const std::map<std::string, LabRunner>& lab_runners() {
-  // One entry per lab test; its catalogue entry (name, metrics, settings) is in catalog.cpp.
-  static const std::map<std::string, LabRunner> runners{
-      {"packing", run_packing},       {"confined_compression", run_confined_compression},
-      {"tensile", run_tensile},       {"wall_friction", run_wall_friction},
-      {"shear_cell", run_shear_cell}, {"rotating_drum", run_rotating_drum},
-      {"hopper", run_hopper},         {"compaction", run_compaction},
-  };
-  return runners;
-}
-
-LabRunner find_lab_runner(const std::string& name) {
-  const auto& runners = lab_runners();
-  if (const auto it = runners.find(name); it != runners.end()) return it->second;
-  find_lab_info(name);  // throws with the known names
-  throw InputError("test", "lab test '" + name + "' is catalogued but has no runner");
 }
 
 Series thinned(const Series& series, std::size_t max_rows) {
@@ -103,7 +92,7 @@ LabOutput run_lab_test(const std::string& name, const MaterialModel& material,
       options.progress(fraction);
     };
   const ProgressScope scope(&options.progress);
-  LabOutput out = find_lab_runner(name)(material, settings, run);
+  LabOutput out = runner_of(name)(material, settings, run);
   out.cost.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   for (const auto& m : info.metrics)

@@ -44,13 +44,6 @@ struct RunOptions {
   std::function<void(double fraction)> progress;  ///< optional, 0..1
 };
 
-using LabRunner = LabOutput (*)(const MaterialModel&, const Settings&, const RunOptions&);
-
-/// Every lab test's runner by name: one per catalogue entry (tests/lab/test_phase_cost.cpp).
-const std::map<std::string, LabRunner>& lab_runners();
-/// The runner of a catalogued test; InputError for an unknown name.
-LabRunner find_lab_runner(const std::string& name);
-
 /// Runs a test by name: validates the settings, runs, and checks that every catalogued metric
 /// was produced.
 LabOutput run_lab_test(const std::string& name, const MaterialModel& material,

@@ -1,20 +1,20 @@
 // packing (seed 000 §2.7.1, §3.1): a bed built in a cylindrical die by the material's
-// preparation (one of the four methods of §2.7.1), its solid fraction and coordination number measured in a sampling volume away from
-// the walls.
-#include "core/lab/packing.hpp"
-
+// preparation (one of the four methods of §2.7.1), its solid fraction and coordination number
+// measured in a sampling volume away from the walls.
 #include <algorithm>
 #include <array>
 #include <cmath>
 
 #include "core/common/rng.hpp"
 #include "core/lab/bed.hpp"
+#include "core/lab/lab_test.hpp"
 #include "core/metrics/bulk.hpp"
+#include "core/model/packing_settings.hpp"
 
 namespace demcal::lab {
 
-LabOutput run_packing(const MaterialModel& material, const Settings& values,
-                      const RunOptions& options) {
+LabOutput PackingTest::run(const MaterialModel& material, const Settings& values,
+                           const RunOptions& options) {
   const auto s = read_settings<PackingSettings>(values, "settings");
   BedSpec bed;
   bed.particles = static_cast<std::size_t>(s.particles);

@@ -127,8 +127,8 @@ double DrumImage::surface_angle() const {
   return std::atan(std::abs(fit.slope())) * 180.0 / M_PI;
 }
 
-LabOutput run_rotating_drum(const MaterialModel& material, const Settings& values,
-                            const RunOptions& options) {
+LabOutput RotatingDrumTest::run(const MaterialModel& material, const Settings& values,
+                                const RunOptions& options) {
   const auto s = read_settings<RotatingDrumSettings>(values, "settings");
   sim::World w = make_material_world(material, options);
   w.gravity = {0, -9.81, 0};

@@ -11,9 +11,6 @@
 #include "core/particles/size_distribution.hpp"
 
 namespace demcal::lab {
-LabOutput run_rotating_drum(const MaterialModel& material, const Settings& settings,
-                            const RunOptions& options);
-
 /// The drum cross-section as an image (seed 001 §3.2.2: ImageJ on photographs): particles of
 /// `world` projected along the drum axis z onto a raster of pixel `pixel` over [-R, R]^2.
 struct DrumImage {

@@ -328,8 +328,8 @@ YieldStep shear_step(ShearCell& c, const sim::World& restart, double step_kpa,
 
 }  // namespace
 
-LabOutput run_shear_cell(const MaterialModel& material, const Settings& values,
-                         const RunOptions& options) {
+LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& values,
+                             const RunOptions& options) {
   require_pour(material, "shear_cell");
   const auto s = read_settings<ShearCellSettings>(values, "settings");
   LabOutput out;

@@ -25,7 +25,4 @@ struct MohrResult {
 };
 MohrResult mohr_evaluation(double slope, double intercept, double sigma_pre, double tau_pre);
 
-LabOutput run_shear_cell(const MaterialModel& material, const Settings& settings,
-                         const RunOptions& options);
-
 }  // namespace demcal::lab

@@ -6,10 +6,12 @@
 // sigma_t = -F_z / A (F_z: the particles' force on it); the fracture is the peak of sigma_t over
 // the pull, and the tensile strength is that peak less the weight of the powder still stuck to
 // the piston at the end of the pull, over A (seed 000 §2.7.3, Fig. 10-11).
-#include "core/lab/tensile.hpp"
-
 #include <algorithm>
 #include <cmath>
+
+#include "core/lab/lab_test.hpp"
+#include "core/lab/piston.hpp"
+#include "core/model/tensile_settings.hpp"
 
 namespace demcal::lab {
 namespace {
@@ -40,8 +42,8 @@ double wall_k2_ratio_eq35(double r) {
   return 10.0 + 5.0 * (r - 5.0) / 45.0;
 }
 
-LabOutput run_tensile(const MaterialModel& material, const Settings& values,
-                      const RunOptions& options) {
+LabOutput TensileTest::run(const MaterialModel& material, const Settings& values,
+                           const RunOptions& options) {
   const auto s = read_settings<TensileSettings>(values, "settings");
   const double fs = material.factors().stress;
   const double r_um = real_radius_um(material);

@@ -5,9 +5,13 @@
 // keeps the stress; the mean torque over the second half of the turn gives tau = 3 T/(2 pi R^3).
 // The piston and bottom have the wall law stiffened by wall_stiffness_factor (seed 000 §2.7.2);
 // the bottom has friction bottom_friction so that the bed does not turn with the piston.
-#include "core/lab/wall_friction.hpp"
-
+// Torque to shear stress for a uniform shear stress on a disk of radius R:
+//   T = int_0^R tau 2 pi r^2 dr = (2/3) pi R^3 tau   =>   tau = 3 T / (2 pi R^3).
 #include <cmath>
+
+#include "core/lab/lab_test.hpp"
+#include "core/lab/piston.hpp"
+#include "core/model/wall_friction_settings.hpp"
 
 namespace demcal::lab {
 
@@ -25,8 +29,8 @@ double two_point_calibration(double mu_a, double phi_a, double mu_b, double phi_
   return mu_a + (phi_target - phi_a) * (mu_b - mu_a) / (phi_b - phi_a);
 }
 
-LabOutput run_wall_friction(const MaterialModel& material, const Settings& values,
-                            const RunOptions& options) {
+LabOutput WallFrictionTest::run(const MaterialModel& material, const Settings& values,
+                                const RunOptions& options) {
   const auto s = read_settings<WallFrictionSettings>(values, "settings");
   const double fs = material.factors().stress;
   const auto piston_spec = stiffen_normal(material.wall_law, s.wall_stiffness_factor);

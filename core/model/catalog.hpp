@@ -1,7 +1,8 @@
 #pragma once
 // The catalogue of virtual lab tests: names, metrics (DESIGN.md names and units), settings tables.
 // Metadata only, without the physics, so the coordinator can validate campaigns (test names,
-// metric names, settings) without linking the DEM engine. The runners are in lab_test.hpp.
+// metric names, settings) without linking the DEM engine. The tests are listed in lab_tests.hpp;
+// their runners are in core/lab.
 #include <map>
 #include <string>
 #include <vector>
@@ -12,6 +13,8 @@
 namespace demcal::lab {
 
 struct MaterialModel;  // material.hpp
+struct LabOutput;      // core/lab/lab_test.hpp: what a runner returns
+struct RunOptions;     // core/lab/lab_test.hpp: how it runs
 
 struct MetricInfo {
   std::string name, unit, description;

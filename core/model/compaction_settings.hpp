@@ -1,6 +1,6 @@
 #pragma once
 // The settings of the compaction lab test as a campaign names them, and its catalogue entry:
-// metadata the coordinator validates with, no physics (the runner: core/lab/compaction.hpp).
+// metadata the coordinator validates with, no physics (the runner: core/lab/compaction.cpp).
 #include <array>
 #include <cstddef>
 #include <string>
@@ -55,5 +55,37 @@ struct CompactionSettings {
 };
 
 LabTestInfo compaction_info();  ///< in catalog.cpp
+
+/// The compaction lab test (seed 004 §2.3-2.4, §3.1): its catalogue entry here, its runner in
+/// core/lab/compaction.cpp.
+struct CompactionTest {
+  static LabTestInfo info() {
+    return {
+        "compaction",
+        "fully periodic cell filled at random and compacted by shrinking it affinely through "
+        "target solid fractions, held at each; contact stress tensor (Love-Weber), "
+        "pressure-density curve, a constant-volume shear probe from the last, and yield probes "
+        "along five strain paths from an unloaded reference state with the modified Cam-clay "
+        "ellipse fitted to their yield points",
+        "seed 004 §2.3-2.4, §3.1",
+        {{"jamming_fraction", "-",
+          "solid fraction at which the contact pressure of the compression first exceeds 1e-2 of "
+          "the final held pressure"},
+         {"final_pressure", "kPa", "mean contact stress p = tr(sigma) / 3 held at phi_max"},
+         {"final_coordination_number", "-", "contacts per body at phi_max"},
+         {"peak_stress_ratio", "-",
+          "yield: the largest q / p of the constant-volume axisymmetric shear probe from "
+          "phi_max"},
+         {"steady_stress_ratio", "-", "mean q / p over the last fifth of the probe"},
+         {"isotropic_yield_pressure", "kPa",
+          "p at yield of the isotropic reload from the reference state (seed 004 eq. 2.11)"},
+         {"yield_cap_pressure", "kPa",
+          "p_c of the modified Cam-clay ellipse q^2 = M^2 p (p_c - p) fitted to the yield points"},
+         {"yield_slope", "-", "M of that ellipse: the critical state stress ratio q / p"}},
+        settings_docs<CompactionSettings>()};
+  }
+  static LabOutput run(const MaterialModel& material, const Settings& settings,
+                       const RunOptions& options);
+};
 
 }  // namespace demcal::lab

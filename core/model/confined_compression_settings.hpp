@@ -1,7 +1,7 @@
 #pragma once
 // The settings of the confined_compression lab test as a campaign names them, and its catalogue
 // entry: metadata the coordinator validates with, no physics (the runner:
-// core/lab/confined_compression.hpp).
+// core/lab/confined_compression.cpp).
 #include <array>
 #include <cstddef>
 #include <string>
@@ -39,5 +39,31 @@ struct ConfinedCompressionSettings : PistonServoSettings {
 };
 
 LabTestInfo confined_compression_info();  ///< in catalog.cpp
+
+/// The confined_compression lab test (seed 000 §2.7.2, eq. 31-33; seed 001 §3.2.1, eq. 19): its
+/// catalogue entry here, its runner in core/lab/confined_compression.cpp.
+struct ConfinedCompressionTest {
+  static LabTestInfo info() {
+    return {
+        "confined_compression",
+        "bed in a cylindrical die loaded by a stress-servo piston to 15 kPa, unloaded to 0.5 kPa "
+        "and reloaded five times, then unloaded",
+        "seed 000 §2.7.2 (eq. 31-33); seed 001 §3.2.1 (eq. 19)",
+        {{"compressibility", "%", "(h0 - h1) / h0 at the first load (seed 000 eq. 31)"},
+         {"k_load", "MPa",
+          "mean reload bulk stiffness (sigma_max - sigma_min) h1 / (h_unloaded - h_loaded) "
+          "(seed 000 eq. 32)"},
+         {"k_unload", "MPa",
+          "mean unload bulk stiffness (sigma_max - sigma_min) h1 / (h_unloaded - h_loaded_before) "
+          "(seed 000 eq. 33)"},
+         {"final_solid_fraction", "-", "solid fraction after the final unload"},
+         {"confined_modulus", "MPa",
+          "E' = (sigma_max - sigma_min) / (eps_max - eps_min) of the last cycle, eps = "
+          "(h0 - h) / h0 (seed 001 eq. 19)"}},
+        settings_docs<ConfinedCompressionSettings>()};
+  }
+  static LabOutput run(const MaterialModel& material, const Settings& settings,
+                       const RunOptions& options);
+};
 
 }  // namespace demcal::lab

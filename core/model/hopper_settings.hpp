@@ -1,6 +1,6 @@
 #pragma once
 // The settings of the hopper lab test as a campaign names them, and its catalogue entry: metadata
-// the coordinator validates with, no physics (the runner: core/lab/hopper.hpp).
+// the coordinator validates with, no physics (the runner: core/lab/hopper.cpp).
 #include <array>
 #include <cstddef>
 #include <string>
@@ -39,5 +39,27 @@ struct HopperSettings {
 };
 
 LabTestInfo hopper_info();  ///< in catalog.cpp
+
+/// The hopper lab test (seed 000 §2.7.6): its catalogue entry here, its runner in
+/// core/lab/hopper.cpp.
+struct HopperTest {
+  static LabTestInfo info() {
+    return {
+        "hopper",
+        "wedge hopper slice with periodic front and back: fill and settle with the gate closed, "
+        "open it, discharge rate from the mass-time curve, arching, ratio to Beverloo's slot "
+        "law (hydraulic-diameter form) W = (4 sqrt 2 / pi) C rho_b sqrt(g) L (b - k d)^1.5 with "
+        "C = 0.58, k = 1.5, times Rose and Tanaka's factor (tan theta tan 45 deg)^-0.35 for walls "
+        "steeper than 45 deg",
+        "seed 000 §2.7.6",
+        {{"discharge_rate", "kg/s", "slope of the discharged mass over time after start-up"},
+         {"arched", "0/1", "1 when no particle left for arch_time before the hopper emptied"},
+         {"beverloo_rate", "kg/s", "Beverloo's slot-form rate with the wall factor"},
+         {"beverloo_ratio", "-", "discharge_rate over beverloo_rate"}},
+        settings_docs<HopperSettings>()};
+  }
+  static LabOutput run(const MaterialModel& material, const Settings& settings,
+                       const RunOptions& options);
+};
 
 }  // namespace demcal::lab

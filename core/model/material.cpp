@@ -176,15 +176,17 @@ ParameterInfo require_parameter(const MaterialModel& model, const std::string& p
       where, "'" + path + "' is not a parameter of this material model (known: " + known + ")");
 }
 
-void check_parameter_value(const MaterialModel& model, const std::string& path, double value,
-                           const std::string& where) {
-  MaterialModel copy = model;
-  try {
-    set_parameter(copy, path, value);
-    copy.validate();
-  } catch (const InputError& e) {
-    throw InputError(where, e.what());
+MaterialModel with_parameters(MaterialModel model, const std::vector<ParameterValue>& values) {
+  for (const auto& v : values) {
+    require_parameter(model, v.path, v.where);
+    try {
+      set_parameter(model, v.path, v.value);
+      model.validate();
+    } catch (const InputError& e) {
+      throw InputError(v.where, e.what());
+    }
   }
+  return model;
 }
 
 void set_parameter(MaterialModel& model, const std::string& path, double value) {

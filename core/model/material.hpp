@@ -68,12 +68,19 @@ bool has_parameter(const MaterialModel& model, const std::string& path);
 /// paths when the model has none there.
 ParameterInfo require_parameter(const MaterialModel& model, const std::string& path,
                                 const std::string& where);
-/// Checks that the model with `value` at `path` is valid as a whole (the model itself is not
-/// changed); InputError naming `where`.
-void check_parameter_value(const MaterialModel& model, const std::string& path, double value,
-                           const std::string& where);
 /// Sets one parameter by path; throws InputError naming the path if unknown or out of range.
 void set_parameter(MaterialModel& model, const std::string& path, double value);
+
+/// A value for a parameter path and the field of the request it came from.
+struct ParameterValue {
+  std::string path;
+  double value = 0.0;
+  std::string where;  ///< the field an error names (e.g. "spec.fixed.density")
+};
+/// The model with every value set, in one call: each path must be a parameter of the model,
+/// each value in its range and the model valid as a whole; otherwise InputError naming the
+/// first wrong value's `where`. The given model is not changed.
+MaterialModel with_parameters(MaterialModel model, const std::vector<ParameterValue>& values);
 double get_parameter(const MaterialModel& model, const std::string& path);
 
 }  // namespace demcal::lab

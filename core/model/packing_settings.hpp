@@ -1,6 +1,6 @@
 #pragma once
 // The settings of the packing lab test as a campaign names them, and its catalogue entry: metadata
-// the coordinator validates with, no physics (the runner: core/lab/packing.hpp).
+// the coordinator validates with, no physics (the runner: core/lab/packing.cpp).
 #include <array>
 #include <cstddef>
 #include <string>
@@ -33,5 +33,24 @@ struct PackingSettings {
 };
 
 LabTestInfo packing_info();  ///< in catalog.cpp
+
+/// The packing lab test (seed 000 §2.7.1, §3.1): its catalogue entry here, its runner in
+/// core/lab/packing.cpp.
+struct PackingTest {
+  static LabTestInfo info() {
+    return {
+        "packing",
+        "bed built in a cylindrical die by the material's preparation and settled; solid fraction "
+        "and coordination number in a sampling volume away from the walls",
+        "seed 000 §2.7.1, §3.1",
+        {{"solid_fraction", "-", "solid volume over sampling volume"},
+         {"coordination_number", "-",
+          "mean number of touching particles (clumps: bodies) per particle in the sampling "
+          "volume"}},
+        settings_docs<PackingSettings>()};
+  }
+  static LabOutput run(const MaterialModel& material, const Settings& settings,
+                       const RunOptions& options);
+};
 
 }  // namespace demcal::lab

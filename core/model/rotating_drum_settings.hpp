@@ -1,6 +1,6 @@
 #pragma once
 // The settings of the rotating_drum lab test as a campaign names them, and its catalogue entry:
-// metadata the coordinator validates with, no physics (the runner: core/lab/rotating_drum.hpp).
+// metadata the coordinator validates with, no physics (the runner: core/lab/rotating_drum.cpp).
 #include <array>
 #include <cstddef>
 #include <string>
@@ -80,5 +80,30 @@ DrumBed drum_bed(const RotatingDrumSettings& s, const particles::SizeDistributio
 std::string drum_rpm_label(double rpm);
 
 LabTestInfo rotating_drum_info();  ///< in catalog.cpp
+
+/// The rotating_drum lab test (seed 001 §3.2.2-3.2.3, eq. 20): its catalogue entry here, its runner
+/// in core/lab/rotating_drum.cpp.
+struct RotatingDrumTest {
+  static LabTestInfo info() {
+    return {
+        "rotating_drum",
+        "drum of D x W mm (100 x 44 in the seed), fill 43 %: the particle count follows from "
+        "the drum, the fill and the simulated sizes; dynamic angle of repose at `rpm` (4) from "
+        "a line fitted to the projected free surface, and the area method at 4, 40, 80, 105 and "
+        "116 rpm from a raster of the projected bed; also reports drum_diameter_ratio D/d and "
+        "particles",
+        "seed 001 §3.2.2-3.2.3 (eq. 20, Fig. 13)",
+        {{"dynamic_angle_of_repose", "deg", "free-surface angle at `rpm` (image fit)"},
+         {"csa_occupied_4", "%", "occupied cross-sectional area at 4 rpm (eq. 20)"},
+         {"csa_occupied_40", "%", "occupied cross-sectional area at 40 rpm (eq. 20)"},
+         {"csa_occupied_80", "%", "occupied cross-sectional area at 80 rpm (eq. 20)"},
+         {"csa_occupied_105", "%", "occupied cross-sectional area at 105 rpm (eq. 20)"},
+         {"csa_occupied_116", "%", "occupied cross-sectional area at 116 rpm (eq. 20)"},
+         {"centrifuging_116", "0/1", "1 when the bed centrifuges at 116 rpm"}},
+        settings_docs<RotatingDrumSettings>()};
+  }
+  static LabOutput run(const MaterialModel& material, const Settings& settings,
+                       const RunOptions& options);
+};
 
 }  // namespace demcal::lab

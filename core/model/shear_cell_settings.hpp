@@ -1,6 +1,6 @@
 #pragma once
 // The settings of the shear_cell lab test as a campaign names them, and its catalogue entry:
-// metadata the coordinator validates with, no physics (the runner: core/lab/shear_cell.hpp).
+// metadata the coordinator validates with, no physics (the runner: core/lab/shear_cell.cpp).
 #include <array>
 #include <cstddef>
 #include <string>
@@ -64,5 +64,34 @@ struct ShearCellSettings {
 };
 
 LabTestInfo shear_cell_info();  ///< in catalog.cpp
+
+/// The shear_cell lab test (seed 000 §2.7.4, Table 3, Fig. 12 and 23): its catalogue entry here,
+/// its runner in core/lab/shear_cell.cpp.
+struct ShearCellTest {
+  static LabTestInfo info() {
+    return {
+        "shear_cell",
+        "FT4 standard shear test: vaned shear head (mesh) in a cylindrical vessel, normal stress "
+        "applied by the container; pre-shear at 3 kPa, then yield under torque control at 2, "
+        "1.75, 1.5, 1.25 and 1 kPa, each from the pre-sheared state; tau = 3 T / (2 pi R^3)",
+        "seed 000 §2.7.4 (Table 3, Fig. 12, Fig. 23)",
+        {{"pre_shear_stress", "kPa", "steady shear stress of the pre-shear at sigma_pre = 3 kPa"},
+         {"yield_locus_slope", "-", "slope of the least-squares yield locus"},
+         {"yield_locus_intercept", "kPa", "intercept (cohesion) of the yield locus"},
+         {"ffc", "-",
+          "flow function sigma_1 / sigma_c from the Mohr circles, at most 100 (100 without "
+          "cohesion, 0 if inconsistent)"},
+         {"effective_friction_angle", "deg",
+          "angle of the origin line touching the consolidation circle (0 if inconsistent)"},
+         {"mohr_consistent", "0/1",
+          "0 when the pre-shear point lies above the yield locus (seed 000 Fig. 23b)"},
+         {"unconfined_yield_strength", "kPa", "sigma_c of the Mohr circle through the origin"},
+         {"major_consolidation_stress", "kPa",
+          "sigma_1 of the circle through the pre-shear point touching the locus"}},
+        settings_docs<ShearCellSettings>()};
+  }
+  static LabOutput run(const MaterialModel& material, const Settings& settings,
+                       const RunOptions& options);
+};
 
 }  // namespace demcal::lab

@@ -1,6 +1,6 @@
 #pragma once
 // The settings of the tensile lab test as a campaign names them, and its catalogue entry: metadata
-// the coordinator validates with, no physics (the runner: core/lab/tensile.hpp).
+// the coordinator validates with, no physics (the runner: core/lab/tensile.cpp).
 #include <array>
 #include <cstddef>
 #include <string>
@@ -51,5 +51,22 @@ double wall_hamaker_ratio_eq34(double r_real_um);
 double wall_k2_ratio_eq35(double r_real_um);
 
 LabTestInfo tensile_info();  ///< in catalog.cpp
+
+/// The tensile lab test (seed 000 §2.7.3, eq. 34-35): its catalogue entry here, its runner in
+/// core/lab/tensile.cpp.
+struct TensileTest {
+  static LabTestInfo info() {
+    return {"tensile",
+            "bed consolidated in the die by an adhesive piston (eq. 34-35), unloaded, and pulled "
+            "apart at constant slow speed inside a frictionless non-cohesive die wall",
+            "seed 000 §2.7.3 (eq. 34-35, Fig. 10-11)",
+            {{"tensile_strength", "kPa",
+              "peak tensile stress on the piston less the weight of the powder stuck to it, over "
+              "the piston area"}},
+            settings_docs<TensileSettings>()};
+  }
+  static LabOutput run(const MaterialModel& material, const Settings& settings,
+                       const RunOptions& options);
+};
 
 }  // namespace demcal::lab

@@ -1,6 +1,6 @@
 #pragma once
 // The settings of the wall_friction lab test as a campaign names them, and its catalogue entry:
-// metadata the coordinator validates with, no physics (the runner: core/lab/wall_friction.hpp).
+// metadata the coordinator validates with, no physics (the runner: core/lab/wall_friction.cpp).
 #include <array>
 #include <cstddef>
 #include <string>
@@ -57,5 +57,22 @@ double two_point_calibration(double mu_a, double phi_a, double mu_b, double phi_
                              double phi_target);
 
 LabTestInfo wall_friction_info();  ///< in catalog.cpp
+
+/// The wall_friction lab test (seed 000 §2.7.5, §3.3.4): its catalogue entry here, its runner in
+/// core/lab/wall_friction.cpp.
+struct WallFrictionTest {
+  static LabTestInfo info() {
+    return {"wall_friction",
+            "bed pressed by the container against a piston that turns at constant normal stress "
+            "(1, 1.25, 1.5, 1.75, 2, 3 kPa); tau = 3 T / (2 pi R^3); regression through the origin",
+            "seed 000 §2.7.5, §3.3.4",
+            {{"wall_friction_angle", "deg",
+              "atan of the slope of the wall shear stress over the normal stress, fitted through "
+              "the origin"}},
+            settings_docs<WallFrictionSettings>()};
+  }
+  static LabOutput run(const MaterialModel& material, const Settings& settings,
+                       const RunOptions& options);
+};
 
 }  // namespace demcal::lab

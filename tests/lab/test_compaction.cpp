@@ -14,7 +14,7 @@
 #include <random>
 
 #include "core/contact/contact_law.hpp"
-#include "core/lab/compaction.hpp"
+#include "core/lab/lab_test.hpp"
 #include "core/metrics/stress.hpp"
 #include "core/metrics/yield_surface.hpp"
 #include "core/sim/world.hpp"

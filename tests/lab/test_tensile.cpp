@@ -2,7 +2,8 @@
 // with kc/k1.
 #include <gtest/gtest.h>
 
-#include "core/lab/tensile.hpp"
+#include "core/lab/lab_test.hpp"
+#include "core/model/tensile_settings.hpp"
 #include "lab_test_util.hpp"
 
 namespace demcal::lab {

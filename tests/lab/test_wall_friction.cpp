@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <limits>
 
-#include "core/lab/wall_friction.hpp"
+#include "core/lab/lab_test.hpp"
+#include "core/lab/piston.hpp"
+#include "core/model/wall_friction_settings.hpp"
 #include "lab_test_util.hpp"
 
 namespace demcal::lab {
