@@ -123,6 +123,14 @@ std::vector<Plan> candidate_plans(const Problem& p) {
     plans.push_back(new_factor_plan(
         p, "shape", "particle shape: elongated rigid rods instead of spheres", {{"shape", "rod"}},
         {"shape.aspect_ratio", doe::Factor{"shape.aspect_ratio", 1.0, o.aspect_ratio_max}}, 1.0));
+  // Irregular clusters of overlapping spheres (lactose crystals are tomahawk-shaped, seed 000
+  // §2.1): their spread scales the centres' distances, and at 0 a cluster is its largest sphere,
+  // which runs as a sphere, so the base runs are the family's low end.
+  if (p.shape_kind == "sphere" && !has_factor(p, "shape.spread"))
+    plans.push_back(new_factor_plan(
+        p, "clusters",
+        "particle shape: irregular clusters of overlapping spheres instead of spheres",
+        {{"shape", "cluster"}}, {"shape.spread", doe::Factor{"shape.spread", 0.0, 1.0}}, 0.0));
   bool rolling_factor = false;
   for (const auto& f : p.factors) rolling_factor |= f.path.rfind("particle_law.rolling.", 0) == 0;
   if (p.rolling_model == "none" && !rolling_factor)
@@ -423,8 +431,8 @@ bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
   auto models = fit_targets(p, coded, y, plan.model);
   for (int round = 1; round <= p.options.rounds; ++round) {
     const Fitted fit = calibrate_targets(p, plan.factors, models);
-    VerifiedPoint point{natural_point(plan.factors, fit.result.natural), {},
-                        std::sqrt(fit.result.objective)};
+    VerifiedPoint point{
+        natural_point(plan.factors, fit.result.natural), {}, std::sqrt(fit.result.objective)};
     point.reaches_all = fit.reaches_all;
     requests.push_back({plan.id + "/verify", round, plan.switches, point.proposed});
     const auto* v = find_group(groups, plan.id + "/verify");

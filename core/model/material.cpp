@@ -121,7 +121,10 @@ double MaterialModel::simulated_density() const {
 
 std::optional<particles::ClumpTemplate> MaterialModel::clump_template() const {
   if (shape.kind == particles::ShapeKind::kSphere) return std::nullopt;
-  return particles::make_template(shape);
+  auto clump = particles::make_template(shape);
+  // A clump of one sphere (a cluster without spread) is a sphere, and runs as one.
+  if (clump.size() == 1) return std::nullopt;
+  return clump;
 }
 
 void MaterialModel::validate() const {

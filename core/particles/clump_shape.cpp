@@ -40,7 +40,7 @@ std::vector<std::string> shape_params(ShapeKind kind) {
     case ShapeKind::kHelix:
       return {"aspect_ratio", "offset_ratio", "revolutions", "spacing"};
     case ShapeKind::kCluster:
-      return {"spheres", "irregularity", "seed"};
+      return {"spheres", "irregularity", "seed", "spread"};
   }
   return {};
 }
@@ -159,6 +159,33 @@ MassProperties union_mass_properties(const std::vector<Vec3>& centres,
   return last;
 }
 
+namespace {
+
+/// Leaves out every sphere that lies inside another one (an earlier one of two equal ones is
+/// kept): it adds nothing to the union, and as a member it would only double the contacts of
+/// the sphere around it.
+void drop_enclosed(std::vector<Vec3>& centres, std::vector<double>& radii) {
+  const auto inside = [&](std::size_t k, std::size_t j) {
+    const double slack = 1e-12 * radii[j];
+    if (norm(centres[k] - centres[j]) + radii[k] > radii[j] + slack) return false;
+    const bool equal = norm(centres[k] - centres[j]) + radii[j] <= radii[k] + slack;
+    return !equal || j < k;
+  };
+  std::vector<Vec3> kept_centres;
+  std::vector<double> kept_radii;
+  for (std::size_t k = 0; k < centres.size(); ++k) {
+    bool enclosed = false;
+    for (std::size_t j = 0; j < centres.size() && !enclosed; ++j) enclosed = j != k && inside(k, j);
+    if (enclosed) continue;
+    kept_centres.push_back(centres[k]);
+    kept_radii.push_back(radii[k]);
+  }
+  centres = std::move(kept_centres);
+  radii = std::move(kept_radii);
+}
+
+}  // namespace
+
 void shape_spheres(const ShapeSpec& s, std::vector<Vec3>& centres, std::vector<double>& radii) {
   centres.clear();
   radii.clear();
@@ -181,6 +208,8 @@ void shape_spheres(const ShapeSpec& s, std::vector<Vec3>& centres, std::vector<d
       centres.push_back(centres[j] + d * random_direction(rng));
       radii.push_back(rk);
     }
+    for (auto& c : centres) c *= s.spread;
+    drop_enclosed(centres, radii);
     return;
   }
   // Rod and helix: equal spheres of radius 1 along x from -(AR - 1) to AR - 1, so the length is

@@ -26,25 +26,31 @@ struct ShapeSpec {
   double spheres = 4.0;       ///< cluster: number of spheres
   double irregularity = 0.5;  ///< cluster: 0 compact .. 1 spread and uneven radii
   double seed = 1.0;          ///< cluster: which random cluster
-  double spacing = 0.5;       ///< rod, helix: largest centre distance of neighbours / diameter
+  /// cluster: every centre's distance from the first sphere's, times this: 1 the cluster as
+  /// built, 0 all centres at one point (the cluster is then its largest sphere, a sphere)
+  double spread = 1.0;
+  double spacing = 0.5;  ///< rod, helix: largest centre distance of neighbours / diameter
 
-  static std::array<contact::ParamInfo<ShapeSpec>, 7> table() {
+  static std::array<contact::ParamInfo<ShapeSpec>, 8> table() {
     using S = ShapeSpec;
-    return {{{"aspect_ratio", "-", 1.0, 20.0, 2.0, "rod, helix: length / sphere diameter",
-              &S::aspect_ratio},
-             {"offset_ratio", "-", 0.0, 2.0, 0.267,
-              "helix: sphere centres' distance from the axis / diameter (seed 004 Table 2.1: "
-              "0.04 / 0.15)",
-              &S::offset_ratio},
-             {"revolutions", "-", 0.0, 10.0, 0.5, "helix: turns over the length (seed 004 eq. 2.1)",
-              &S::revolutions},
-             {"spheres", "-", 2.0, 50.0, 4.0, "cluster: number of spheres", &S::spheres},
-             {"irregularity", "-", 0.0, 1.0, 0.5,
-              "cluster: 0 compact, equal spheres .. 1 spread, uneven radii", &S::irregularity},
-             {"seed", "-", 1.0, 1e9, 1.0, "cluster: which random cluster", &S::seed},
-             {"spacing", "-", 0.05, 1.0, 0.5,
-              "rod, helix: largest distance of neighbouring centres / diameter (overlap)",
-              &S::spacing}}};
+    return {
+        {{"aspect_ratio", "-", 1.0, 20.0, 2.0, "rod, helix: length / sphere diameter",
+          &S::aspect_ratio},
+         {"offset_ratio", "-", 0.0, 2.0, 0.267,
+          "helix: sphere centres' distance from the axis / diameter (seed 004 Table 2.1: "
+          "0.04 / 0.15)",
+          &S::offset_ratio},
+         {"revolutions", "-", 0.0, 10.0, 0.5, "helix: turns over the length (seed 004 eq. 2.1)",
+          &S::revolutions},
+         {"spheres", "-", 2.0, 50.0, 4.0, "cluster: number of spheres", &S::spheres},
+         {"irregularity", "-", 0.0, 1.0, 0.5,
+          "cluster: 0 compact, equal spheres .. 1 spread, uneven radii", &S::irregularity},
+         {"seed", "-", 1.0, 1e9, 1.0, "cluster: which random cluster", &S::seed},
+         {"spread", "-", 0.0, 1.0, 1.0,
+          "cluster: centre distances from the first sphere times this (0: one sphere)", &S::spread},
+         {"spacing", "-", 0.05, 1.0, 0.5,
+          "rod, helix: largest distance of neighbouring centres / diameter (overlap)",
+          &S::spacing}}};
   }
   void finalize(const std::string&) {}
 };

@@ -76,5 +76,27 @@ TEST(ClumpPacking, HelicesAndClustersPack) {
   }
 }
 
+// The cluster family contains the sphere: without spread a cluster is its largest sphere and runs
+// as one, to the bit; spread out, the irregular clusters pack denser with more contacts.
+TEST(ClumpPacking, ClusterWithoutSpreadIsTheSphereAndSpreadChangesThePacking) {
+  const Settings s{{"particles", 120}};
+  auto clusters = [](double spread) {
+    MaterialModel m = testing::soft_luding();
+    m.shape = particles::make_shape_spec("cluster", {{"spread", spread}}, "shape");
+    return m;
+  };
+  const auto spheres = run_lab_test("packing", testing::soft_luding(), s, {});
+  const auto point = run_lab_test("packing", clusters(0.0), s, {});
+  const auto spread = run_lab_test("packing", clusters(1.0), s, {});
+  for (const char* metric : {"solid_fraction", "coordination_number"})
+    EXPECT_EQ(point.metrics.at(metric), spheres.metrics.at(metric)) << metric;
+  // Slightly non-spherical particles jam denser and with more contacts than spheres (Donev et
+  // al., Science 303 (2004) 990, for ellipsoids); measured with seed 1: 0.586 and 5.44 against
+  // 0.548 and 4.53.
+  EXPECT_GT(spread.metrics.at("solid_fraction"), spheres.metrics.at("solid_fraction") + 0.015);
+  EXPECT_GT(spread.metrics.at("coordination_number"),
+            spheres.metrics.at("coordination_number") + 0.4);
+}
+
 }  // namespace
 }  // namespace demcal::lab

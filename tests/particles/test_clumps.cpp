@@ -200,6 +200,49 @@ TEST(ParticlesClumps, ClusterTemplateIsDeterministicPerSeedAndConnected) {
   }
 }
 
+TEST(ParticlesClumps, ClusterSpreadShrinksItToItsLargestSphere) {
+  const std::map<std::string, double> base{{"spheres", 5.0}, {"irregularity", 0.6}, {"seed", 3}};
+  auto at = [&](double spread) {
+    auto params = base;
+    params["spread"] = spread;
+    std::vector<Vec3> centres;
+    std::vector<double> radii;
+    shape_spheres(spec("cluster", params), centres, radii);
+    return std::make_pair(centres, radii);
+  };
+  // Spread 1 is the cluster as built; 0 puts every centre at the first sphere's, which (radius
+  // 1, the largest) encloses the others: one sphere is left, and the template is a unit sphere.
+  const auto [built, built_radii] = at(1.0);
+  std::vector<Vec3> unspread;
+  std::vector<double> unspread_radii;
+  shape_spheres(spec("cluster", base), unspread, unspread_radii);
+  ASSERT_EQ(built.size(), 5u);
+  for (std::size_t k = 0; k < built.size(); ++k) EXPECT_EQ(norm(built[k] - unspread[k]), 0.0);
+  const auto [point, point_radii] = at(0.0);
+  ASSERT_EQ(point.size(), 1u);
+  EXPECT_EQ(point_radii[0], 1.0);
+  const auto sphere = make_template(spec("cluster", {{"spread", 0.0}}));
+  ASSERT_EQ(sphere.size(), 1u);
+  expect_rel(sphere.radii[0], 1.0, 1e-5, "radius");  // the union's volume is integrated to 2e-5
+  expect_rel(sphere.volume, kSphereVolume, 1e-9, "volume");
+  // Between, a sphere is left out exactly when another one encloses it: the count of members
+  // falls with the spread, through values between 5 and 1, and no kept sphere is enclosed.
+  std::size_t last = 5;
+  bool between = false;
+  for (int step = 50; step >= 0; --step) {
+    const double spread = step / 50.0;
+    const auto [near, near_radii] = at(spread);
+    EXPECT_LE(near.size(), last) << spread;
+    last = near.size();
+    between |= near.size() > 1 && near.size() < 5;
+    for (std::size_t k = 0; k < near.size(); ++k)
+      for (std::size_t j = 0; j < near.size(); ++j)
+        if (j != k) EXPECT_GT(norm(near[k] - near[j]) + near_radii[k], near_radii[j]) << k << j;
+  }
+  EXPECT_TRUE(between);
+  EXPECT_EQ(last, 1u);
+}
+
 TEST(ParticlesClumps, ShapeSpecErrorsNameTheParameter) {
   try {
     spec("rod", {{"spheres", 4.0}});
