@@ -125,8 +125,13 @@ std::vector<Plan> candidate_plans(const Problem& p) {
         {"shape.aspect_ratio", doe::Factor{"shape.aspect_ratio", 1.0, o.aspect_ratio_max}}, 1.0));
   // Irregular clusters of overlapping spheres (lactose crystals are tomahawk-shaped, seed 000
   // §2.1): their spread scales the centres' distances, and at 0 a cluster is its largest sphere,
-  // which runs as a sphere, so the base runs are the family's low end.
-  if (p.shape_kind == "sphere" && !has_factor(p, "shape.spread"))
+  // which runs as a sphere, so the base runs are the family's low end. Only when asked for: on
+  // packing data alone they fit the data of other causes as well as those causes do
+  // (docs/diagnosis.md), so by default they would name a shape the data cannot tell apart.
+  const bool asked = [&](const std::string& id) {
+    return std::find(o.candidates.begin(), o.candidates.end(), id) != o.candidates.end();
+  }("clusters");
+  if (asked && p.shape_kind == "sphere" && !has_factor(p, "shape.spread"))
     plans.push_back(new_factor_plan(
         p, "clusters",
         "particle shape: irregular clusters of overlapping spheres instead of spheres",

@@ -324,9 +324,12 @@ TEST(Diagnosis, AliasedInteractionIsNamedAndCutsTheVerifiedError) {
 /// cuts the verified error by at least 30 %; the report, for more checks.
 Report expect_hidden_cause_found(const Simulator& sim, const Parameters& truth,
                                  const Switches& switches, const std::string& cause,
-                                 const std::string& path, double tolerance) {
+                                 const std::string& path, double tolerance,
+                                 const std::vector<std::string>& candidates = {}) {
   const auto ms = targets_at(sim(truth, switches), {kSf, kCn});
-  const Driven d = drive(make_problem(sim, {kSf, kCn}, ms), sim);
+  Problem p = make_problem(sim, {kSf, kCn}, ms);
+  p.options.candidates = candidates;
+  const Driven d = drive(p, sim);
   const Report& r = d.step.report;
   EXPECT_EQ(r.state, "done");
   EXPECT_EQ(r.named_cause, cause) << r.conclusion;
@@ -400,7 +403,8 @@ TEST(Diagnosis, HiddenClusterShapeIsNamedAndItsSpreadRecovered) {
   auto truth_point = natural_point(-0.3, 0.2, 0.4);
   truth_point[kSpread] = 0.6;
   const Report r = expect_hidden_cause_found(shape_truth, truth_point, {{"shape", "cluster"}},
-                                             "clusters", kSpread, 0.06);
+                                             "clusters", kSpread, 0.06,
+                                             {"shape", "clusters", "rolling", "size_distribution"});
   const CandidateOutcome* rods = candidate(r, "shape");
   ASSERT_NE(rods, nullptr);
   EXPECT_GT(rods->verified_rms, 2.0 * candidate(r, "clusters")->verified_rms);
@@ -525,13 +529,8 @@ TEST(Diagnosis, FirstCallRequestsTheBaselineAndEveryCandidatesDesign) {
               0.5 * (1.0 + p.options.aspect_ratio_max), 1e-12);
   expect_base_factors_at(shape[4], 0.0, 0.0, 0.0);
 
-  // clusters: the same as clusters of the largest spread (1), and the middle run (0.5).
-  const auto clusters = of_group(s.requests, "clusters");
-  ASSERT_EQ(clusters.size(), 5u);
-  EXPECT_EQ(clusters[0].switches, (Switches{{"shape", "cluster"}}));
-  EXPECT_DOUBLE_EQ(clusters[0].parameters.at(kSpread), 1.0);
-  EXPECT_DOUBLE_EQ(clusters[4].parameters.at(kSpread), 0.5);
-  expect_base_factors_at(clusters[1], d(1, 0), d(1, 1), d(1, 2));
+  // clusters: only when asked for (below).
+  EXPECT_TRUE(of_group(s.requests, "clusters").empty());
 
   // rolling: the same with the CDT switch at mu_r = rolling_max, and the middle run.
   const auto rolling = of_group(s.requests, "rolling");
@@ -569,7 +568,21 @@ TEST(Diagnosis, FirstCallRequestsTheBaselineAndEveryCandidatesDesign) {
       expect_base_factors_at(axial[std::size_t(2 * f + side)], x[0], x[1], x[2]);
     }
 
-  EXPECT_EQ(s.requests.size(), 1u + 5u + 5u + 5u + 5u + 6u + 4u);
+  EXPECT_EQ(s.requests.size(), 1u + 5u + 5u + 5u + 6u + 4u);
+
+  // Asked for, clusters: the factorial runs as clusters of the largest spread (1), and the
+  // middle run (0.5) at the design centre.
+  Problem asked = p;
+  asked.options.candidates = {"clusters"};
+  const auto clusters = of_group(diagnose::advance(asked, {}).requests, "clusters");
+  ASSERT_EQ(clusters.size(), 5u);
+  EXPECT_EQ(clusters[0].switches, (Switches{{"shape", "cluster"}}));
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_DOUBLE_EQ(clusters[i].parameters.at(kSpread), 1.0);
+    expect_base_factors_at(clusters[i], d(i, 0), d(i, 1), d(i, 2));
+  }
+  EXPECT_DOUBLE_EQ(clusters[4].parameters.at(kSpread), 0.5);
+  expect_base_factors_at(clusters[4], 0.0, 0.0, 0.0);
 }
 
 // --- e) inputs that cannot be diagnosed -----------------------------------------------------
