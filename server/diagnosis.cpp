@@ -154,6 +154,7 @@ v1::DiagnosisReport report_message(const diagnose::Report& r) {
   v1::DiagnosisReport out;
   out.set_state(r.state);
   out.set_named_cause(r.named_cause);
+  for (const auto& id : r.rivals) out.add_rivals(id);
   out.set_conclusion(r.conclusion);
   for (const auto& m : r.metrics) *out.add_metrics() = metric_message(m);
   auto* b = out.mutable_baseline();

@@ -586,6 +586,19 @@ void name_cause(const Problem& p, bool all_verified, Report& rep) {
   } else if (named) {
     rep.named_cause = named->id;
     rep.conclusion = why + "; named cause: " + named->cause + " (" + named->evidence + ")";
+    // A rival verifies within the margin of the named cause's error, or both within the
+    // convergence tolerance, where differences are the simulations' noise.
+    const double close =
+        std::max(named->verified_rms / (1.0 - p.options.margin), p.options.converged);
+    std::string rivals;
+    for (const auto& c : rep.candidates)
+      if (&c != named && c.explains && c.verified_rms < close) {
+        rep.rivals.push_back(c.id);
+        rivals += (rivals.empty() ? "" : ", ") + c.id + " " + percent(c.verified_rms);
+      }
+    if (!rivals.empty())
+      rep.conclusion += "; not told apart from it by these data, within the margin of its " +
+                        percent(named->verified_rms) + ": " + rivals;
   } else {
     rep.conclusion = "no candidate cuts the verified error (" + percent(rep.baseline_verified_rms) +
                      ") by " + percent(p.options.margin) + " or more: none is named";

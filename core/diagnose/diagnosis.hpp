@@ -165,6 +165,10 @@ struct Report {
   std::vector<Conflict> conflicts;
   std::vector<CandidateOutcome> candidates;  ///< ranked once verified (best first)
   std::string named_cause;                   ///< candidate id, empty when none is named
+  /// Other candidates that explain the misfit with a verified error within the margin of the
+  /// named cause's (below its error / (1 - margin), or both below `converged`): the data do not
+  /// tell them apart from it.
+  std::vector<std::string> rivals;
   std::string conclusion;                    ///< plain words
 };
 

@@ -12,6 +12,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -215,6 +216,18 @@ Responses shape_truth(const Parameters& p, const Switches& s) {
           {kCn, 5.0 + 0.5 * l + 0.8 * rod + 0.3 * spread}};
 }
 
+/// Rolling resistance and a width of sizes that act alike on both metrics (a sigma_g - 1 of
+/// 0.6 mu_r does what mu_r does): data of either are fitted by both.
+Responses twin_truth(const Parameters& p, const Switches& s) {
+  const auto [a, b, c] = coded_point(p);
+  const auto rolling = s.find("particle_law.rolling");
+  const auto sizes = s.find("sizes");
+  const double hidden = (rolling != s.end() ? p.at(kMuR) : 0.0) +
+                        (sizes != s.end() ? (p.at(kSigmaG) - 1.0) / 0.6 : 0.0);
+  const double l = a + 0.5 * b + 0.3 * c;
+  return {{kSf, 0.60 - 0.02 * l - 0.25 * hidden}, {kCn, 5.0 + 0.5 * l - 6.0 * hidden}};
+}
+
 std::vector<Measurement> targets_at(const Responses& y, const std::vector<std::string>& which) {
   std::vector<Measurement> out;
   for (const auto& r : which) {
@@ -408,6 +421,29 @@ TEST(Diagnosis, HiddenClusterShapeIsNamedAndItsSpreadRecovered) {
   const CandidateOutcome* rods = candidate(r, "shape");
   ASSERT_NE(rods, nullptr);
   EXPECT_GT(rods->verified_rms, 2.0 * candidate(r, "clusters")->verified_rms);
+  EXPECT_TRUE(r.rivals.empty()) << r.conclusion;
+}
+
+TEST(Diagnosis, CandidatesTheDataCannotTellApartAreNamedAsRivals) {
+  auto truth_point = natural_point(0.2, -0.3, 0.1);
+  truth_point[kMuR] = 0.2;
+  const auto ms =
+      targets_at(twin_truth(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  Problem p = make_problem(twin_truth, {kSf, kCn}, ms);
+  p.options.candidates = {"rolling", "size_distribution", "shape"};
+  const Report r = drive(p, twin_truth).step.report;
+  ASSERT_EQ(r.state, "done");
+  const std::set<std::string> twins{"rolling", "size_distribution"};
+  ASSERT_TRUE(twins.count(r.named_cause)) << r.conclusion;
+  const std::string other = r.named_cause == "rolling" ? "size_distribution" : "rolling";
+  EXPECT_EQ(r.rivals, std::vector<std::string>{other}) << r.conclusion;
+  EXPECT_NE(r.conclusion.find("not told apart"), std::string::npos) << r.conclusion;
+  // A cause the other candidates do not reach has no rival.
+  auto rolling_point = truth_point;
+  const Report alone =
+      expect_hidden_cause_found(rolling_truth, rolling_point, {{"particle_law.rolling", "cdt"}},
+                                "rolling", kMuR, 0.1 * kTrueMuR);
+  EXPECT_TRUE(alone.rivals.empty()) << alone.conclusion;
 }
 
 TEST(Diagnosis, HiddenSizeDistributionIsNamedAndItsWidthRecovered) {
