@@ -10,6 +10,7 @@
 #include "client/commands.hpp"
 #include "client/liggghts_fragment.hpp"
 #include "client/service_client.hpp"
+#include "rpc/material_convert.hpp"
 
 namespace demcal::cli {
 namespace {
@@ -26,10 +27,10 @@ std::string liggghts_export(v1::CampaignService::Stub& stub, const rpc::ChannelO
   req.set_id(id);
   v1::CalibrateReply cal;
   check(stub.Calibrate(rpc::make_context(channel, 300).get(), req, &cal), "calibrate");
-  std::map<std::string, double> parameters(campaign.spec().fixed().begin(),
-                                           campaign.spec().fixed().end());
+  std::map<std::string, double> proposed;
   for (int i = 0; i < cal.factor_paths_size(); ++i)
-    parameters[cal.factor_paths(i)] = cal.proposed_values(i);
+    proposed[cal.factor_paths(i)] = cal.proposed_values(i);
+  const auto parameters = rpc::run_parameters(campaign.spec(), proposed);
   const std::string title =
       "demcal campaign " + std::to_string(id) + " '" + campaign.name() + "': the calibrated set (" +
       (cal.conclusion().empty() ? cal.verification_state() : cal.conclusion()) + ")";

@@ -109,4 +109,14 @@ lab::Settings to_settings(const google::protobuf::Map<std::string, double>& sett
   return lab::Settings(settings.begin(), settings.end());
 }
 
+std::map<std::string, double> run_parameters(const v1::CampaignSpec& spec,
+                                             const std::map<std::string, double>& factors) {
+  std::map<std::string, double> out(spec.fixed().begin(), spec.fixed().end());
+  for (const auto& [path, value] : factors) out[path] = value;
+  for (const auto& f : spec.factors())
+    if (const auto it = factors.find(f.path()); it != factors.end())
+      for (const auto& tied : f.tied()) out[tied] = it->second;
+  return out;
+}
+
 }  // namespace demcal::rpc

@@ -7,6 +7,7 @@
 
 #include "core/model/catalog.hpp"
 #include "core/model/material.hpp"
+#include "demcal/v1/campaign.pb.h"
 #include "demcal/v1/worker.pb.h"
 
 namespace demcal::rpc {
@@ -20,5 +21,10 @@ lab::MaterialModel to_material_model(const v1::Material& material, const std::st
 lab::MaterialModel job_material(const v1::JobSpec& job);
 
 lab::Settings to_settings(const google::protobuf::Map<std::string, double>& settings);
+
+/// The parameters a run of the campaign sets on its material for the given factor values (path
+/// to value): the spec's fixed values, the factors', and each factor's tied paths at its value.
+std::map<std::string, double> run_parameters(const v1::CampaignSpec& spec,
+                                             const std::map<std::string, double>& factors);
 
 }  // namespace demcal::rpc

@@ -82,8 +82,8 @@ v1::JobSpec instance_job(const v1::CampaignSpec& spec, const v1::LabTest& t,
   job.set_test(t.test());
   *job.mutable_settings() = t.settings();
   *job.mutable_material() = instance_material(material, t);
-  *job.mutable_parameters() = spec.fixed();
-  for (const auto& [path, value] : parameters) (*job.mutable_parameters())[path] = value;
+  for (const auto& [path, value] : rpc::run_parameters(spec, parameters))
+    (*job.mutable_parameters())[path] = value;
   job.set_seed(seed);
   job.set_threads(t.threads());
   return job;
@@ -201,6 +201,26 @@ void check_factor_bounds(const v1::Factor& f, const lab::ParameterInfo& info,
     throw InputError(where + ".low", "must be > 0 on a log scale");
 }
 
+/// A factor's tied paths: each a parameter of the material and of every instance, taking both
+/// of the factor's bounds, and set by nothing else (no factor, no fixed value, no other tie).
+void plan_tied(const v1::CampaignSpec& spec, const v1::Factor& f, const lab::MaterialModel& model,
+               const Instances& instances, const std::string& where, std::set<std::string>& seen) {
+  for (int i = 0; i < f.tied_size(); ++i) {
+    const std::string& path = f.tied(i);
+    const std::string at = where + "." + idx("tied", i);
+    lab::require_parameter(model, path, at);
+    const bool a_factor = std::any_of(spec.factors().begin(), spec.factors().end(),
+                                      [&](const v1::Factor& g) { return g.path() == path; });
+    if (a_factor || spec.fixed().count(path) || !seen.insert(path).second)
+      throw InputError(at, "'" + path + "' is set twice (a factor, a fixed value or another tie)");
+    lab::with_parameters(model, {{path, f.low(), at}, {path, f.high(), at}});
+    for (const auto& [name, instance] : instances)
+      if (!lab::has_parameter(instance, path))
+        throw InputError(at, "'" + path + "' is not a parameter of test '" + name +
+                                 "' (its own wall_law lacks it)");
+  }
+}
+
 void plan_factors(const v1::CampaignSpec& spec, const lab::MaterialModel& model,
                   const Instances& instances, CampaignPlan& plan) {
   if (spec.factors_size() == 0) throw InputError("spec.factors", "a campaign needs factors");
@@ -222,6 +242,7 @@ void plan_factors(const v1::CampaignSpec& spec, const lab::MaterialModel& model,
       if (!lab::has_parameter(instance, f.path()))
         throw InputError(where + ".path", "'" + f.path() + "' is not a parameter of test '" + name +
                                               "' (its own wall_law lacks it)");
+    plan_tied(spec, f, model, instances, where, seen);
     plan.factors.push_back(
         {f.path(),
          doe::Factor{f.name().empty() ? f.path() : f.name(), f.low(), f.high(),

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
@@ -144,6 +145,43 @@ TEST(TestInstances, BadInstancesAreRefusedNamingTheField) {
       ADD_FAILURE() << c.to << " accepted";
     } catch (const InputError& e) {
       EXPECT_EQ(std::string(e.what()).rfind(c.field, 0), 0u) << c.field << " vs " << e.what();
+    }
+  }
+}
+
+// Seed 001 §4.2 ties the granule-wall friction to the granule-granule one: a factor's `tied`
+// paths take its value in every job, and a tie that cannot hold is refused naming it.
+TEST(TestInstances, ATiedPathTakesItsFactorsValueInEveryJob) {
+  const std::string tie = "name: mu_s, tied: [wall_law.tangential.mu_s]}";
+  const auto file = cli::parse_campaign_spec(replaced(drums_spec(), "name: mu_s}", tie), "d.yaml");
+  ASSERT_EQ(file.spec.factors(0).tied_size(), 1);
+  std::vector<server::NewJob> jobs;
+  server::plan_campaign(file.spec, jobs);
+  ASSERT_EQ(jobs.size(), 8u);
+  std::set<double> values;
+  for (const auto& job : jobs) {
+    v1::JobSpec spec;
+    server::from_json(job.payload, spec);
+    const double mu = spec.parameters().at("particle_law.tangential.mu_s");
+    EXPECT_EQ(spec.parameters().at("wall_law.tangential.mu_s"), mu) << job.test;
+    values.insert(mu);
+  }
+  ASSERT_EQ(values.size(), 2u);  // the factor's two levels, 0.3 and 0.7
+  EXPECT_NEAR(*values.begin(), 0.3, 1e-12);
+  EXPECT_NEAR(*values.rbegin(), 0.7, 1e-12);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"tied: [wall_law.rolling.mu_r]", "spec.factors[0].tied[0]"},            // no rolling model
+      {"tied: [particle_law.normal.restitution]", "spec.factors[0].tied[0]"},  // a factor
+      {"tied: [wall_law.normal.youngs_modulus]", "spec.factors[0].tied[0]"},   // 0.3 Pa < 1 Pa
+  };
+  for (const auto& [to, field] : bad) {
+    const auto f = cli::parse_campaign_spec(
+        replaced(drums_spec(), "name: mu_s}", "name: mu_s, " + to + "}"), "d.yaml");
+    try {
+      server::plan_campaign(f.spec, jobs);
+      ADD_FAILURE() << to << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(field, 0), 0u) << field << " vs " << e.what();
     }
   }
 }
