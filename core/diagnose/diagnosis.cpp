@@ -128,10 +128,9 @@ std::vector<Plan> candidate_plans(const Problem& p) {
   // which runs as a sphere, so the base runs are the family's low end. Only when asked for: on
   // packing data alone they fit the data of other causes as well as those causes do
   // (docs/diagnosis.md), so by default they would name a shape the data cannot tell apart.
-  const bool asked = [&](const std::string& id) {
-    return std::find(o.candidates.begin(), o.candidates.end(), id) != o.candidates.end();
-  }("clusters");
-  if (asked && p.shape_kind == "sphere" && !has_factor(p, "shape.spread"))
+  const bool clusters_asked =
+      std::find(o.candidates.begin(), o.candidates.end(), "clusters") != o.candidates.end();
+  if (clusters_asked && p.shape_kind == "sphere" && !has_factor(p, "shape.spread"))
     plans.push_back(new_factor_plan(
         p, "clusters",
         "particle shape: irregular clusters of overlapping spheres instead of spheres",
