@@ -20,6 +20,9 @@ namespace {
 constexpr std::string_view kPrefix = "diagnose:";
 
 /// An option: `fallback` when unset (0), else `v` if lo < v <= hi.
+/// Lab seeds per verification at most: each multiplies the diagnosis's verification runs.
+constexpr int kMaxReplicates = 16;
+
 double option(double v, double fallback, double lo, double hi, const std::string& field) {
   if (v == 0.0) return fallback;
   if (!(v > lo && v <= hi))
@@ -188,6 +191,10 @@ diagnose::Options diagnose_options(const v1::DiagnoseOptions& o, const std::stri
       option(o.sigma_g_max(), out.sigma_g_max, diagnose::kSigmaGLow, 10.0, where + ".sigma_g_max");
   out.fixed_span = option(o.fixed_span(), out.fixed_span, 1.0, 100.0, where + ".fixed_span");
   out.margin = option(o.margin(), out.margin, 0.0, 0.99, where + ".margin");
+  if (o.replicates() < 0 || o.replicates() > kMaxReplicates)
+    throw InputError(where + ".replicates", "must be 0 (the default, 1) or in [1, " +
+                                                std::to_string(kMaxReplicates) + "]");
+  if (o.replicates() > 0) out.replicates = o.replicates();
   return out;
 }
 
@@ -213,8 +220,8 @@ v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::u
   for (const auto& req : step.requests) {
     const std::string kind = std::string(kPrefix) + req.group;
     if (stored.count({kind, req.row})) continue;
-    const auto add =
-        jobs_at(spec, switched(spec.material(), req.switches), req.parameters, req.row, kind);
+    const auto add = jobs_at(spec, switched(spec.material(), req.switches), req.parameters, req.row,
+                             kind, static_cast<std::uint64_t>(req.replicate));
     fresh.insert(fresh.end(), add.begin(), add.end());
   }
   if (read_only) fresh.clear();

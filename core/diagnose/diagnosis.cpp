@@ -358,12 +358,25 @@ std::vector<Conflict> conflicts(const Problem& p, const Fitted& joint) {
   return out;
 }
 
-/// Simulated values of the verification row of a group (row 1), or empty while pending.
-std::map<std::string, double> verified(const std::map<std::string, GroupResults>& groups,
-                                       const std::string& name) {
-  const auto* g = find_group(groups, name);
-  if (!g || !g->count(1)) return {};
-  return g->at(1);
+/// The mean of a replicated verification: rows first .. first + replicates - 1 of a group, each
+/// metric averaged (NaN when a replicate failed); empty while one is pending.
+std::map<std::string, double> replicate_mean(const Problem& p, const GroupResults* g, int first) {
+  const int n = p.options.replicates;
+  std::map<std::string, double> mean;
+  for (int row = first; row < first + n; ++row) {
+    if (!g || !g->count(row)) return {};
+    for (const auto& [metric, value] : g->at(row)) mean[metric] += value / n;
+  }
+  return mean;
+}
+
+/// The replicated verification runs of one point: rows first .. first + replicates - 1.
+void request_replicates(const Problem& p, const std::string& group, int first,
+                        const std::map<std::string, std::string>& switches,
+                        const std::map<std::string, double>& point,
+                        std::vector<RunRequest>& requests) {
+  for (int k = 0; k < p.options.replicates; ++k)
+    requests.push_back({group, first + k, switches, point, k});
 }
 
 /// Step 1, the baseline: each measured metric against the base box's envelope, the best
@@ -438,9 +451,10 @@ bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
     VerifiedPoint point{
         natural_point(plan.factors, fit.result.natural), {}, std::sqrt(fit.result.objective)};
     point.reaches_all = fit.reaches_all;
-    requests.push_back({plan.id + "/verify", round, plan.switches, point.proposed});
-    const auto* v = find_group(groups, plan.id + "/verify");
-    if (!v || !v->count(round)) {
+    const int first = (round - 1) * p.options.replicates + 1;
+    request_replicates(p, plan.id + "/verify", first, plan.switches, point.proposed, requests);
+    point.simulated = replicate_mean(p, find_group(groups, plan.id + "/verify"), first);
+    if (point.simulated.empty()) {
       if (c.best_round == 0) {  // nothing verified yet: show what is being verified
         c.proposed = point.proposed;
         c.predicted_rms = point.predicted_rms;
@@ -449,7 +463,6 @@ bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
       }
       return false;
     }
-    point.simulated = v->at(round);
     point.verified_rms = rms_error(p, base.all, point.simulated, false);
     point.holdout_rms = rms_error(p, base.all, point.simulated, true);
     c.rounds = round;
@@ -620,10 +633,10 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
       p, p.factors, fit_targets(p, p.design, p.results, doe::ModelKind::kTwoFactor));
   rep.baseline_proposed = natural_point(p.factors, base.result.natural);
   rep.baseline_predicted_rms = std::sqrt(base.result.objective);
-  const auto base_sim = verified(groups, "baseline");
+  const auto base_sim = replicate_mean(p, find_group(groups, "baseline"), 1);
   rep.metrics = baseline_rows(p, base, base_sim);
   rep.conflicts = conflicts(p, base);
-  step.requests.push_back({"baseline", 1, {}, rep.baseline_proposed});
+  request_replicates(p, "baseline", 1, {}, rep.baseline_proposed, step.requests);
   if (!base_sim.empty()) {
     rep.baseline_verified_rms = rms_error(p, base.all, base_sim, false);
     rep.baseline_holdout_rms = rms_error(p, base.all, base_sim, true);

@@ -75,6 +75,10 @@ struct Options {
   /// error is at most `converged`.
   int rounds = 3;
   double converged = 0.01;
+  /// Every verification (the baseline's and each candidate's round) is simulated with this many
+  /// lab seeds (offsets 0..replicates - 1) and its metrics averaged: the noise of a verified
+  /// error falls as 1 / sqrt(replicates), at that many times the verification runs.
+  int replicates = 1;
 };
 
 /// The campaign as the diagnosis sees it.
@@ -94,7 +98,7 @@ struct Problem {
   /// preparation: the longest agitation time it runs (s, simulated): the preparation's own
   /// default, 3 largest diameters at the speed sqrt(g d).
   double agitation_time_max = 0.0;
-  std::map<std::string, double> fixed;     ///< parameters held fixed (path -> value)
+  std::map<std::string, double> fixed;  ///< parameters held fixed (path -> value)
   std::map<std::string, std::pair<double, double>> valid;  ///< valid range of each path
   Options options;
 };
@@ -108,6 +112,7 @@ struct RunRequest {
       switches;  ///< "shape" -> "rod", "particle_law.rolling" -> "cdt", "sizes" -> "lognormal",
                  ///< "preparation" -> "clusters"
   std::map<std::string, double> parameters;
+  int replicate = 0;  ///< a replicated verification's lab-seed offset, 0..replicates - 1
 };
 
 /// Finished runs of a group: row -> response -> value (NaN = the run failed).
@@ -169,7 +174,7 @@ struct Report {
   /// named cause's (below its error / (1 - margin), or both below `converged`): the data do not
   /// tell them apart from it.
   std::vector<std::string> rivals;
-  std::string conclusion;                    ///< plain words
+  std::string conclusion;  ///< plain words
 };
 
 struct Step {

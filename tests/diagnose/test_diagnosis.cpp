@@ -677,5 +677,42 @@ TEST(Diagnosis, HeldOutMeasurementIsNotCalibratedButReported) {
   EXPECT_NEAR(c.report.baseline_verified_rms, rms(at, with.measurements), 1e-12);
 }
 
+TEST(Diagnosis, ReplicatedVerificationsAverageTheirSeeds) {
+  // Noise of opposite sign on the coordination number of the two lab seeds of every
+  // verification: averaged over 2 replicates it cancels, the baseline's verified error is the
+  // noise-free one, and each verified point takes two runs on seed offsets 0 and 1.
+  auto truth_point = natural_point(0.2, -0.3, 0.1);
+  truth_point[kMuR] = kTrueMuR;
+  const auto ms =
+      targets_at(rolling_truth(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  const Disturbance noise = [](const RunRequest& r, Responses& y) {
+    const bool verification = r.group == "baseline" || r.group.find("/verify") != std::string::npos;
+    if (verification) y[kCn] *= r.replicate == 0 ? 1.05 : 0.95;
+  };
+  for (const int replicates : {1, 2}) {
+    Problem p = make_problem(rolling_truth, {kSf, kCn}, ms);
+    p.options.replicates = replicates;
+    const Driven d = drive(p, rolling_truth, 30, noise);
+    const Report& r = d.step.report;
+    ASSERT_EQ(r.state, "done");
+    const double clean = rms(rolling_truth(r.baseline_proposed, {}), ms);
+    if (replicates == 2)
+      EXPECT_NEAR(r.baseline_verified_rms, clean, 1e-12);
+    else
+      EXPECT_GT(std::abs(r.baseline_verified_rms - clean), 0.01);
+    const auto baseline = of_group(d.step.requests, "baseline");
+    ASSERT_EQ(baseline.size(), std::size_t(replicates));
+    for (int k = 0; k < replicates; ++k) {
+      EXPECT_EQ(baseline[std::size_t(k)].row, k + 1);
+      EXPECT_EQ(baseline[std::size_t(k)].replicate, k);
+    }
+    const CandidateOutcome* rolling = candidate(r, "rolling");
+    ASSERT_NE(rolling, nullptr);
+    EXPECT_EQ(of_group(d.step.requests, "rolling/verify").size(),
+              std::size_t(replicates * rolling->rounds));
+    EXPECT_EQ(r.named_cause, "rolling") << r.conclusion;
+  }
+}
+
 }  // namespace
 }  // namespace demcal::diagnose
