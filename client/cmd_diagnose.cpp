@@ -75,8 +75,8 @@ void print_candidates(std::ostream& out, const v1::DiagnosisReport& r) {
         << std::setw(13) << pct(c.has_design_misprediction(), c.design_misprediction())
         << std::setw(11) << pct(c.has_predicted_rms(), c.predicted_rms()) << std::setw(10)
         << pct(c.has_verified_rms(), c.verified_rms()) << std::setw(8)
-        << (std::to_string(c.best_round()) + "/" + std::to_string(c.rounds()))
-        << std::setw(10) << pct(c.has_holdout_rms(), c.holdout_rms()) << std::setw(10)
+        << (std::to_string(c.best_round()) + "/" + std::to_string(c.rounds())) << std::setw(10)
+        << pct(c.has_holdout_rms(), c.holdout_rms()) << std::setw(10)
         << (c.explains() ? "yes" : "no") << "\n";
     out << "    " << c.cause() << " [" << c.state() << "]";
     if (!c.evidence().empty()) out << ": " << c.evidence();

@@ -236,8 +236,8 @@ void plan_factors(const v1::CampaignSpec& spec, const lab::MaterialModel& model,
     if (!seen.insert(f.path()).second)
       throw InputError(where + ".path", "'" + f.path() + "' is a factor twice");
     check_factor_bounds(f, info, where);
-    lab::with_parameters(model, {{f.path(), f.low(), where + ".low"}});
-    lab::with_parameters(model, {{f.path(), f.high(), where + ".high"}});
+    lab::with_parameters(
+        model, {{f.path(), f.low(), where + ".low"}, {f.path(), f.high(), where + ".high"}});
     for (const auto& [name, instance] : instances)
       if (!lab::has_parameter(instance, f.path()))
         throw InputError(where + ".path", "'" + f.path() + "' is not a parameter of test '" + name +

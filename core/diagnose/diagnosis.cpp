@@ -22,6 +22,7 @@ struct Plan {
   double base_coded = 0.0;                       ///< the new factor's coded value in the base runs
   Eigen::MatrixXd new_rows = Eigen::MatrixXd();  ///< runs to simulate
   doe::ModelKind model = doe::ModelKind::kTwoFactor;
+  bool by_default = true;  ///< tested without being listed in `candidates`
 };
 
 bool is_factorial(const Eigen::MatrixXd& x, Eigen::Index r) {
@@ -125,16 +126,16 @@ std::vector<Plan> candidate_plans(const Problem& p) {
         {"shape.aspect_ratio", doe::Factor{"shape.aspect_ratio", 1.0, o.aspect_ratio_max}}, 1.0));
   // Irregular clusters of overlapping spheres (lactose crystals are tomahawk-shaped, seed 000
   // §2.1): their spread scales the centres' distances, and at 0 a cluster is its largest sphere,
-  // which runs as a sphere, so the base runs are the family's low end. Only when asked for: on
+  // which runs as a sphere, so the base runs are the family's low end. Only when listed: on
   // packing data alone they fit the data of other causes as well as those causes do
   // (docs/diagnosis.md), so by default they would name a shape the data cannot tell apart.
-  const bool clusters_asked =
-      std::find(o.candidates.begin(), o.candidates.end(), "clusters") != o.candidates.end();
-  if (clusters_asked && p.shape_kind == "sphere" && !has_factor(p, "shape.spread"))
+  if (p.shape_kind == "sphere" && !has_factor(p, "shape.spread")) {
     plans.push_back(new_factor_plan(
         p, "clusters",
         "particle shape: irregular clusters of overlapping spheres instead of spheres",
         {{"shape", "cluster"}}, {"shape.spread", doe::Factor{"shape.spread", 0.0, 1.0}}, 0.0));
+    plans.back().by_default = false;
+  }
   bool rolling_factor = false;
   for (const auto& f : p.factors) rolling_factor |= f.path.rfind("particle_law.rolling.", 0) == 0;
   if (p.rolling_model == "none" && !rolling_factor)
@@ -189,7 +190,10 @@ std::vector<Plan> candidate_plans(const Problem& p) {
     plan.new_rows = -factorial_rows(p.design);
     plans.push_back(std::move(plan));
   }
-  if (o.candidates.empty()) return plans;
+  if (o.candidates.empty()) {
+    std::erase_if(plans, [](const Plan& x) { return !x.by_default; });
+    return plans;
+  }
   std::vector<Plan> chosen;
   for (const auto& id : o.candidates) {
     auto it = std::find_if(plans.begin(), plans.end(), [&](const Plan& x) { return x.id == id; });

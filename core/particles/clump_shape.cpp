@@ -166,9 +166,9 @@ namespace {
 /// the sphere around it.
 void drop_enclosed(std::vector<Vec3>& centres, std::vector<double>& radii) {
   const auto inside = [&](std::size_t k, std::size_t j) {
-    const double slack = 1e-12 * radii[j];
-    if (norm(centres[k] - centres[j]) + radii[k] > radii[j] + slack) return false;
-    const bool equal = norm(centres[k] - centres[j]) + radii[j] <= radii[k] + slack;
+    const double gap = norm(centres[k] - centres[j]), slack = 1e-12 * radii[j];
+    if (gap + radii[k] > radii[j] + slack) return false;
+    const bool equal = gap + radii[j] <= radii[k] + slack;
     return !equal || j < k;
   };
   std::vector<Vec3> kept_centres;
