@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/common/bytes.hpp"
 #include "core/common/domain.hpp"
 #include "core/common/vec3.hpp"
 
@@ -29,6 +30,11 @@ class VerletList {
 
   std::size_t pairs() const { return nbr.size(); }
   std::size_t builds() const { return builds_; }
+
+  /// The list's state for a checkpoint: the rows, the positions of the last build and the build
+  /// count (the buffers a build reuses carry nothing from one build to the next).
+  void save(ByteWriter& out) const;
+  void restore(ByteReader& in);
 
  private:
   std::vector<Vec3> x_at_build_;

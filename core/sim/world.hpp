@@ -3,6 +3,8 @@
 // step function carries from one step to the next (neighbour list, per-contact history).
 #include <algorithm>
 #include <cstdint>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/common/domain.hpp"
@@ -66,6 +68,17 @@ class World {
   /// Removes flagged particles (e.g. a bed cut to height); contact history is dropped.
   void remove_particles(const std::vector<char>& flags);
 
+  /// The whole state a run carries from one step to the next, for a checkpoint: particles and
+  /// clumps, walls, domain, gravity, time step, time and step count, the neighbour list with the
+  /// contact history, the walls' histories and lists, and the clumps' frames. Not in it: the
+  /// contact laws and the thread settings, which the resuming run sets up as the saving run did
+  /// (restore_state refuses laws of another shape). Restored into a world set up so, a run goes
+  /// on to the same bits as from the saved moment, on the same number of threads.
+  std::string save_state() const;
+  /// Replaces this world's state by a saved one; throws InputError naming "checkpoint" for a
+  /// record that is damaged or was made with other laws, and leaves the world unchanged then.
+  void restore_state(std::string_view state);
+
   /// The largest interaction reach beyond contact over all laws (cohesion range), m.
   double interaction_range() const;
   /// Builds the neighbour list for the current positions (wrapped into periodic boxes), carrying
@@ -110,6 +123,8 @@ class World {
 
  private:
   void grow_law_tables(int n);
+  /// Why the arrays of a restored state do not fit together (empty: they do).
+  std::string state_mismatch() const;
   std::vector<contact::ContactLaw> pair_laws_;               // n_materials_^2
   std::vector<std::vector<contact::ContactLaw>> wall_laws_;  // [wall material][particle material]
   std::vector<bool> pair_set_;
