@@ -7,6 +7,10 @@
 #include <string>
 #include <vector>
 
+namespace demcal {
+class ByteWriter;
+class ByteReader;
+}  // namespace demcal
 namespace demcal::sim {
 class World;
 }
@@ -52,6 +56,10 @@ class PhaseClock {
   double time0_ = 0.0;
   std::chrono::steady_clock::time_point wall0_;
 };
+
+/// A phase's cost in a checkpoint record, and back.
+void put_phase(ByteWriter& out, const PhaseCost& phase);
+PhaseCost get_phase(ByteReader& in);
 
 /// "15 kPa" style text of a stress in Pa, for phase targets.
 std::string stress_text(double pa);

@@ -95,6 +95,9 @@ LabOutput run_lab_test(const std::string& name, const MaterialModel& material,
   LabOutput out = runner_of(name)(material, settings, run);
   out.cost.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (out.resumed_from != options.resume.stage)
+    throw InputError("checkpoint", "stage '" + options.resume.stage + "' is not one the " + name +
+                                       " test goes on from");
   for (const auto& m : info.metrics)
     if (!out.metrics.count(m.name))
       throw std::logic_error("lab test '" + name + "' did not produce its metric '" + m.name + "'");

@@ -23,6 +23,14 @@ struct Series {
 /// a worker sends with its result; `demcal lab run` writes the full series).
 Series thinned(const Series& series, std::size_t max_rows);
 
+/// A point a run can go on from (docs/worker.md, "Checkpoints"): the stage it had reached and
+/// the record of its state there. A run resumed from it gives bitwise the metrics of a run that
+/// was never interrupted, on the same number of threads.
+struct Checkpoint {
+  std::string stage;  ///< e.g. "piston bed"; empty: none
+  std::string state;  ///< the stage's record (the world's state and what the test keeps of it)
+};
+
 struct LabOutput {
   std::map<std::string, double> metrics;  ///< by the names of the catalogue
   std::map<std::string, Series> series;
@@ -32,6 +40,8 @@ struct LabOutput {
   /// Metrics that cannot be trusted, with the reason: a phase they are computed from did not
   /// reach its target. A flagged metric is reported, never silently used.
   std::map<std::string, std::string> flags;
+  /// The checkpoint stage the run went on from (empty: it ran from the start).
+  std::string resumed_from;
 
   /// Records a phase; if it did not reach its target, flags `metrics` with its name and target.
   void add_phase(const PhaseCost& phase, const std::vector<std::string>& metrics);
@@ -42,6 +52,13 @@ struct RunOptions {
   std::uint64_t seed = 1;
   std::string snapshot_dir;                       ///< empty: no VTK
   std::function<void(double fraction)> progress;  ///< optional, 0..1
+  /// Offered a checkpoint at each stage a test can go on from, with the maker of its record:
+  /// the receiver calls it only for a checkpoint it keeps (a worker, every few minutes).
+  std::function<void(const std::string& stage, const std::function<std::string()>& record)>
+      checkpoint;
+  /// Go on from this checkpoint instead of simulating up to its stage (empty stage: start
+  /// afresh). run_lab_test refuses one whose stage the test never reached.
+  Checkpoint resume;
 };
 
 /// Runs a test by name: validates the settings, runs, and checks that every catalogued metric

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/common/bytes.hpp"
 #include "core/lab/run_cancelled.hpp"
 #include "core/sim/step.hpp"
 #include "core/sim/time_step.hpp"
@@ -164,6 +165,11 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
 
 void add_bed_phases(LabOutput& out, const PistonBed& bed,
                     const std::vector<std::string>& depending) {
+  if (!bed.resumed_from.empty()) {
+    out.resumed_from = bed.resumed_from;
+    out.notes.push_back("went on from the checkpoint '" + bed.resumed_from +
+                        "': the phases up to it ran in an earlier attempt (their costs are its)");
+  }
   out.add_phase(bed.filled, {});
   if (bed.built.prepared.steps > 0) out.add_phase(bed.built.prepared, {});
   out.add_phase(bed.built.settled, depending);
@@ -176,9 +182,57 @@ void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string&
   out.add_phase(cost, depending);
 }
 
+namespace {
+
+constexpr const char* kPistonBedStage = "piston bed";
+
+std::string piston_bed_record(const PistonBed& b) {
+  ByteWriter out;
+  out.put(b.world.save_state());
+  out.put<std::uint64_t>(b.piston);
+  out.put(b.radius);
+  out.put(b.area);
+  out.put(b.h0);
+  out.put(b.limits);
+  put_phase(out, b.filled);
+  put_phase(out, b.built.prepared);
+  put_phase(out, b.built.settled);
+  return out.take();
+}
+
+/// The bed of a checkpoint: the world the test sets up (laws, threads) with the saved state.
+PistonBed resumed_piston_bed(const MaterialModel& material, const RunOptions& options,
+                             const std::function<void(sim::World&)>& set_laws) {
+  ByteReader in(options.resume.state, "checkpoint");
+  PistonBed b;
+  b.world = make_material_world(material, options);
+  if (set_laws) set_laws(b.world);
+  std::string world;
+  in.get(world);
+  b.world.restore_state(world);
+  b.piston = in.get<std::uint64_t>();
+  in.get(b.radius);
+  in.get(b.area);
+  in.get(b.h0);
+  in.get(b.limits);
+  b.filled = get_phase(in);
+  b.built.prepared = get_phase(in);
+  b.built.settled = get_phase(in);
+  in.expect_end();
+  if (b.piston >= b.world.walls.size() ||
+      !std::holds_alternative<walls::Disk>(b.world.walls[b.piston].shape))
+    throw InputError("checkpoint", "its piston is not a disk wall of its world");
+  b.resumed_from = kPistonBedStage;
+  return b;
+}
+
+}  // namespace
+
 PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, double safety,
                           double stress_level, const RunOptions& options,
                           const std::function<void(sim::World&)>& set_laws) {
+  if (options.resume.stage == kPistonBedStage)
+    return resumed_piston_bed(material, options, set_laws);
   BedSpec spec;
   spec.particles = particles;
   spec.time_step_safety = safety;
@@ -202,6 +256,8 @@ PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, 
   disk.centre.z = b.h0;
   w.walls[b.piston].pivot = disk.centre;
   b.limits = die_limits(w, b.radius, b.h0);
+  if (options.checkpoint)
+    options.checkpoint(kPistonBedStage, [&b] { return piston_bed_record(b); });
   return b;
 }
 

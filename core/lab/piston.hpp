@@ -73,6 +73,7 @@ struct PistonBed {
   sim::HealthLimits limits;
   PhaseCost filled;  ///< the phases that built it
   PreparedBed built;
+  std::string resumed_from;  ///< the checkpoint stage it was restored from (empty: built)
 };
 /// Records the bed's fill and settle phases in `out`; `depending` are the metrics read from the
 /// settled state (its height).
@@ -84,7 +85,8 @@ void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string&
 /// Builds the die world, lets `set_laws` replace wall laws (e.g. stiff or adhesive piston and
 /// bottom), sets dt = safety * critical over all laws, settles relative to `stress_level` (the
 /// largest stress the test applies, simulated; BedSpec::rest_stress), and adds the piston at the
-/// bed top.
+/// bed top. The bed is a checkpoint stage ("piston bed"): offered to options.checkpoint once
+/// built, and restored instead of built when options.resume names it.
 PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, double safety,
                           double stress_level, const RunOptions& options,
                           const std::function<void(sim::World&)>& set_laws);
