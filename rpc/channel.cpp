@@ -1,5 +1,6 @@
 #include "rpc/channel.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <fstream>
 #include <sstream>
@@ -13,8 +14,14 @@ bool loopback(const std::string& a) {
 }
 }  // namespace
 
+int checkpoint_message_limit(double max_checkpoint_mb) {
+  constexpr double kMiB = 1024.0 * 1024.0;
+  return static_cast<int>(std::min((max_checkpoint_mb + 1.0) * kMiB, 2147483647.0));
+}
+
 std::shared_ptr<grpc::Channel> make_channel(const ChannelOptions& o) {
   grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(checkpoint_message_limit(kMaxCheckpointMb));
   // Reconnect quickly after a coordinator restart.
   args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 200);
   args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 2000);

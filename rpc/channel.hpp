@@ -18,6 +18,13 @@ struct ChannelOptions {
   bool insecure = false;  ///< plain TCP (a coordinator started with --insecure)
 };
 
+/// The largest checkpoint a coordinator may be configured to take (--max-checkpoint-mb).
+constexpr double kMaxCheckpointMb = 1024.0;
+/// The message size that holds a checkpoint of `max_checkpoint_mb` MiB with its call's other
+/// fields: a coordinator's receive limit, and a channel's (a lease hands the checkpoint back).
+int checkpoint_message_limit(double max_checkpoint_mb);
+
+/// A channel that receives messages up to checkpoint_message_limit(kMaxCheckpointMb).
 std::shared_ptr<grpc::Channel> make_channel(const ChannelOptions& options);
 
 /// The bearer token in the first line of `path` (trailing blanks dropped). Throws

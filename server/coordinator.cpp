@@ -5,6 +5,7 @@
 
 #include <stdexcept>
 
+#include "rpc/channel.hpp"
 #include "server/auth.hpp"
 #include "server/reflection.hpp"
 
@@ -35,9 +36,14 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
     throw std::invalid_argument("--max-watch-interval must lie in [0.05, 3600] s");
   if (!(options_.idle_retry_seconds >= 0.01 && options_.idle_retry_seconds <= 60.0))
     throw std::invalid_argument("the idle retry must lie in [0.01, 60] s");
-  ServiceConfig config{tokens, options_.heartbeat_seconds,
+  if (!(options_.max_checkpoint_mb >= 1.0 && options_.max_checkpoint_mb <= 1024.0))
+    throw std::invalid_argument("--max-checkpoint-mb must lie in [1, 1024]");
+  ServiceConfig config{tokens,
+                       options_.heartbeat_seconds,
                        std::min(options_.idle_retry_seconds, options_.heartbeat_seconds),
-                       options_.max_starts, options_.max_watch_interval};
+                       options_.max_starts,
+                       options_.max_watch_interval,
+                       options_.max_checkpoint_mb};
   campaigns_ = std::make_unique<CampaignServiceImpl>(*store_, config, stopping_);
   workers_ = std::make_unique<WorkerServiceImpl>(*store_, config);
 
@@ -57,6 +63,8 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
     spdlog::warn("listening on {} without TLS: tokens and data travel in clear text",
                  options_.listen);
   builder.AddListeningPort(options_.listen, creds, &port_);
+  // A checkpoint is the largest message a call carries; every other one is far below it.
+  builder.SetMaxReceiveMessageSize(rpc::checkpoint_message_limit(options_.max_checkpoint_mb));
   builder.RegisterService(campaigns_.get());
   builder.RegisterService(workers_.get());
   if (reflection_) builder.RegisterService(reflection_.get());

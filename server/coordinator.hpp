@@ -37,6 +37,7 @@ struct CoordinatorOptions {
   bool fsync_every_commit = false;
   int max_starts = 256;              ///< Calibrate `starts`, at most
   double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
+  double max_checkpoint_mb = 64.0;   ///< a worker's checkpoint, at most (MiB)
   std::string tls_cert, tls_key;
   bool insecure = false;  ///< plain TCP (behind a trusted network or a TLS-terminating proxy)
 };

@@ -57,6 +57,9 @@ int main(int argc, char** argv) {
   app.add_option("--max-watch-interval", o.max_watch_interval,
                  "Watch interval a client may ask for, at most (s)")
       ->capture_default_str();
+  app.add_option("--max-checkpoint-mb", o.max_checkpoint_mb,
+                 "a worker's checkpoint of a running job, at most (MiB, 1-1024)")
+      ->capture_default_str();
   app.add_option("--tls-cert", o.tls_cert, "PEM certificate chain (enables TLS)");
   app.add_option("--tls-key", o.tls_key, "PEM private key");
   app.add_flag("--insecure", o.insecure, "plain TCP: tokens and data in clear text");

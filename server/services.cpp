@@ -351,6 +351,10 @@ grpc::Status WorkerServiceImpl::Lease(grpc::ServerContext* ctx, const v1::LeaseR
   spec.set_job_id(job->id);
   spec.set_attempt(job->attempt);
   spec.set_campaign_id(job->campaign_id);
+  if (auto checkpoint = store_.checkpoint(job->id)) {
+    spec.set_checkpoint_stage(checkpoint->stage);
+    spec.set_checkpoint_state(std::move(checkpoint->state));
+  }
   *reply->mutable_job() = spec;
   spdlog::info("job {} ({} run {}) leased to {} (attempt {})", job->id, job->test, job->std_order,
                req->worker(), job->attempt);
@@ -473,6 +477,26 @@ grpc::Status WorkerServiceImpl::Fail(grpc::ServerContext* ctx, const v1::FailReq
     return lease_refused(answer, req->job_id(), req->attempt(), req->worker(), "");
   spdlog::info("job {} attempt {} {} by {}: {}", req->job_id(), req->attempt(),
                req->give_back() ? "given back" : "failed", req->worker(), req->reason());
+  return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::Checkpoint(grpc::ServerContext* ctx,
+                                           const v1::CheckpointRequest* req, v1::CheckpointReply*) {
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
+  if (req->stage().empty() || req->stage().size() > 64)
+    return {grpc::StatusCode::INVALID_ARGUMENT, "stage: 1-64 characters"};
+  const double max_bytes = config_.max_checkpoint_mb * 1024.0 * 1024.0;
+  if (static_cast<double>(req->state().size()) > max_bytes)
+    return {grpc::StatusCode::INVALID_ARGUMENT,
+            fmt::format("state: {} bytes, more than the coordinator's --max-checkpoint-mb {:g}",
+                        req->state().size(), config_.max_checkpoint_mb)};
+  if (const auto answer = store_.save_checkpoint(req->job_id(), req->attempt(), req->worker(),
+                                                 req->stage(), req->state(), steady_seconds());
+      answer != LeaseAnswer::kOk)
+    return lease_refused(answer, req->job_id(), req->attempt(), req->worker(),
+                         "; checkpoint not kept");
+  spdlog::info("job {} attempt {}: checkpoint '{}' ({} bytes) from {}", req->job_id(),
+               req->attempt(), req->stage(), req->state().size(), req->worker());
   return grpc::Status::OK;
 }
 

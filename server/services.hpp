@@ -21,6 +21,7 @@ struct ServiceConfig {
   double idle_retry_seconds = 1.0;
   int max_starts = 256;              ///< Calibrate `starts`, at most
   double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
+  double max_checkpoint_mb = 64.0;   ///< a checkpoint's state, at most (MiB)
 };
 
 /// The shortest Watch interval.
@@ -94,6 +95,8 @@ class WorkerServiceImpl final : public v1::WorkerService::Service {
   grpc::Status Complete(grpc::ServerContext*, const v1::CompleteRequest*,
                         v1::CompleteReply*) override;
   grpc::Status Fail(grpc::ServerContext*, const v1::FailRequest*, v1::FailReply*) override;
+  grpc::Status Checkpoint(grpc::ServerContext*, const v1::CheckpointRequest*,
+                          v1::CheckpointReply*) override;
 
  private:
   Store& store_;

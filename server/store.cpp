@@ -140,6 +140,17 @@ const std::vector<const char*>& migrations() {
         job_id INTEGER PRIMARY KEY REFERENCES results(job_id),
         series_json TEXT NOT NULL);
       )sql",
+      // 7: the latest checkpoint of a job's simulation, from the lease that sent it; handed out
+      // with the job's next lease, dropped when its result is stored.
+      R"sql(
+      CREATE TABLE checkpoints (
+        job_id INTEGER PRIMARY KEY REFERENCES jobs(id),
+        attempt INTEGER NOT NULL,
+        worker TEXT NOT NULL,
+        stage TEXT NOT NULL,
+        state BLOB NOT NULL,
+        stored REAL NOT NULL);
+      )sql",
   };
   return m;
 }
@@ -185,12 +196,16 @@ class Store::Statement {
     sqlite3_bind_text(stmt_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
     return *this;
   }
-  /// True while there is a row.
+  Statement& bind_blob(int i, const std::string& v) {
+    sqlite3_bind_blob(stmt_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+    return *this;
+  }
   /// Ready to run again with new bindings.
   void reset() {
     sqlite3_reset(stmt_);
     sqlite3_clear_bindings(stmt_);
   }
+  /// True while there is a row.
   bool step() {
     const int rc = sqlite3_step(stmt_);
     if (rc == SQLITE_ROW) return true;
@@ -204,6 +219,11 @@ class Store::Statement {
   std::string text(int c) const {
     const auto* p = sqlite3_column_text(stmt_, c);
     return p ? std::string(reinterpret_cast<const char*>(p)) : std::string();
+  }
+  std::string blob(int c) const {
+    const auto* p = static_cast<const char*>(sqlite3_column_blob(stmt_, c));
+    return p ? std::string(p, static_cast<std::size_t>(sqlite3_column_bytes(stmt_, c)))
+             : std::string();
   }
 
  private:
@@ -726,10 +746,35 @@ LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string&
     Statement c(*this, "INSERT INTO result_series (job_id, series_json) VALUES (?, ?)");
     c.bind(1, job_id).bind(2, series_json).step();
   }
+  Statement d(*this, "DELETE FROM checkpoints WHERE job_id = ?");
+  d.bind(1, job_id).step();
   finish_campaigns(stored);
   tx.commit();
   deadlines_.erase(job_id);
   return LeaseAnswer::kOk;
+}
+
+LeaseAnswer Store::save_checkpoint(std::int64_t job_id, int attempt, const std::string& worker,
+                                   const std::string& stage, const std::string& state, double now) {
+  Guard lock(*this);
+  Transaction tx(*this);
+  if (const auto answer = check_lease(job_id, attempt, worker, now); answer != LeaseAnswer::kOk)
+    return answer;
+  Statement s(*this,
+              "INSERT OR REPLACE INTO checkpoints (job_id, attempt, worker, stage, state, stored) "
+              "VALUES (?, ?, ?, ?, ?, ?)");
+  s.bind(1, job_id).bind(2, attempt).bind(3, worker).bind(4, stage).bind_blob(5, state);
+  s.bind(6, server::wall_seconds()).step();
+  tx.commit();
+  return LeaseAnswer::kOk;
+}
+
+std::optional<CheckpointRow> Store::checkpoint(std::int64_t job_id) {
+  Guard lock(*this);
+  Statement s(*this, "SELECT attempt, stage, state FROM checkpoints WHERE job_id = ?");
+  s.bind(1, job_id);
+  if (!s.step()) return std::nullopt;
+  return CheckpointRow{s.i32(0), s.text(1), s.blob(2)};
 }
 
 bool Store::requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason,

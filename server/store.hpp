@@ -84,6 +84,12 @@ struct CalibrationStageRow {
   double created = 0.0;
 };
 
+/// The latest checkpoint of a job's simulation (proto CheckpointRequest).
+struct CheckpointRow {
+  int attempt = 0;  ///< the lease that sent it
+  std::string stage, state;
+};
+
 struct Counts {
   std::int64_t queued = 0, leased = 0, done = 0, failed = 0, cancelled = 0;
   std::int64_t total() const { return queued + leased + done + failed + cancelled; }
@@ -178,6 +184,12 @@ class Store {
   /// See the state machine above; only the current lease's holder may fail it.
   LeaseAnswer fail(std::int64_t job_id, int attempt, const std::string& worker,
                    const std::string& reason, bool retryable, bool give_back, double now);
+  /// Keeps a checkpoint of the current, unexpired lease held by `worker`, in place of the job's
+  /// earlier one; a stored result drops it.
+  LeaseAnswer save_checkpoint(std::int64_t job_id, int attempt, const std::string& worker,
+                              const std::string& stage, const std::string& state, double now);
+  /// The job's latest checkpoint, if any.
+  std::optional<CheckpointRow> checkpoint(std::int64_t job_id);
   /// Expired leases go back to the queue, or fail at the attempt cap. Returns jobs reaped.
   int reap(double now);
   /// The current lease's deadline on the monotonic clock, if the job has one (for tests).

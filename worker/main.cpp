@@ -35,6 +35,11 @@ int main(int argc, char** argv) {
   app.add_option("--max-job-seconds", o.max_job_seconds,
                  "stop and fail a job running longer than this (s; 0 = no limit)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--checkpoint-seconds", o.checkpoint_seconds,
+                 "send a checkpoint a job offers once this long has passed since its start or "
+                 "its last one (s; 0 = every one offered)")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
   app.add_option("--max-backoff", o.max_backoff, "longest reconnection back-off (s)")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);

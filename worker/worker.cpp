@@ -115,11 +115,34 @@ int job_threads(const v1::JobSpec& job, int worker_threads) {
   return job.threads() > 0 ? std::min(job.threads(), worker_threads) : worker_threads;
 }
 
+/// Sends a checkpoint the job offers (stage, its record) to the coordinator.
+using CheckpointSender = std::function<void(const std::string&, const std::string&)>;
+
+/// Runs the job's lab test, from the checkpoint the lease carries if any: one that this build
+/// cannot go on from (another format, a stage the test never reaches) is set aside with a
+/// warning, and the job runs from the start.
+lab::LabOutput run_lab(const v1::JobSpec& job, lab::RunOptions options) {
+  const lab::MaterialModel material = rpc::job_material(job);
+  const lab::Settings settings = rpc::to_settings(job.settings());
+  options.resume = {job.checkpoint_stage(), job.checkpoint_state()};
+  if (!options.resume.stage.empty()) {
+    try {
+      spdlog::info("job {}: going on from checkpoint '{}'", job.job_id(), options.resume.stage);
+      return lab::run_lab_test(job.test(), material, settings, options);
+    } catch (const InputError& e) {
+      if (e.where() != "checkpoint") throw;
+      spdlog::warn("job {}: {}; running it from the start", job.job_id(), e.what());
+      options.resume = {};
+    }
+  }
+  return lab::run_lab_test(job.test(), material, settings, options);
+}
+
 Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progress,
-                const JobStop& stop) {
+                const JobStop& stop, const CheckpointSender& send_checkpoint,
+                double checkpoint_seconds) {
   Outcome o;
   try {
-    const lab::MaterialModel material = rpc::job_material(job);
     lab::RunOptions ro;
     ro.threads = job_threads(job, threads);
     ro.seed = job.seed() ? job.seed() : 1;
@@ -127,8 +150,14 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
       progress = f;
       stop.check();
     };
-    const lab::LabOutput out =
-        lab::run_lab_test(job.test(), material, rpc::to_settings(job.settings()), ro);
+    ro.checkpoint = [&send_checkpoint, checkpoint_seconds, last = Clock::now()](
+                        const std::string& stage,
+                        const std::function<std::string()>& record) mutable {
+      if (std::chrono::duration<double>(Clock::now() - last).count() < checkpoint_seconds) return;
+      send_checkpoint(stage, record());
+      last = Clock::now();
+    };
+    const lab::LabOutput out = run_lab(job, ro);
     o.ok = true;
     o.metrics = out.metrics;
     o.flags = out.flags;
@@ -291,8 +320,13 @@ class Worker {
     // It reads `progress` and `job_stop` only until it returns; a detached simulation (give-back
     // on abort) is followed by the process exiting.
     auto task = std::make_shared<std::packaged_task<Outcome()>>(
-        [job, threads = opt_.threads, &progress, &job_stop] {
-          return run_job(job, threads, progress, job_stop);
+        [this, job, threads = opt_.threads, &progress, &job_stop] {
+          return run_job(
+              job, threads, progress, job_stop,
+              [this, &job](const std::string& stage, const std::string& state) {
+                send_checkpoint(job, stage, state);
+              },
+              opt_.checkpoint_seconds);
         });
     auto future = task->get_future();
     std::thread sim([task] { (*task)(); });
@@ -380,6 +414,22 @@ class Worker {
     for (const auto& series : out.series) *c.add_series() = series;
     v1::CompleteReply cr;
     return stub_->Complete(rpc::make_context(opt_.channel, 10).get(), c, &cr);
+  }
+
+  /// One try: a checkpoint that does not arrive costs only the time it would have saved.
+  void send_checkpoint(const v1::JobSpec& job, const std::string& stage, const std::string& state) {
+    v1::CheckpointRequest c;
+    c.set_job_id(job.job_id());
+    c.set_attempt(job.attempt());
+    c.set_worker(id_);
+    c.set_stage(stage);
+    c.set_state(state);
+    v1::CheckpointReply cr;
+    const auto s = stub_->Checkpoint(rpc::make_context(opt_.channel, 30).get(), c, &cr);
+    if (s.ok())
+      spdlog::info("job {}: checkpoint '{}' sent ({} bytes)", job.job_id(), stage, state.size());
+    else
+      spdlog::warn("job {}: checkpoint '{}' not kept: {}", job.job_id(), stage, s.error_message());
   }
 
   grpc::Status fail(const v1::JobSpec& job, const std::string& reason, bool retryable,

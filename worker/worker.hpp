@@ -22,6 +22,9 @@ struct WorkerOptions {
                                ///< (0 = finish the job however long it takes)
   double max_particles = 0;    ///< refuse jobs with more particles (0 = no limit)
   double max_job_seconds = 0;  ///< stop a job's simulation after this long and fail it (0 = none)
+  /// A checkpoint a job offers is sent once this long has passed since the job's start or its
+  /// last one sent (0: every one offered); a re-leased job goes on from the latest.
+  double checkpoint_seconds = 300;
 };
 
 /// Stop requests: `stop` = finish the current job and lease no more; `abort` = give the

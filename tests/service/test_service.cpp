@@ -18,10 +18,12 @@
 #include "client/service_client.hpp"
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
+#include "core/lab/lab_test.hpp"
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "grpc/reflection/v1alpha/reflection.grpc.pb.h"
 #include "rpc/channel.hpp"
+#include "rpc/material_convert.hpp"
 #include "tests/service/process.hpp"
 
 namespace demcal::test {
@@ -346,7 +348,7 @@ TEST_F(Service, EveryMethodRefusesACallWithoutItsToken) {
           << method;
     }
   }
-  EXPECT_EQ(methods, 15);  // 11 campaign and 4 worker methods in the protocol today
+  EXPECT_EQ(methods, 16);  // 11 campaign and 5 worker methods in the protocol today
 }
 
 /// One request on a reflection stream, as `o` presents itself: the status of the call and the
@@ -526,6 +528,102 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("factors[1].scale"), std::string::npos) << e.what();
   }
+}
+
+// A job's checkpoint goes from the lease that sent it to the job's next lease, and a real worker
+// goes on from it to the result of a run that was never interrupted, to the bit.
+TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  const std::string spec = R"(
+name: checkpointed
+material:
+  particle_law:
+    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, phi_f: 0.05, restitution: 0.3}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 0.001}}
+  density: 1500
+tests:
+  - test: wall_friction
+    settings: {particles: 30}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.2, high: 0.4}
+  - {path: wall_law.tangential.mu_s, low: 0.2, high: 0.4}
+design: {type: full_factorial}
+measurements:
+  - {metric: wall_friction_angle, value: 20, uncertainty: 1}
+)";
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(spec, &id).ok());
+  v1::LeaseRequest lr;
+  lr.set_worker("first");
+  v1::LeaseReply first;
+  ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &first).ok());
+  ASSERT_TRUE(first.has_job());
+  const v1::JobSpec& job = first.job();
+  EXPECT_TRUE(job.checkpoint_stage().empty());
+  // The first worker's run, as the worker runs it, keeping the checkpoint it offers; then the
+  // worker stops and gives the lease back.
+  lab::RunOptions options;
+  options.seed = job.seed() ? job.seed() : 1;  // as the worker
+  lab::Checkpoint kept;
+  options.checkpoint = [&kept](const std::string& stage,
+                               const std::function<std::string()>& record) {
+    kept = {stage, record()};
+  };
+  const lab::LabOutput whole = lab::run_lab_test(job.test(), rpc::job_material(job),
+                                                 rpc::to_settings(job.settings()), options);
+  ASSERT_EQ(kept.stage, "piston bed");
+  v1::CheckpointRequest cp;
+  cp.set_job_id(job.job_id());
+  cp.set_attempt(job.attempt());
+  cp.set_worker("intruder");
+  cp.set_stage(kept.stage);
+  cp.set_state(kept.state);
+  v1::CheckpointReply cpr;
+  EXPECT_EQ(workers_stub_->Checkpoint(ctx().get(), cp, &cpr).error_code(),
+            grpc::StatusCode::PERMISSION_DENIED);
+  cp.set_worker("first");
+  v1::CheckpointRequest unnamed = cp;
+  unnamed.set_stage("");
+  EXPECT_EQ(workers_stub_->Checkpoint(ctx().get(), unnamed, &cpr).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  ASSERT_TRUE(workers_stub_->Checkpoint(ctx().get(), cp, &cpr).ok());
+  v1::FailRequest give_back;
+  give_back.set_job_id(job.job_id());
+  give_back.set_attempt(job.attempt());
+  give_back.set_worker("first");
+  give_back.set_retryable(true);
+  give_back.set_give_back(true);
+  v1::FailReply fr;
+  ASSERT_TRUE(workers_stub_->Fail(ctx().get(), give_back, &fr).ok());
+  // A real worker leases the job again with its checkpoint and goes on from it.
+  Process& second = start_worker("second", kToken, {"--max-jobs", "1"});
+  std::optional<v1::JobResult> stored;
+  ASSERT_TRUE(wait_until(
+      [&] {
+        const auto now = results(id);
+        for (const auto& j : now.jobs())
+          if (j.job_id() == job.job_id() && j.state() == "done") stored = j;
+        return stored.has_value();
+      },
+      120))
+      << second.log();
+  EXPECT_NE(second.log().find("going on from checkpoint 'piston bed'"), std::string::npos)
+      << second.log();
+  EXPECT_EQ(stored->attempt(), 2);
+  ASSERT_EQ(stored->metrics().size(), whole.metrics.size());
+  for (const auto& [name, value] : whole.metrics)
+    EXPECT_EQ(stored->metrics().at(name), value) << name;  // exact: the same bits
+  // The bed's phases are the first run's (their wall times carried in the checkpoint).
+  ASSERT_GT(stored->cost().phases_size(), 2);
+  EXPECT_EQ(stored->cost().phases(0).name(), "fill");
+  EXPECT_EQ(stored->cost().phases(0).wall_seconds(), whole.cost.phases[0].wall_seconds);
+  EXPECT_EQ(stored->cost().steps(), whole.cost.steps);
+  // A stored result drops its job's checkpoint.
+  int checkpoints = -1;
+  each_row(path("c.db"), "SELECT COUNT(*) FROM checkpoints",
+           [&](sqlite3_stmt* st) { checkpoints = sqlite3_column_int(st, 0); });
+  EXPECT_EQ(checkpoints, 0);
 }
 
 TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
