@@ -32,6 +32,12 @@ class ByteWriter {
     put<std::uint64_t>(text.size());
     bytes_.append(text);
   }
+  /// put() under the name ByteReader reads with, so that one function listing a record's
+  /// fields serves both directions.
+  template <class T>
+  void field(const T& value) {
+    put(value);
+  }
   std::string take() { return std::move(bytes_); }
 
  private:
@@ -65,6 +71,10 @@ class ByteReader {
   void get(std::string& text) {
     const auto n = get<std::uint64_t>();
     text.assign(take(n), n);
+  }
+  template <class T>
+  void field(T& value) {
+    get(value);
   }
   std::size_t left() const { return bytes_.size() - at_; }
   /// Throws unless every byte was read.

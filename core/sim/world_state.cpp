@@ -10,19 +10,59 @@ namespace {
 constexpr char kMagic[] = "demcal-world-state";
 constexpr std::uint32_t kVersion = 1;
 
+/// The fields of a mesh, a particle store, a wall and the clumps' frames, in record order, each
+/// handed to `a.field` (ByteWriter to save, ByteReader to restore).
+template <class A, class M>
+void mesh_fields(A& a, M& m) {
+  a.field(m.vertices);
+  a.field(m.triangles);
+  a.field(m.lo);
+  a.field(m.hi);
+  a.field(m.fitted);
+}
+
+template <class A, class P>
+void particle_fields(A& a, P& p) {
+  for (auto* v : {&p.x, &p.v, &p.omega, &p.f, &p.torque, &p.body_offset}) a.field(*v);
+  for (auto* v : {&p.radius, &p.mass, &p.inertia, &p.inv_mass, &p.inv_inertia}) a.field(*v);
+  a.field(p.material);
+  a.field(p.motion);
+  a.field(p.body);
+  auto& c = p.clumps;
+  a.field(c.first);
+  a.field(c.count);
+  for (auto* v : {&c.x, &c.v, &c.omega, &c.angular_momentum, &c.inertia}) a.field(*v);
+  a.field(c.q);
+  a.field(c.mass);
+  a.field(c.volume_weight);
+  a.field(c.parked);
+}
+
+template <class A, class W>
+void wall_fields(A& a, W& w) {
+  a.field(w.name);
+  a.field(w.material);
+  for (auto* v : {&w.velocity, &w.omega, &w.pivot, &w.force, &w.torque, &w.displacement})
+    a.field(*v);
+}
+
+template <class A, class F>
+void frame_fields(A& a, F& f) {
+  a.field(f.q);
+  a.field(f.rotation);
+  for (auto* v : {&f.inv_inertia, &f.force, &f.torque}) a.field(*v);
+  a.field(f.has_wrench);
+  a.field(f.gravity);
+}
+
 void put_shape(ByteWriter& out, const walls::Shape& shape) {
   out.put<std::uint8_t>(static_cast<std::uint8_t>(shape.index()));
   std::visit(
       [&](const auto& s) {
-        if constexpr (std::is_same_v<std::decay_t<decltype(s)>, walls::Mesh>) {
-          out.put(s.vertices);
-          out.put(s.triangles);
-          out.put(s.lo);
-          out.put(s.hi);
-          out.put(s.fitted);
-        } else {
+        if constexpr (std::is_same_v<std::decay_t<decltype(s)>, walls::Mesh>)
+          mesh_fields(out, s);
+        else
           out.put(s);
-        }
       },
       shape);
 }
@@ -37,121 +77,12 @@ walls::Shape get_shape(ByteReader& in) {
       return in.get<walls::Disk>();
     case 3: {
       walls::Mesh m;
-      in.get(m.vertices);
-      in.get(m.triangles);
-      in.get(m.lo);
-      in.get(m.hi);
-      in.get(m.fitted);
+      mesh_fields(in, m);
       return m;
     }
     default:
       throw InputError("checkpoint", "unknown wall shape");
   }
-}
-
-void put_particles(ByteWriter& out, const particles::ParticleStore& p) {
-  out.put(p.x);
-  out.put(p.v);
-  out.put(p.omega);
-  out.put(p.f);
-  out.put(p.torque);
-  out.put(p.radius);
-  out.put(p.mass);
-  out.put(p.inertia);
-  out.put(p.inv_mass);
-  out.put(p.inv_inertia);
-  out.put(p.material);
-  out.put(p.motion);
-  out.put(p.body);
-  out.put(p.body_offset);
-  const auto& c = p.clumps;
-  out.put(c.first);
-  out.put(c.count);
-  out.put(c.x);
-  out.put(c.v);
-  out.put(c.omega);
-  out.put(c.angular_momentum);
-  out.put(c.q);
-  out.put(c.mass);
-  out.put(c.inertia);
-  out.put(c.volume_weight);
-  out.put(c.parked);
-}
-
-void get_particles(ByteReader& in, particles::ParticleStore& p) {
-  in.get(p.x);
-  in.get(p.v);
-  in.get(p.omega);
-  in.get(p.f);
-  in.get(p.torque);
-  in.get(p.radius);
-  in.get(p.mass);
-  in.get(p.inertia);
-  in.get(p.inv_mass);
-  in.get(p.inv_inertia);
-  in.get(p.material);
-  in.get(p.motion);
-  in.get(p.body);
-  in.get(p.body_offset);
-  auto& c = p.clumps;
-  in.get(c.first);
-  in.get(c.count);
-  in.get(c.x);
-  in.get(c.v);
-  in.get(c.omega);
-  in.get(c.angular_momentum);
-  in.get(c.q);
-  in.get(c.mass);
-  in.get(c.inertia);
-  in.get(c.volume_weight);
-  in.get(c.parked);
-}
-
-void put_wall(ByteWriter& out, const walls::Wall& w) {
-  out.put(w.name);
-  put_shape(out, w.shape);
-  out.put(w.material);
-  out.put(w.velocity);
-  out.put(w.omega);
-  out.put(w.pivot);
-  out.put(w.force);
-  out.put(w.torque);
-  out.put(w.displacement);
-}
-
-walls::Wall get_wall(ByteReader& in) {
-  walls::Wall w;
-  in.get(w.name);
-  w.shape = get_shape(in);
-  in.get(w.material);
-  in.get(w.velocity);
-  in.get(w.omega);
-  in.get(w.pivot);
-  in.get(w.force);
-  in.get(w.torque);
-  in.get(w.displacement);
-  return w;
-}
-
-void put_frames(ByteWriter& out, const integrate::ClumpFrames& f) {
-  out.put(f.q);
-  out.put(f.rotation);
-  out.put(f.inv_inertia);
-  out.put(f.force);
-  out.put(f.torque);
-  out.put(f.has_wrench);
-  out.put(f.gravity);
-}
-
-void get_frames(ByteReader& in, integrate::ClumpFrames& f) {
-  in.get(f.q);
-  in.get(f.rotation);
-  in.get(f.inv_inertia);
-  in.get(f.force);
-  in.get(f.torque);
-  in.get(f.has_wrench);
-  in.get(f.gravity);
-  f.q_mid.resize(f.q.size());
 }
 
 /// What the saving run's laws were like: a resuming run with other laws cannot go on from it.
@@ -192,9 +123,12 @@ std::string World::save_state() const {
   out.put(std::string(kMagic));
   out.put(kVersion);
   out.put(LawShape{n_materials_, pair_stride_});
-  put_particles(out, particles);
+  particle_fields(out, particles);
   out.put<std::uint64_t>(walls.size());
-  for (const auto& w : walls) put_wall(out, w);
+  for (const auto& w : walls) {
+    put_shape(out, w.shape);
+    wall_fields(out, w);
+  }
   out.put(domain);
   out.put(gravity);
   out.put(dt);
@@ -217,7 +151,7 @@ std::string World::save_state() const {
     out.put(r.extent);
     out.put(r.valid);
   }
-  put_frames(out, clump_frames);
+  frame_fields(out, clump_frames);
   return out.take();
 }
 
@@ -236,9 +170,13 @@ void World::restore_state(std::string_view state) {
   // bounded by the bytes left, as each element takes some.
   World w = *this;
   w.pair_stride_ = laws.pair_stride;
-  get_particles(in, w.particles);
+  particle_fields(in, w.particles);
   w.walls.clear();
-  for (auto n = in.get<std::uint64_t>(); n > 0; --n) w.walls.push_back(get_wall(in));
+  for (auto n = in.get<std::uint64_t>(); n > 0; --n) {
+    walls::Wall& wall = w.walls.emplace_back();
+    wall.shape = get_shape(in);
+    wall_fields(in, wall);
+  }
   in.get(w.domain);
   in.get(w.gravity);
   in.get(w.dt);
@@ -262,7 +200,8 @@ void World::restore_state(std::string_view state) {
     in.get(r.extent);
     in.get(r.valid);
   }
-  get_frames(in, w.clump_frames);
+  frame_fields(in, w.clump_frames);
+  w.clump_frames.q_mid.resize(w.clump_frames.q.size());
   in.expect_end();
   if (const std::string why = w.state_mismatch(); !why.empty()) throw InputError("checkpoint", why);
   w.deferred.clear();

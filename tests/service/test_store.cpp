@@ -133,6 +133,30 @@ TEST(Store, LeasesInRunOrderAndStoresAResultExactlyOnce) {
   EXPECT_EQ(s.campaign(id)->state, "done");
 }
 
+TEST(Store, KeepsTheLatestCheckpointOfTheLeaseHolderUntilTheResultIsStored) {
+  Store s(":memory:", {10.0, 3});
+  s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  const auto a = s.lease("w1", 0.0);
+  const std::string state("\0binary\xff", 9);
+  EXPECT_EQ(s.save_checkpoint(a->id, 1, "intruder", "bed", state, 1.0), kNotHolder);
+  EXPECT_FALSE(s.checkpoint(a->id));
+  EXPECT_EQ(s.save_checkpoint(a->id, 1, "w1", "bed", "old", 1.0), kOk);
+  EXPECT_EQ(s.save_checkpoint(a->id, 1, "w1", "bed", state, 2.0), kOk);
+  // The lease lapses: the next one is handed the latest checkpoint, bytes intact; the lapsed
+  // lease can no longer replace it.
+  EXPECT_EQ(s.reap(20.0), 1);
+  EXPECT_EQ(s.save_checkpoint(a->id, 1, "w1", "bed", "late", 20.5), kStale);
+  const auto b = s.lease("w2", 21.0);
+  ASSERT_TRUE(b);
+  const auto kept = s.checkpoint(b->id);
+  ASSERT_TRUE(kept);
+  EXPECT_EQ(kept->stage, "bed");
+  EXPECT_EQ(kept->state, state);
+  EXPECT_EQ(kept->attempt, 1);
+  EXPECT_EQ(s.complete(b->id, 2, "w2", "{}", 0.5, 22.0), kOk);
+  EXPECT_FALSE(s.checkpoint(b->id));
+}
+
 TEST(Store, KeepsTheFlagsAndTheCostOfAResult) {
   Store s(":memory:");
   s.create_campaign("c", "{}", "{}", jobs(2), 0.0);
@@ -404,7 +428,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 6);
+    EXPECT_EQ(Store::latest_schema_version(), 7);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
