@@ -19,10 +19,10 @@ namespace {
 
 constexpr std::string_view kPrefix = "diagnose:";
 
-/// An option: `fallback` when unset (0), else `v` if lo < v <= hi.
 /// Lab seeds per verification at most: each multiplies the diagnosis's verification runs.
 constexpr int kMaxReplicates = 16;
 
+/// An option: `fallback` when unset (0), else `v` if lo < v <= hi.
 double option(double v, double fallback, double lo, double hi, const std::string& field) {
   if (v == 0.0) return fallback;
   if (!(v > lo && v <= hi))

@@ -351,11 +351,12 @@ grpc::Status WorkerServiceImpl::Lease(grpc::ServerContext* ctx, const v1::LeaseR
   spec.set_job_id(job->id);
   spec.set_attempt(job->attempt);
   spec.set_campaign_id(job->campaign_id);
-  if (auto checkpoint = store_.checkpoint(job->id)) {
+  // A checkpoint comes from an earlier lease of the job: a first lease has none to look up.
+  if (auto checkpoint = job->attempt > 1 ? store_.checkpoint(job->id) : std::nullopt) {
     spec.set_checkpoint_stage(checkpoint->stage);
     spec.set_checkpoint_state(std::move(checkpoint->state));
   }
-  *reply->mutable_job() = spec;
+  *reply->mutable_job() = std::move(spec);
   spdlog::info("job {} ({} run {}) leased to {} (attempt {})", job->id, job->test, job->std_order,
                req->worker(), job->attempt);
   return grpc::Status::OK;

@@ -116,7 +116,7 @@ int job_threads(const v1::JobSpec& job, int worker_threads) {
 }
 
 /// Sends a checkpoint the job offers (stage, its record) to the coordinator.
-using CheckpointSender = std::function<void(const std::string&, const std::string&)>;
+using CheckpointSender = std::function<void(const std::string&, std::string)>;
 
 /// Runs the job's lab test, from the checkpoint the lease carries if any: one that this build
 /// cannot go on from (another format, a stage the test never reaches) is set aside with a
@@ -157,7 +157,7 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
       send_checkpoint(stage, record());
       last = Clock::now();
     };
-    const lab::LabOutput out = run_lab(job, ro);
+    const lab::LabOutput out = run_lab(job, std::move(ro));
     o.ok = true;
     o.metrics = out.metrics;
     o.flags = out.flags;
@@ -323,8 +323,8 @@ class Worker {
         [this, job, threads = opt_.threads, &progress, &job_stop] {
           return run_job(
               job, threads, progress, job_stop,
-              [this, &job](const std::string& stage, const std::string& state) {
-                send_checkpoint(job, stage, state);
+              [this, &job](const std::string& stage, std::string state) {
+                send_checkpoint(job, stage, std::move(state));
               },
               opt_.checkpoint_seconds);
         });
@@ -417,17 +417,18 @@ class Worker {
   }
 
   /// One try: a checkpoint that does not arrive costs only the time it would have saved.
-  void send_checkpoint(const v1::JobSpec& job, const std::string& stage, const std::string& state) {
+  void send_checkpoint(const v1::JobSpec& job, const std::string& stage, std::string state) {
+    const std::size_t bytes = state.size();
     v1::CheckpointRequest c;
     c.set_job_id(job.job_id());
     c.set_attempt(job.attempt());
     c.set_worker(id_);
     c.set_stage(stage);
-    c.set_state(state);
+    c.set_state(std::move(state));
     v1::CheckpointReply cr;
     const auto s = stub_->Checkpoint(rpc::make_context(opt_.channel, 30).get(), c, &cr);
     if (s.ok())
-      spdlog::info("job {}: checkpoint '{}' sent ({} bytes)", job.job_id(), stage, state.size());
+      spdlog::info("job {}: checkpoint '{}' sent ({} bytes)", job.job_id(), stage, bytes);
     else
       spdlog::warn("job {}: checkpoint '{}' not kept: {}", job.job_id(), stage, s.error_message());
   }

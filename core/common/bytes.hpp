@@ -64,7 +64,7 @@ class ByteReader {
   void get(std::vector<T>& values) {
     static_assert(std::is_trivially_copyable_v<T>);
     const auto n = get<std::uint64_t>();
-    if (n > left() / (sizeof(T) ? sizeof(T) : 1)) short_of(n * sizeof(T));
+    if (n > left() / sizeof(T)) short_of(n * sizeof(T));
     values.resize(n);
     if (n) std::memcpy(values.data(), take(n * sizeof(T)), n * sizeof(T));
   }

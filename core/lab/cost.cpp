@@ -3,31 +3,10 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/common/bytes.hpp"
 #include "core/sim/time_step.hpp"
 #include "core/sim/world.hpp"
 
 namespace demcal::lab {
-
-void put_phase(ByteWriter& out, const PhaseCost& phase) {
-  out.put(phase.name);
-  out.put(phase.target);
-  out.put(phase.steps);
-  out.put(phase.simulated_time);
-  out.put(phase.wall_seconds);
-  out.put(phase.reached);
-}
-
-PhaseCost get_phase(ByteReader& in) {
-  PhaseCost phase;
-  in.get(phase.name);
-  in.get(phase.target);
-  in.get(phase.steps);
-  in.get(phase.simulated_time);
-  in.get(phase.wall_seconds);
-  in.get(phase.reached);
-  return phase;
-}
 
 double RunCost::particle_steps_per_second() const {
   return wall_seconds > 0.0

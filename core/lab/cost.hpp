@@ -7,10 +7,6 @@
 #include <string>
 #include <vector>
 
-namespace demcal {
-class ByteWriter;
-class ByteReader;
-}  // namespace demcal
 namespace demcal::sim {
 class World;
 }
@@ -57,9 +53,17 @@ class PhaseClock {
   std::chrono::steady_clock::time_point wall0_;
 };
 
-/// A phase's cost in a checkpoint record, and back.
-void put_phase(ByteWriter& out, const PhaseCost& phase);
-PhaseCost get_phase(ByteReader& in);
+/// A phase's cost in a checkpoint record: its fields handed to `a.field` in record order
+/// (ByteWriter to save, ByteReader to restore; core/common/bytes.hpp).
+template <class A, class P>
+void phase_fields(A& a, P& phase) {
+  a.field(phase.name);
+  a.field(phase.target);
+  a.field(phase.steps);
+  a.field(phase.simulated_time);
+  a.field(phase.wall_seconds);
+  a.field(phase.reached);
+}
 
 /// "15 kPa" style text of a stress in Pa, for phase targets.
 std::string stress_text(double pa);

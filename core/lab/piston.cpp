@@ -186,17 +186,23 @@ namespace {
 
 constexpr const char* kPistonBedStage = "piston bed";
 
+/// What a piston bed keeps beside its world, handed to `a.field` in record order.
+template <class A, class B>
+void bed_fields(A& a, B& b) {
+  a.field(b.piston);
+  a.field(b.radius);
+  a.field(b.area);
+  a.field(b.h0);
+  a.field(b.limits);
+  phase_fields(a, b.filled);
+  phase_fields(a, b.built.prepared);
+  phase_fields(a, b.built.settled);
+}
+
 std::string piston_bed_record(const PistonBed& b) {
   ByteWriter out;
   out.put(b.world.save_state());
-  out.put<std::uint64_t>(b.piston);
-  out.put(b.radius);
-  out.put(b.area);
-  out.put(b.h0);
-  out.put(b.limits);
-  put_phase(out, b.filled);
-  put_phase(out, b.built.prepared);
-  put_phase(out, b.built.settled);
+  bed_fields(out, b);
   return out.take();
 }
 
@@ -210,14 +216,7 @@ PistonBed resumed_piston_bed(const MaterialModel& material, const RunOptions& op
   std::string world;
   in.get(world);
   b.world.restore_state(world);
-  b.piston = in.get<std::uint64_t>();
-  in.get(b.radius);
-  in.get(b.area);
-  in.get(b.h0);
-  in.get(b.limits);
-  b.filled = get_phase(in);
-  b.built.prepared = get_phase(in);
-  b.built.settled = get_phase(in);
+  bed_fields(in, b);
   in.expect_end();
   if (b.piston >= b.world.walls.size() ||
       !std::holds_alternative<walls::Disk>(b.world.walls[b.piston].shape))

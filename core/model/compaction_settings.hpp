@@ -54,8 +54,6 @@ struct CompactionSettings {
   }
 };
 
-LabTestInfo compaction_info();  ///< in catalog.cpp
-
 /// The compaction lab test (seed 004 §2.3-2.4, §3.1): its catalogue entry here, its runner in
 /// core/lab/compaction.cpp.
 struct CompactionTest {

@@ -38,8 +38,6 @@ struct ConfinedCompressionSettings : PistonServoSettings {
   }
 };
 
-LabTestInfo confined_compression_info();  ///< in catalog.cpp
-
 /// The confined_compression lab test (seed 000 §2.7.2, eq. 31-33; seed 001 §3.2.1, eq. 19): its
 /// catalogue entry here, its runner in core/lab/confined_compression.cpp.
 struct ConfinedCompressionTest {

@@ -38,8 +38,6 @@ struct HopperSettings {
   void finalize(const std::string&) {}
 };
 
-LabTestInfo hopper_info();  ///< in catalog.cpp
-
 /// The hopper lab test (seed 000 §2.7.6): its catalogue entry here, its runner in
 /// core/lab/hopper.cpp.
 struct HopperTest {

@@ -32,8 +32,6 @@ struct PackingSettings {
   void finalize(const std::string&) {}
 };
 
-LabTestInfo packing_info();  ///< in catalog.cpp
-
 /// The packing lab test (seed 000 §2.7.1, §3.1): its catalogue entry here, its runner in
 /// core/lab/packing.cpp.
 struct PackingTest {

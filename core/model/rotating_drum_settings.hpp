@@ -79,8 +79,6 @@ DrumBed drum_bed(const RotatingDrumSettings& s, const particles::SizeDistributio
 /// The drum speed as written in phase names ("4", "105", "2.5").
 std::string drum_rpm_label(double rpm);
 
-LabTestInfo rotating_drum_info();  ///< in catalog.cpp
-
 /// The rotating_drum lab test (seed 001 §3.2.2-3.2.3, eq. 20): its catalogue entry here, its runner
 /// in core/lab/rotating_drum.cpp.
 struct RotatingDrumTest {

@@ -63,8 +63,6 @@ struct ShearCellSettings {
   void finalize(const std::string&) {}
 };
 
-LabTestInfo shear_cell_info();  ///< in catalog.cpp
-
 /// The shear_cell lab test (seed 000 §2.7.4, Table 3, Fig. 12 and 23): its catalogue entry here,
 /// its runner in core/lab/shear_cell.cpp.
 struct ShearCellTest {

@@ -50,8 +50,6 @@ double wall_hamaker_ratio_eq34(double r_real_um);
 /// Seed 000 eq. 35: k2,wall / k2 = 10 + 5 (r_real - 5) / 45, r_real in um (clamped likewise).
 double wall_k2_ratio_eq35(double r_real_um);
 
-LabTestInfo tensile_info();  ///< in catalog.cpp
-
 /// The tensile lab test (seed 000 §2.7.3, eq. 34-35): its catalogue entry here, its runner in
 /// core/lab/tensile.cpp.
 struct TensileTest {

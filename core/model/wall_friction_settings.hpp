@@ -56,8 +56,6 @@ double slope_through_origin(const std::vector<double>& x, const std::vector<doub
 double two_point_calibration(double mu_a, double phi_a, double mu_b, double phi_b,
                              double phi_target);
 
-LabTestInfo wall_friction_info();  ///< in catalog.cpp
-
 /// The wall_friction lab test (seed 000 §2.7.5, §3.3.4): its catalogue entry here, its runner in
 /// core/lab/wall_friction.cpp.
 struct WallFrictionTest {

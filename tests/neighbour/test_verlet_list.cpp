@@ -62,7 +62,9 @@ void expect_rows_sorted_above_the_diagonal(const VerletList& list) {
   for (std::size_t i = 0; i + 1 < list.row_start.size(); ++i)
     for (int k = list.row_start[i]; k < list.row_start[i + 1]; ++k) {
       EXPECT_GT(list.nbr[k], static_cast<int>(i));
-      if (k > list.row_start[i]) EXPECT_LT(list.nbr[k - 1], list.nbr[k]);
+      if (k > list.row_start[i]) {
+        EXPECT_LT(list.nbr[k - 1], list.nbr[k]);
+      }
     }
 }
 
