@@ -1,10 +1,19 @@
 #pragma once
 // A flat binary record of plain values, for the state a checkpoint carries (sim::World's
-// save_state). Values are written as their bytes on this machine: a record is read back by the
-// same build on the same kind of machine (a worker resuming a job), not exchanged between
-// platforms. Reading checks every length against what is left and names what is short.
+// save_state, the stages of a lab test). Values are written as their bytes on this machine: a
+// record is read back by the same build on the same kind of machine (a worker resuming a job),
+// not exchanged between platforms. Reading checks every length against what is left and names
+// what is short.
+//
+// field() is the one name both directions use, so that one function listing a record's fields
+// serves saving and restoring: plain values and vectors of them as their bytes, strings, vectors
+// and maps element by element, and any other type through the function `record_fields(a, value)`
+// found beside the type (one template for a ByteWriter and a ByteReader, `value` const or not:
+// declare it with RecordOf).
+#include <concepts>
 #include <cstdint>
 #include <cstring>
+#include <map>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -13,6 +22,10 @@
 #include "core/common/error.hpp"
 
 namespace demcal {
+
+/// `P` is `T` or `const T`: the value parameter of a record_fields overload for T.
+template <class P, class T>
+concept RecordOf = std::same_as<std::remove_const_t<P>, T>;
 
 class ByteWriter {
  public:
@@ -32,11 +45,30 @@ class ByteWriter {
     put<std::uint64_t>(text.size());
     bytes_.append(text);
   }
-  /// put() under the name ByteReader reads with, so that one function listing a record's
-  /// fields serves both directions.
   template <class T>
   void field(const T& value) {
-    put(value);
+    if constexpr (std::is_trivially_copyable_v<T>)
+      put(value);
+    else
+      record_fields(*this, value);
+  }
+  void field(const std::string& text) { put(text); }
+  template <class T>
+  void field(const std::vector<T>& values) {
+    if constexpr (std::is_trivially_copyable_v<T>) {
+      put(values);
+    } else {
+      put<std::uint64_t>(values.size());
+      for (const T& value : values) field(value);
+    }
+  }
+  template <class K, class V>
+  void field(const std::map<K, V>& values) {
+    put<std::uint64_t>(values.size());
+    for (const auto& [key, value] : values) {
+      field(key);
+      field(value);
+    }
   }
   std::string take() { return std::move(bytes_); }
 
@@ -74,7 +106,31 @@ class ByteReader {
   }
   template <class T>
   void field(T& value) {
-    get(value);
+    if constexpr (std::is_trivially_copyable_v<T>)
+      get(value);
+    else
+      record_fields(*this, value);
+  }
+  void field(std::string& text) { get(text); }
+  template <class T>
+  void field(std::vector<T>& values) {
+    if constexpr (std::is_trivially_copyable_v<T>) {
+      get(values);
+    } else {
+      values.resize(count());
+      for (T& value : values) field(value);
+    }
+  }
+  template <class K, class V>
+  void field(std::map<K, V>& values) {
+    values.clear();
+    for (auto n = count(); n > 0; --n) {
+      K key;
+      V value;
+      field(key);
+      field(value);
+      values.insert_or_assign(std::move(key), std::move(value));
+    }
   }
   std::size_t left() const { return bytes_.size() - at_; }
   /// Throws unless every byte was read.
@@ -84,6 +140,12 @@ class ByteReader {
   }
 
  private:
+  /// The count of elements that follows, each at least one byte.
+  std::uint64_t count() {
+    const auto n = get<std::uint64_t>();
+    if (n > left()) short_of(n);
+    return n;
+  }
   const char* take(std::size_t n) {
     if (n > left()) short_of(n);
     const char* p = bytes_.data() + at_;

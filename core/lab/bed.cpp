@@ -329,11 +329,11 @@ contact::ContactLaw simulated_law(const MaterialModel& material,
 
 namespace demcal::lab {
 void write_snapshot(const sim::World& world, const RunOptions& options, const std::string& name,
-                    LabOutput& out) {
+                    LabOutput& out, double extent) {
   if (options.snapshot_dir.empty()) return;
   const std::string base = options.snapshot_dir + "/" + name;
   io::write_particles_vtk(base + "_particles.vtk", world);
-  io::write_walls_vtk(base + "_walls.vtk", world, 2.0 * die_radius(world));
+  io::write_walls_vtk(base + "_walls.vtk", world, extent > 0.0 ? extent : 2.0 * die_radius(world));
   out.snapshots.push_back(base + "_particles.vtk");
   out.snapshots.push_back(base + "_walls.vtk");
 }

@@ -121,7 +121,8 @@ contact::ContactLaw simulated_law(const MaterialModel& material,
 
 namespace demcal::lab {
 /// Writes `<dir>/<name>_particles.vtk` and `<name>_walls.vtk` when options.snapshot_dir is set
-/// and records them in out.snapshots.
+/// and records them in out.snapshots; the walls are drawn over `extent` (m; 0: the die's
+/// diameter).
 void write_snapshot(const sim::World& world, const RunOptions& options, const std::string& name,
-                    LabOutput& out);
+                    LabOutput& out, double extent = 0.0);
 }  // namespace demcal::lab

@@ -10,6 +10,7 @@
 #include "core/io/vtk.hpp"
 #include "core/lab/bed.hpp"
 #include "core/lab/lab_test.hpp"
+#include "core/lab/stages.hpp"
 #include "core/metrics/bulk.hpp"
 #include "core/metrics/stress.hpp"
 #include "core/metrics/yield_surface.hpp"
@@ -329,12 +330,9 @@ void probe_yield(const Cell& compacted, double held_pressure, const CompactionSe
   out.series["yield_paths"] = std::move(paths);
 }
 
-}  // namespace
-
-LabOutput CompactionTest::run(const MaterialModel& material, const Settings& values,
-                              const RunOptions& options) {
-  const auto s = read_settings<CompactionSettings>(values, "settings");
-  sim::World w = make_material_world(material, options);
+/// The periodic cell without gravity at phi_start, filled at random (the fill phase).
+void fill_cell(sim::World& w, const MaterialModel& material, const CompactionSettings& s,
+               const RunOptions& options, LabOutput& out) {
   w.gravity = {0.0, 0.0, 0.0};
   const auto n = static_cast<std::size_t>(s.particles);
   const double side = std::cbrt(
@@ -355,18 +353,43 @@ LabOutput CompactionTest::run(const MaterialModel& material, const Settings& val
                      "the cell at this solid fraction cannot take the particles at random (" +
                          e.message() + "); elongated clumps need a lower phi_start, e.g. 0.06");
   }
-  LabOutput out;
   out.add_phase(fill_clock.stop(w, "fill", "all particles inserted", true), {});
+}
 
-  const double t_c = sim::critical_time_step(w).critical;
-  const double rate = s.strain_rate / t_c;  // linear strain per second
-  const Cell cell{w,
-                  solid_volume(w),
-                  material.factors().stress,
-                  rate,
-                  std::max<long>(1, std::lround(0.002 / (rate * w.dt))),
-                  std::max<long>(2, std::lround(s.hold * t_c / w.dt))};
-  const metrics::Tensor3 held = compress(cell, s, options, out);
+}  // namespace
+
+LabOutput CompactionTest::run(const MaterialModel& material, const Settings& values,
+                              const RunOptions& options) {
+  const auto s = read_settings<CompactionSettings>(values, "settings");
+  LabOutput out;
+  metrics::Tensor3 held{};  // the stress held at phi_max
+  // The cell's scales, fixed once filled: its solid volume, strain rate (linear strain per
+  // second), steps between samples (0.002 of strain) and of a hold.
+  struct {
+    double solid = 0.0, rate = 0.0;
+    long sample_every = 0, hold_steps = 0;
+  } scales;
+  // The one stage: the cell compacted to phi_max (the probes start from it).
+  Stages stages(options, {"compacted"}, out, [&](auto& a) {
+    a.field(held);
+    a.field(scales);
+  });
+  sim::World w = make_material_world(material, options);
+  const bool resumed = stages.resume(w) > 0;
+  if (!resumed) {
+    fill_cell(w, material, s, options, out);
+    const double t_c = sim::critical_time_step(w).critical;
+    scales.solid = solid_volume(w);
+    scales.rate = s.strain_rate / t_c;
+    scales.sample_every = std::max<long>(1, std::lround(0.002 / (scales.rate * w.dt)));
+    scales.hold_steps = std::max<long>(2, std::lround(s.hold * t_c / w.dt));
+  }
+  const Cell cell{w,           scales.solid,        material.factors().stress,
+                  scales.rate, scales.sample_every, scales.hold_steps};
+  if (!resumed) {
+    held = compress(cell, s, options, out);
+    stages.reached(0, w);
+  }
   const double p_held = metrics::mean_stress(held);
   jamming(cell.kpa(p_held), s.phi_max, out);
   out.metrics["final_pressure"] = cell.kpa(p_held);

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "core/common/bytes.hpp"
+
 namespace demcal::sim {
 class World;
 }
@@ -55,8 +57,8 @@ class PhaseClock {
 
 /// A phase's cost in a checkpoint record: its fields handed to `a.field` in record order
 /// (ByteWriter to save, ByteReader to restore; core/common/bytes.hpp).
-template <class A, class P>
-void phase_fields(A& a, P& phase) {
+template <class A, RecordOf<PhaseCost> P>
+void record_fields(A& a, P& phase) {
   a.field(phase.name);
   a.field(phase.target);
   a.field(phase.steps);

@@ -28,8 +28,8 @@
 #include "core/common/error.hpp"
 #include "core/common/line_fit.hpp"
 #include "core/common/rng.hpp"
-#include "core/io/vtk.hpp"
 #include "core/lab/bed.hpp"
+#include "core/lab/stages.hpp"
 #include "core/metrics/bulk.hpp"
 #include "core/particles/insertion.hpp"
 #include "core/sim/step.hpp"
@@ -60,6 +60,15 @@ struct Hopper {
   double top = 0.0;             ///< width at the top of the wedge (m)
   double rho_b = 0.0;           ///< bulk density of the settled bed (kg/m^3)
 };
+
+/// What the hopper keeps beside its world, in a checkpoint record (core/lab/stages.hpp).
+template <class A, RecordOf<Hopper> H>
+void record_fields(A& a, H& hp) {
+  a.field(hp.limits);
+  for (auto* v :
+       {&hp.r_max, &hp.d, &hp.b, &hp.depth, &hp.theta, &hp.h, &hp.bin, &hp.top, &hp.rho_b})
+    a.field(*v);
+}
 
 /// Sizes the hopper for the bed (the wedge of height h holds (b + h tan) h depth of bulk; the
 /// particles, solid fraction ~0.6, fill the wedge and a little of the bin above), fills,
@@ -201,12 +210,14 @@ LabOutput HopperTest::run(const MaterialModel& material, const Settings& values,
                           const RunOptions& options) {
   const auto s = read_settings<HopperSettings>(values, "settings");
   LabOutput out;
-  Hopper hp = build_hopper(material, s, options, out);
-  if (!options.snapshot_dir.empty()) {
-    io::write_particles_vtk(options.snapshot_dir + "/hopper_settled_particles.vtk", hp.w);
-    io::write_walls_vtk(options.snapshot_dir + "/hopper_walls.vtk", hp.w, hp.top);
-    out.snapshots = {options.snapshot_dir + "/hopper_settled_particles.vtk",
-                     options.snapshot_dir + "/hopper_walls.vtk"};
+  Hopper hp;
+  // The one stage: the settled bed before the gate opens.
+  Stages stages(options, {"hopper bed"}, out, [&hp](auto& a) { a.field(hp); });
+  hp.w = make_material_world(material, options);
+  if (stages.resume(hp.w) == 0) {
+    hp = build_hopper(material, s, options, out);
+    write_snapshot(hp.w, options, "hopper_settled", out, hp.top);
+    stages.reached(0, hp.w);
   }
   Discharge dis = discharge(hp, s, options, out);
   const double rate = discharge_rate(dis);

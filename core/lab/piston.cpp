@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/common/bytes.hpp"
 #include "core/lab/run_cancelled.hpp"
 #include "core/sim/step.hpp"
 #include "core/sim/time_step.hpp"
@@ -163,16 +162,10 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
   return out;
 }
 
-void add_bed_phases(LabOutput& out, const PistonBed& bed,
-                    const std::vector<std::string>& depending) {
-  if (!bed.resumed_from.empty()) {
-    out.resumed_from = bed.resumed_from;
-    out.notes.push_back("went on from the checkpoint '" + bed.resumed_from +
-                        "': the phases up to it ran in an earlier attempt (their costs are its)");
-  }
+void add_bed_phases(LabOutput& out, const PistonBed& bed, const PistonBedRequest& request) {
   out.add_phase(bed.filled, {});
   if (bed.built.prepared.steps > 0) out.add_phase(bed.built.prepared, {});
-  out.add_phase(bed.built.settled, depending);
+  out.add_phase(bed.built.settled, request.depending);
 }
 
 void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string& name,
@@ -182,81 +175,39 @@ void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string&
   out.add_phase(cost, depending);
 }
 
-namespace {
-
-constexpr const char* kPistonBedStage = "piston bed";
-
-/// What a piston bed keeps beside its world, handed to `a.field` in record order.
-template <class A, class B>
-void bed_fields(A& a, B& b) {
-  a.field(b.piston);
-  a.field(b.radius);
-  a.field(b.area);
-  a.field(b.h0);
-  a.field(b.limits);
-  phase_fields(a, b.filled);
-  phase_fields(a, b.built.prepared);
-  phase_fields(a, b.built.settled);
-}
-
-std::string piston_bed_record(const PistonBed& b) {
-  ByteWriter out;
-  out.put(b.world.save_state());
-  bed_fields(out, b);
-  return out.take();
-}
-
-/// The bed of a checkpoint: the world the test sets up (laws, threads) with the saved state.
-PistonBed resumed_piston_bed(const MaterialModel& material, const RunOptions& options,
-                             const std::function<void(sim::World&)>& set_laws) {
-  ByteReader in(options.resume.state, "checkpoint");
-  PistonBed b;
-  b.world = make_material_world(material, options);
-  if (set_laws) set_laws(b.world);
-  std::string world;
-  in.get(world);
-  b.world.restore_state(world);
-  bed_fields(in, b);
-  in.expect_end();
-  if (b.piston >= b.world.walls.size() ||
-      !std::holds_alternative<walls::Disk>(b.world.walls[b.piston].shape))
+void check_piston(const PistonBed& bed) {
+  if (bed.piston >= bed.world.walls.size() ||
+      !std::holds_alternative<walls::Disk>(bed.world.walls[bed.piston].shape))
     throw InputError("checkpoint", "its piston is not a disk wall of its world");
-  b.resumed_from = kPistonBedStage;
-  return b;
 }
 
-}  // namespace
-
-PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, double safety,
-                          double stress_level, const RunOptions& options,
-                          const std::function<void(sim::World&)>& set_laws) {
-  if (options.resume.stage == kPistonBedStage)
-    return resumed_piston_bed(material, options, set_laws);
+PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
+                          const RunOptions& options) {
   BedSpec spec;
-  spec.particles = particles;
-  spec.time_step_safety = safety;
-  spec.rest_stress = stress_level;
+  spec.particles = request.particles;
+  spec.time_step_safety = request.safety;
+  spec.rest_stress = request.stress_level;
   PistonBed b;
   const PhaseClock fill_clock;
   b.world = make_die_world(material, spec, options);
   b.filled = fill_clock.stop(b.world, "fill", "all particles inserted", true);
   sim::World& w = b.world;
-  if (set_laws) set_laws(w);
+  if (request.set_laws) request.set_laws(w);
   // The piston shares the bottom's law; add it (far above) so the time step covers its law.
   b.radius = die_radius(w);
   b.area = M_PI * b.radius * b.radius;
   const double top = metrics_top(w);
   b.limits = die_limits(w, b.radius, top);
   b.piston = add_piston(w, 1e3 * top + 1.0);
-  w.dt = sim::adapted_time_step(w, safety);
+  w.dt = sim::adapted_time_step(w, request.safety);
   b.built = prepare_and_settle(w, material, spec, b.limits, top, options.seed);
   b.h0 = metrics_top(w);
   auto& disk = std::get<walls::Disk>(w.walls[b.piston].shape);
   disk.centre.z = b.h0;
   w.walls[b.piston].pivot = disk.centre;
   b.limits = die_limits(w, b.radius, b.h0);
-  if (options.checkpoint)
-    options.checkpoint(kPistonBedStage, [&b] { return piston_bed_record(b); });
+  if (request.stress_level > 0.0)
+    b.servo = make_servo(w, b.h0, request.stress_level, request.servo);
   return b;
 }
 

@@ -73,22 +73,75 @@ struct PistonBed {
   sim::HealthLimits limits;
   PhaseCost filled;  ///< the phases that built it
   PreparedBed built;
-  std::string resumed_from;  ///< the checkpoint stage it was restored from (empty: built)
+  /// The piston's servo at the test's largest stress (make_servo); fixed with the bed, as its
+  /// hold time is in steps of the bed's time step, which adapts as the run goes.
+  ServoSettings servo;
 };
-/// Records the bed's fill and settle phases in `out`; `depending` are the metrics read from the
-/// settled state (its height).
-void add_bed_phases(LabOutput& out, const PistonBed& bed,
-                    const std::vector<std::string>& depending);
+
+/// What a piston bed keeps beside its world, in a checkpoint record (core/lab/stages.hpp).
+template <class A, RecordOf<PistonBed> B>
+void record_fields(A& a, B& b) {
+  a.field(b.piston);
+  a.field(b.radius);
+  a.field(b.area);
+  a.field(b.h0);
+  a.field(b.limits);
+  a.field(b.filled);
+  a.field(b.built.prepared);
+  a.field(b.built.settled);
+  a.field(b.servo);
+}
+
+/// The die bed a piston test asks for.
+struct PistonBedRequest {
+  std::size_t particles = 0;
+  double safety = 0.0;  ///< time-step safety factor
+  /// The largest stress the test applies (simulated; BedSpec::rest_stress): the settling
+  /// criterion's scale.
+  double stress_level = 0.0;
+  /// The test's servo settings, for PistonBed::servo at stress_level (none when it is 0).
+  PistonServoSettings servo{};
+  /// Replaces wall laws (e.g. stiff or adhesive piston and bottom).
+  std::function<void(sim::World&)> set_laws;
+  /// The metrics read from the settled state (its height): flagged if settling fell short.
+  std::vector<std::string> depending;
+};
+
+/// Records the bed's fill and settle phases in `out`, flagging the request's `depending`.
+void add_bed_phases(LabOutput& out, const PistonBed& bed, const PistonBedRequest& request);
 /// Records a servo phase under `name`, flagging `depending` if it did not reach its target.
 void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string& name,
                      const std::vector<std::string>& depending);
-/// Builds the die world, lets `set_laws` replace wall laws (e.g. stiff or adhesive piston and
-/// bottom), sets dt = safety * critical over all laws, settles relative to `stress_level` (the
-/// largest stress the test applies, simulated; BedSpec::rest_stress), and adds the piston at the
-/// bed top. The bed is a checkpoint stage ("piston bed"): offered to options.checkpoint once
-/// built, and restored instead of built when options.resume names it.
-PistonBed make_piston_bed(const MaterialModel& material, std::size_t particles, double safety,
-                          double stress_level, const RunOptions& options,
-                          const std::function<void(sim::World&)>& set_laws);
+/// Builds the die world, lets `set_laws` replace wall laws, sets dt = safety * critical over all
+/// laws, settles relative to the stress level, adds the piston at the bed top and sets its
+/// servo.
+PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
+                          const RunOptions& options);
+
+/// The first checkpoint stage of every piston test: the settled bed with its piston.
+inline constexpr const char* kPistonBedStage = "piston bed";
+
+/// Throws naming `checkpoint` unless the bed's piston is a disk wall of its world.
+void check_piston(const PistonBed& bed);
+
+/// The start of a piston test whose stages (core/lab/stages.hpp) begin with kPistonBedStage:
+/// a run resumed from one of them gets its bed, output and fields restored; any other makes
+/// the bed, records its phases in `out` and offers the stage. Returns the index of the first
+/// stage still to reach.
+template <class S>
+std::size_t start_piston_test(S& stages, const MaterialModel& material,
+                              const PistonBedRequest& request, const RunOptions& options,
+                              PistonBed& bed, LabOutput& out) {
+  bed.world = make_material_world(material, options);
+  if (request.set_laws) request.set_laws(bed.world);
+  if (const std::size_t next = stages.resume(bed.world)) {
+    check_piston(bed);
+    return next;
+  }
+  bed = make_piston_bed(material, request, options);
+  add_bed_phases(out, bed, request);
+  stages.reached(0, bed.world);
+  return 1;
+}
 
 }  // namespace demcal::lab

@@ -22,8 +22,8 @@
 
 #include "core/common/line_fit.hpp"
 #include "core/common/rng.hpp"
-#include "core/io/vtk.hpp"
 #include "core/lab/bed.hpp"
+#include "core/lab/stages.hpp"
 #include "core/particles/insertion.hpp"
 #include "core/sim/step.hpp"
 #include "core/sim/time_step.hpp"
@@ -130,29 +130,47 @@ double DrumImage::surface_angle() const {
 LabOutput RotatingDrumTest::run(const MaterialModel& material, const Settings& values,
                                 const RunOptions& options) {
   const auto s = read_settings<RotatingDrumSettings>(values, "settings");
-  sim::World w = make_material_world(material, options);
-  w.gravity = {0, -9.81, 0};
   const auto sizes = material.simulated_sizes();
   const double r_max = particles::max_radius(sizes);
-
   require_pour(material, "rotating_drum");
   const DrumBed bed = drum_bed(s, sizes, "settings");
   const double radius = bed.radius, depth = bed.length;
-  Rng rng(options.seed);
-  add_drum_walls(w, radius, depth);
 
-  particles::InsertRequest req = material_insert_request(
-      material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth}, bed.particles);
-  const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety, kRealApparatus);
-
+  LabOutput out;
   sim::HealthLimits limits;
-  limits.lo = {-1.5 * radius, -1.5 * radius, -radius};
-  limits.hi = {1.5 * radius, 1.5 * radius, depth + radius};
-  limits.max_kinetic_energy = 1e3 * w.particles.total_mass() * 9.81 * 2.0 * radius;
-
-  BedSpec settle_spec;
-  settle_spec.max_settle_time = 1.0;
-  const PhaseCost settled = settle(w, settle_spec, limits, kRealApparatus);
+  Series angle_series{{"time", "angle_deg", "csa_occupied_percent"}, {}};
+  Series profile{{"x_m", "y_m"}, {}};  // the free surface of the last image
+  Series area{{"rpm", "rpm_simulated", "csa_occupied_percent", "centrifuging"}, {}};
+  // The stages: the settled bed, the angle measured, then each speed of the area method done.
+  std::vector<std::string> names{"drum bed", "angle"};
+  for (const int rpm : kDrumSpeeds) names.push_back("area " + std::to_string(rpm) + " rpm");
+  const double frame = 0.05;  // s between images
+  long frame_steps = 0;       // fixed once the bed has settled, in steps of that time step
+  Stages stages(options, std::move(names), out, [&](auto& a) {
+    a.field(limits);
+    a.field(frame_steps);
+    a.field(angle_series);
+    a.field(profile);
+    a.field(area);
+  });
+  sim::World w = make_material_world(material, options);
+  std::size_t next = stages.resume(w);
+  if (next == 0) {
+    w.gravity = {0, -9.81, 0};
+    Rng rng(options.seed);
+    add_drum_walls(w, radius, depth);
+    particles::InsertRequest req = material_insert_request(
+        material, particles::CylinderRegion{{0, 0, 0}, radius, 0.0, depth}, bed.particles);
+    out.add_phase(timed_fill(w, req, rng, s.time_step_safety, kRealApparatus), {});
+    limits.lo = {-1.5 * radius, -1.5 * radius, -radius};
+    limits.hi = {1.5 * radius, 1.5 * radius, depth + radius};
+    limits.max_kinetic_energy = 1e3 * w.particles.total_mass() * 9.81 * 2.0 * radius;
+    BedSpec settle_spec;
+    settle_spec.max_settle_time = 1.0;
+    out.add_phase(settle(w, settle_spec, limits, kRealApparatus), {});
+    stages.reached(0, w);
+    next = 1;
+  }
 
   // Froude scaling: Fr = w^2 R / g of the seed's drum at the seed's rpm.
   const double speed_factor =
@@ -168,12 +186,7 @@ LabOutput RotatingDrumTest::run(const MaterialModel& material, const Settings& v
   const double pixel = 0.25 * r_max;
   auto image = [&] { return project_drum(w.particles.x, w.particles.radius, radius, pixel); };
 
-  LabOutput out;
-  out.add_phase(filled, {});
-  out.add_phase(settled, {});
-  Series angle_series{{"time", "angle_deg", "csa_occupied_percent"}, {}};
-  const double frame = 0.05;  // s between images
-  const long frame_steps = std::max<long>(1, std::lround(frame / w.dt));
+  if (next == 1) frame_steps = std::max<long>(1, std::lround(frame / w.dt));
   auto run_for = [&](double seconds, const std::function<void()>& on_frame) {
     const long frames = std::max<long>(1, std::lround(seconds / frame));
     for (long f = 0; f < frames; ++f) {
@@ -184,36 +197,33 @@ LabOutput RotatingDrumTest::run(const MaterialModel& material, const Settings& v
 
   // At `rpm`: first turn the bed up to its angle (60 deg of drum rotation, 3 s at most), then
   // measure.
-  const double w_angle = set_speed(s.rpm);
-  const PhaseClock angle_clock(w);
-  run_for(std::min(60.0 * M_PI / 180.0 / w_angle, 3.0), {});
-  double angle_sum = 0.0;
-  int angle_n = 0;
-  Series profile{{"x_m", "y_m"}, {}};  // the free surface of the last image
-  run_for(s.angle_time, [&] {
-    const DrumImage img = image();
-    const double a = img.surface_angle();
-    angle_series.rows.push_back({w.time, a, img.occupied_percent()});
-    profile.rows.clear();
-    for (const auto& [x, y] : img.surface()) profile.rows.push_back({x, y});
-    if (angle_series.rows.size() * 2 > static_cast<std::size_t>(s.angle_time / frame)) {
-      angle_sum += a;
-      ++angle_n;
-    }
-  });
-  out.metrics["dynamic_angle_of_repose"] = angle_n ? angle_sum / angle_n : 0.0;
-  out.add_phase(angle_clock.stop(w, drum_rpm_label(s.rpm) + " rpm", "angle_time of turning", true),
-                {});
-  if (options.progress) options.progress(0.4);
-  if (!options.snapshot_dir.empty()) {
-    const std::string p = options.snapshot_dir + "/drum_4rpm_particles.vtk";
-    io::write_particles_vtk(p, w);
-    io::write_walls_vtk(options.snapshot_dir + "/drum_walls.vtk", w, radius);
-    out.snapshots = {p, options.snapshot_dir + "/drum_walls.vtk"};
+  if (next == 1) {
+    const double w_angle = set_speed(s.rpm);
+    const PhaseClock angle_clock(w);
+    run_for(std::min(60.0 * M_PI / 180.0 / w_angle, 3.0), {});
+    double angle_sum = 0.0;
+    int angle_n = 0;
+    run_for(s.angle_time, [&] {
+      const DrumImage img = image();
+      const double a = img.surface_angle();
+      angle_series.rows.push_back({w.time, a, img.occupied_percent()});
+      profile.rows.clear();
+      for (const auto& [x, y] : img.surface()) profile.rows.push_back({x, y});
+      if (angle_series.rows.size() * 2 > static_cast<std::size_t>(s.angle_time / frame)) {
+        angle_sum += a;
+        ++angle_n;
+      }
+    });
+    out.metrics["dynamic_angle_of_repose"] = angle_n ? angle_sum / angle_n : 0.0;
+    out.add_phase(
+        angle_clock.stop(w, drum_rpm_label(s.rpm) + " rpm", "angle_time of turning", true), {});
+    if (options.progress) options.progress(0.4);
+    write_snapshot(w, options, "drum_angle", out, radius);
+    stages.reached(1, w);
+    next = 2;
   }
 
-  Series area{{"rpm", "rpm_simulated", "csa_occupied_percent", "centrifuging"}, {}};
-  for (std::size_t k = 0; k < kDrumSpeeds.size(); ++k) {
+  for (std::size_t k = next - 2; k < kDrumSpeeds.size(); ++k) {
     const int rpm = kDrumSpeeds[k];
     const double omega = set_speed(rpm);
     const PhaseClock rpm_clock(w);
@@ -236,6 +246,7 @@ LabOutput RotatingDrumTest::run(const MaterialModel& material, const Settings& v
     if (options.progress)
       options.progress(0.4 +
                        0.6 * static_cast<double>(k + 1) / static_cast<double>(kDrumSpeeds.size()));
+    stages.reached(k + 2, w);
   }
   out.metrics["drum_diameter"] = 2.0 * radius;
   out.metrics["drum_diameter_ratio"] = bed.diameter_ratio;

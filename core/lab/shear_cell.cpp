@@ -27,8 +27,8 @@
 
 #include "core/common/line_fit.hpp"
 #include "core/common/rng.hpp"
-#include "core/io/vtk.hpp"
 #include "core/lab/bed.hpp"
+#include "core/lab/stages.hpp"
 #include "core/metrics/bulk.hpp"
 #include "core/particles/insertion.hpp"
 #include "core/sim/step.hpp"
@@ -151,14 +151,34 @@ struct ShearCell {
   }
 };
 
+/// What the cell keeps beside its world, in a checkpoint record (core/lab/stages.hpp).
+template <class A, RecordOf<ShearCell> C>
+void record_fields(A& a, C& c) {
+  a.field(c.limits);
+  a.field(c.servo);
+  a.field(c.d);
+  a.field(c.radius);
+  a.field(c.r_head);
+  a.field(c.real_kpa);
+  a.field(c.sigma_pre);
+  a.field(c.omega);
+}
+
+/// The world of the cell as the test sets it up: the material's laws, the vessel's and floor's.
+sim::World cell_world(const MaterialModel& material, const ShearCellSettings& s,
+                      const RunOptions& options) {
+  sim::World w = make_material_world(material, options);
+  set_cell_wall_laws(w, material, s);
+  return w;
+}
+
 /// Fills the vessel, settles the bed and hangs the head over it, its vanes in the bed's top;
 /// records the fill and settle phases.
 ShearCell build_cell(const MaterialModel& material, const ShearCellSettings& s,
                      const RunOptions& options, LabOutput& out) {
   ShearCell c;
   sim::World& w = c.w;
-  w = make_material_world(material, options);
-  set_cell_wall_laws(w, material, s);
+  w = cell_world(material, s, options);
   const auto sizes = material.simulated_sizes();
   c.d = 2.0 * particles::max_radius(sizes);
   Rng rng(options.seed);
@@ -282,13 +302,14 @@ struct YieldStep {
   bool yielded = false;  ///< the tips moved 1.5 diameters within the time
 };
 
-/// One shear step from a copy of the pre-sheared cell: re-consolidated at sigma_pre, reduced to
-/// sigma_x, then sheared under torque control, the set torque ramped to twice the pre-shear
-/// torque; the yield point is the peak of the shear stress averaged over the time the tips need
-/// for 0.5 d at full speed (a shorter mean would pick up contact noise, not the bed's strength).
-YieldStep shear_step(ShearCell& c, const sim::World& restart, double step_kpa,
+/// One shear step (phase `name`) from a copy of the pre-sheared cell: re-consolidated at sigma_pre,
+/// reduced to sigma_x, then sheared under torque control, the set torque ramped to twice the
+/// pre-shear torque; the yield point is the peak of the shear stress averaged over the time the
+/// tips need for 0.5 d at full speed (a shorter mean would pick up contact noise, not the bed's
+/// strength).
+YieldStep shear_step(ShearCell& c, const std::string& name, double step_kpa,
                      const ShearCellSettings& s, double tau_pre, LabOutput& out) {
-  sim::World v = restart;
+  sim::World v = c.w;
   const PhaseClock step_clock(v);
   YieldStep y;
   y.sigma_x = step_kpa * c.real_kpa * s.stress_scale;
@@ -317,10 +338,8 @@ YieldStep shear_step(ShearCell& c, const sim::World& restart, double step_kpa,
                 return angle * c.r_head < 1.5 * c.d;  // yielded: the tips moved 1.5 diameters
               });
   y.yielded = angle * c.r_head >= 1.5 * c.d;
-  char step_name[64];
-  std::snprintf(step_name, sizeof step_name, "shear step %g kPa", step_kpa);
   out.add_phase(
-      step_clock.stop(v, step_name, "yield: tips moved 1.5 diameters within the time", y.yielded),
+      step_clock.stop(v, name, "yield: tips moved 1.5 diameters within the time", y.yielded),
       {"yield_locus_slope", "yield_locus_intercept", "ffc", "effective_friction_angle",
        "mohr_consistent", "unconfined_yield_strength", "major_consolidation_stress"});
   return y;
@@ -333,28 +352,45 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
   require_pour(material, "shear_cell");
   const auto s = read_settings<ShearCellSettings>(values, "settings");
   LabOutput out;
-  ShearCell c = build_cell(material, s, options, out);
-  const PreShear pre = pre_shear(c, s, options, out);
-  if (!options.snapshot_dir.empty()) {
-    io::write_particles_vtk(options.snapshot_dir + "/shear_cell_preshear_particles.vtk", c.w);
-    io::write_walls_vtk(options.snapshot_dir + "/shear_cell_walls.vtk", c.w, c.radius);
-    out.snapshots = {options.snapshot_dir + "/shear_cell_preshear_particles.vtk",
-                     options.snapshot_dir + "/shear_cell_walls.vtk"};
-  }
-  // The shear steps, each from the pre-sheared state; the locus uses the normal stress measured
-  // on the floor at the yield point.
-  const sim::World restart = c.w;
+  ShearCell c;
+  PreShear pre;
   Series points{{"sigma_x_kpa", "sigma_measured_kpa", "yield_shear_stress_kpa"}, {}};
   LineFit locus;
   std::vector<double> ys;
-  for (std::size_t k = 0; k < kShearNormalKPa.size(); ++k) {
-    const YieldStep y = shear_step(c, restart, kShearNormalKPa[k], s, pre.tau, out);
+  // The stages: the pre-sheared cell, then each shear step done.
+  std::vector<std::string> names{"pre-shear"};
+  for (const double kpa : kShearNormalKPa) {
+    char name[64];
+    std::snprintf(name, sizeof name, "shear step %g kPa", kpa);
+    names.emplace_back(name);
+  }
+  Stages stages(options, std::move(names), out, [&](auto& a) {
+    a.field(c);
+    a.field(pre);
+    a.field(points);
+    a.field(locus);
+    a.field(ys);
+  });
+  c.w = cell_world(material, s, options);
+  std::size_t next = stages.resume(c.w);
+  if (next == 0) {
+    c = build_cell(material, s, options, out);
+    pre = pre_shear(c, s, options, out);
+    write_snapshot(c.w, options, "shear_cell_preshear", out, c.radius);
+    stages.reached(0, c.w);
+    next = 1;
+  }
+  // The shear steps, each from the pre-sheared state (c.w, left as it is); the locus uses the
+  // normal stress measured on the floor at the yield point.
+  for (std::size_t k = next - 1; k < kShearNormalKPa.size(); ++k) {
+    const YieldStep y = shear_step(c, stages.name(k + 1), kShearNormalKPa[k], s, pre.tau, out);
     points.rows.push_back({y.sigma_x / c.real_kpa, y.sigma / c.real_kpa, y.tau / c.real_kpa});
     locus.add(y.sigma / c.real_kpa, y.tau / c.real_kpa);
     ys.push_back(y.tau / c.real_kpa);
     if (options.progress)
       options.progress(0.4 + 0.6 * static_cast<double>(k + 1) /
                                  static_cast<double>(kShearNormalKPa.size()));
+    stages.reached(k + 1, c.w);
   }
   // The yield locus: least squares tau = slope sigma + intercept through the yield points (kPa).
   const MohrResult mohr = mohr_evaluation(locus.slope(), locus.intercept(),

@@ -11,6 +11,7 @@
 
 #include "core/lab/lab_test.hpp"
 #include "core/lab/piston.hpp"
+#include "core/lab/stages.hpp"
 #include "core/model/tensile_settings.hpp"
 
 namespace demcal::lab {
@@ -70,29 +71,50 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   const auto adhesive_law = simulated_law(material, adhesive);
   const auto die_law = simulated_law(material, die);
 
-  PistonBed bed =
-      make_piston_bed(material, static_cast<std::size_t>(s.particles), s.time_step_safety,
-                      s.consolidation_stress * fs, options, [&](sim::World& w) {
-                        w.set_wall_law(kWallPiston, 0, adhesive_law);
-                        w.set_wall_law(kWallBottom, 0, adhesive_law);
-                        w.set_wall_law(kWallDie, 0, die_law);
-                      });
-  sim::World& w = bed.world;
+  PistonBedRequest request;
+  request.particles = static_cast<std::size_t>(s.particles);
+  request.safety = s.time_step_safety;
+  request.servo = s;
+  request.stress_level = s.consolidation_stress * fs;
+  request.set_laws = [&](sim::World& w) {
+    w.set_wall_law(kWallPiston, 0, adhesive_law);
+    w.set_wall_law(kWallBottom, 0, adhesive_law);
+    w.set_wall_law(kWallDie, 0, die_law);
+  };
   LabOutput out;
-  add_bed_phases(out, bed, {});
-  const ServoSettings servo = make_servo(w, bed.h0, s.consolidation_stress * fs, s);
-  auto phase = [&](double target_real) {
+  PistonBed bed;
+  // The heights the servo phases ended at, and whether the consolidation reached its stress.
+  struct Loaded {
+    double consolidated_z = 0.0, unloaded_z = 0.0;
+    bool consolidated = false;
+  } loaded;
+  Stages stages(options, {kPistonBedStage, "consolidate", "unload"}, out, [&](auto& a) {
+    a.field(bed);
+    a.field(loaded);
+  });
+  const std::size_t next = start_piston_test(stages, material, request, options, bed, out);
+  sim::World& w = bed.world;
+  const ServoSettings& servo = bed.servo;
+  auto phase = [&](std::size_t stage, double target_real) {
     ServoSettings ps = servo;
     ps.tolerance = std::max(servo.tolerance * target_real, 2e-3 * s.consolidation_stress) * fs;
-    return servo_phase(w, bed.piston, bed.piston, {0, 0, -1}, bed.area, target_real * fs, ps,
-                       bed.limits);
+    const ServoPhase r = servo_phase(w, bed.piston, bed.piston, {0, 0, -1}, bed.area,
+                                     target_real * fs, ps, bed.limits);
+    add_servo_phase(out, r, stages.name(stage), {"tensile_strength"});
+    return r;
   };
-  const ServoPhase consolidated = phase(s.consolidation_stress);
-  add_servo_phase(out, consolidated, "consolidate", {"tensile_strength"});
-  const ServoPhase unloaded = phase(s.unload_stress);
-  add_servo_phase(out, unloaded, "unload", {"tensile_strength"});
-  if (options.progress) options.progress(0.5);
-  write_snapshot(w, options, "consolidated", out);
+  if (next <= 1) {
+    const ServoPhase consolidated = phase(1, s.consolidation_stress);
+    loaded.consolidated_z = consolidated.position;
+    loaded.consolidated = consolidated.reached;
+    stages.reached(1, w);
+  }
+  if (next <= 2) {
+    loaded.unloaded_z = phase(2, s.unload_stress).position;
+    if (options.progress) options.progress(0.5);
+    write_snapshot(w, options, "consolidated", out);
+    stages.reached(2, w);
+  }
 
   // Pull-off at constant speed.
   const auto& p = w.particles;
@@ -101,7 +123,7 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   d_mean /= static_cast<double>(p.size());
   const double v = s.pull_speed > 0.0 ? s.pull_speed : 0.5 * servo.max_speed;
   const double travel = s.pull_distance * d_mean;
-  const double h_start = unloaded.position;
+  const double h_start = loaded.unloaded_z;
   auto& piston = w.walls[bed.piston];
   piston.velocity = {0, 0, v};
   Series series{{"time_s", "displacement_m", "strain", "tensile_stress_kPa"}, {}};
@@ -152,8 +174,8 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   out.series["fracture"] = Series{
       {"peak_stress_kPa", "peak_strain", "stuck_weight_stress_kPa", "consolidated_height_m",
        "unloaded_height_m", "consolidation_reached", "wall_hamaker_factor", "wall_k2_factor"},
-      {{peak / fs / 1e3, peak_strain, stuck_stress / fs / 1e3, consolidated.position,
-        unloaded.position, consolidated.reached ? 1.0 : 0.0, f_ah, f_k2}}};
+      {{peak / fs / 1e3, peak_strain, stuck_stress / fs / 1e3, loaded.consolidated_z,
+        loaded.unloaded_z, loaded.consolidated ? 1.0 : 0.0, f_ah, f_k2}}};
   out.cost.close(w);
   return out;
 }

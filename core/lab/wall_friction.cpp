@@ -11,6 +11,7 @@
 
 #include "core/lab/lab_test.hpp"
 #include "core/lab/piston.hpp"
+#include "core/lab/stages.hpp"
 #include "core/model/wall_friction_settings.hpp"
 
 namespace demcal::lab {
@@ -38,18 +39,33 @@ LabOutput WallFrictionTest::run(const MaterialModel& material, const Settings& v
   bottom_spec.tangential.params["mu_s"] = s.bottom_friction;
   const auto piston_law = simulated_law(material, piston_spec);
   const auto bottom_law = simulated_law(material, bottom_spec);
-  PistonBed bed = make_piston_bed(
-      material, static_cast<std::size_t>(s.particles), s.time_step_safety,
-      wall_friction_stresses().back() * s.stress_factor * fs, options, [&](sim::World& w) {
-        w.set_wall_law(kWallPiston, 0, piston_law);
-        w.set_wall_law(kWallBottom, 0, bottom_law);
-      });
-  sim::World& w = bed.world;
-  LabOutput out;
-  add_bed_phases(out, bed, {});
   const auto& stresses = wall_friction_stresses();
-  const double s_max = stresses.back() * s.stress_factor * fs;
-  const ServoSettings servo = make_servo(w, bed.h0, s_max, s);
+  PistonBedRequest request;
+  request.particles = static_cast<std::size_t>(s.particles);
+  request.safety = s.time_step_safety;
+  request.servo = s;
+  request.stress_level = stresses.back() * s.stress_factor * fs;
+  request.set_laws = [&](sim::World& w) {
+    w.set_wall_law(kWallPiston, 0, piston_law);
+    w.set_wall_law(kWallBottom, 0, bottom_law);
+  };
+  // The stages: the bed, then each normal stress once turned.
+  std::vector<std::string> names{kPistonBedStage};
+  for (double sigma_real : stresses)
+    names.push_back("turn " + stress_text(sigma_real * s.stress_factor));
+  LabOutput out;
+  PistonBed bed;
+  Series series{{"normal_stress_kPa", "shear_stress_kPa", "torque_Nm", "measured_normal_kPa"}, {}};
+  std::vector<double> sig, tau;  // the measured (normal, shear) pairs so far
+  Stages stages(options, std::move(names), out, [&](auto& a) {
+    a.field(bed);
+    a.field(series);
+    a.field(sig);
+    a.field(tau);
+  });
+  const std::size_t next = start_piston_test(stages, material, request, options, bed, out);
+  sim::World& w = bed.world;
+  const ServoSettings& servo = bed.servo;
   double d_mean = 0.0;
   for (double r : w.particles.radius) d_mean += 2.0 * r;
   d_mean /= static_cast<double>(w.particles.size());
@@ -60,13 +76,11 @@ LabOutput WallFrictionTest::run(const MaterialModel& material, const Settings& v
   const std::size_t bottom = 0;
   const double floor_z = std::get<walls::Plane>(w.walls[bottom].shape).point.z;
 
-  Series series{{"normal_stress_kPa", "shear_stress_kPa", "torque_Nm", "measured_normal_kPa"}, {}};
-  std::vector<double> sig, tau;
-  int k = 0;
-  for (double sigma_real : stresses) {
+  for (std::size_t k = next - 1; k < stresses.size(); ++k) {
+    const double sigma_real = stresses[k];
     const double target = sigma_real * s.stress_factor * fs;
     ServoSettings ps = servo;
-    ps.tolerance = std::max(servo.tolerance * target, 2e-3 * s_max);
+    ps.tolerance = std::max(servo.tolerance * target, 2e-3 * request.stress_level);
     // A turn can jam the bed between the piston and the die: the stress then stays above the
     // target however far the bottom sinks, and the loose powder would fall with it. The bottom
     // stops at the floor; the measured stress, not the target, enters the regression.
@@ -95,7 +109,7 @@ LabOutput WallFrictionTest::run(const MaterialModel& material, const Settings& v
           n_sum += 1.0;
         },
         1);
-    add_servo_phase(out, turned, "turn " + at, {});
+    add_servo_phase(out, turned, stages.name(k + 1), {});
     piston.omega = {};
     const double torque = t_sum / n_sum;
     const double t = shear_stress_from_torque(torque, bed.radius);
@@ -103,7 +117,9 @@ LabOutput WallFrictionTest::run(const MaterialModel& material, const Settings& v
     tau.push_back(t / fs);
     series.rows.push_back(
         {sigma_real * s.stress_factor / 1e3, t / fs / 1e3, torque, s_sum / n_sum / fs / 1e3});
-    if (options.progress) options.progress(++k / static_cast<double>(stresses.size()));
+    if (options.progress)
+      options.progress(static_cast<double>(k + 1) / static_cast<double>(stresses.size()));
+    stages.reached(k + 1, w);
   }
   write_snapshot(w, options, "final", out);
   // Regression through the origin on the measured (normal, shear) pairs (seed 000 §2.7.5).

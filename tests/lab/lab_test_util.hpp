@@ -2,6 +2,7 @@
 // Small materials for the lab-test tests: soft Luding spheres of 1 mm radius so that a
 // few hundred particles run in seconds, and cohesionless Hertz spheres.
 #include "core/lab/lab_test.hpp"
+#include "core/lab/piston.hpp"
 
 namespace demcal::lab::testing {
 
@@ -34,6 +35,15 @@ inline MaterialModel hertz_spheres(double mu_s) {
   m.sizes = particles::Monodisperse{1e-3};
   m.density = 2500.0;
   return m;
+}
+
+/// A bare die bed of `particles`: time-step safety 0.2, settled against gravity alone, the
+/// material's wall laws.
+inline PistonBedRequest bare_bed(std::size_t particles) {
+  PistonBedRequest request;
+  request.particles = particles;
+  request.safety = 0.2;
+  return request;
 }
 
 }  // namespace demcal::lab::testing

@@ -1,9 +1,12 @@
-// Checkpoints of lab tests: a run that goes on from the checkpoint an earlier run offered gives
-// the metrics of the uninterrupted run to the last bit (the runs are deterministic for a thread
-// count, and the checkpoint holds the whole state the steps carry), for a cohesive bed whose
-// preparation changes the contact law and for rigid rods; a checkpoint the test never reaches,
-// or a damaged one, is refused naming it.
+// Checkpoints of lab tests: a run that goes on from any checkpoint an earlier run offered gives
+// the metrics, flags, curves and step counts of the uninterrupted run to the last bit (the runs
+// are deterministic for a thread count, and the checkpoint holds the whole state the steps
+// carry: the world, the output so far and what the test's phases measured), for every lab test
+// that offers stages; a stage the test never reaches, or a damaged record, is refused naming
+// `checkpoint`.
 #include <gtest/gtest.h>
+
+#include <set>
 
 #include "core/common/error.hpp"
 #include "core/lab/lab_test.hpp"
@@ -12,14 +15,14 @@
 namespace demcal::lab {
 namespace {
 
-/// Runs the test once from the start, keeping the checkpoint it offers.
-LabOutput run_keeping_checkpoint(const std::string& test, const MaterialModel& material,
-                                 const Settings& settings, Checkpoint& kept) {
+/// Runs the test once from the start, keeping every checkpoint it offers.
+LabOutput run_keeping_checkpoints(const std::string& test, const MaterialModel& material,
+                                  const Settings& settings, std::vector<Checkpoint>& kept) {
   RunOptions options;
   options.seed = 3;
   options.checkpoint = [&kept](const std::string& stage,
                                const std::function<std::string()>& record) {
-    kept = {stage, record()};
+    kept.push_back({stage, record()});
   };
   return run_lab_test(test, material, settings, options);
 }
@@ -38,46 +41,111 @@ void expect_same_run(const LabOutput& whole, const LabOutput& resumed_run) {
     EXPECT_EQ(value, resumed_run.metrics.at(name)) << name;  // exact: the same bits
   EXPECT_EQ(whole.flags, resumed_run.flags);
   ASSERT_EQ(whole.cost.phases.size(), resumed_run.cost.phases.size());
-  for (std::size_t k = 0; k < whole.cost.phases.size(); ++k)
+  for (std::size_t k = 0; k < whole.cost.phases.size(); ++k) {
+    EXPECT_EQ(whole.cost.phases[k].name, resumed_run.cost.phases[k].name);
     EXPECT_EQ(whole.cost.phases[k].steps, resumed_run.cost.phases[k].steps)
         << whole.cost.phases[k].name;
+  }
   EXPECT_EQ(whole.cost.steps, resumed_run.cost.steps);
-  for (const auto& [name, series] : whole.series)
+  ASSERT_EQ(whole.series.size(), resumed_run.series.size());
+  for (const auto& [name, series] : whole.series) {
+    EXPECT_EQ(series.columns, resumed_run.series.at(name).columns) << name;
     EXPECT_EQ(series.rows, resumed_run.series.at(name).rows) << name;
+  }
 }
 
-TEST(Checkpoint, ACohesiveCompressionGoesOnFromItsBedToTheSameBits) {
+/// Runs `test` from the start, then from each of its checkpoints whose stage is in `resume_at`
+/// (all when empty), and expects the same run every time; returns the stages offered, in order.
+std::vector<std::string> expect_resumes_to_the_same_bits(const std::string& test,
+                                                         const MaterialModel& material,
+                                                         const Settings& settings,
+                                                         const std::set<std::string>& resume_at) {
+  std::vector<Checkpoint> kept;
+  const LabOutput whole = run_keeping_checkpoints(test, material, settings, kept);
+  EXPECT_TRUE(whole.resumed_from.empty());
+  std::vector<std::string> stages;
+  for (const Checkpoint& from : kept) {
+    stages.push_back(from.stage);
+    if (!resume_at.empty() && !resume_at.count(from.stage)) continue;
+    SCOPED_TRACE(test + " from '" + from.stage + "'");
+    const LabOutput again = resumed(test, material, settings, from);
+    EXPECT_EQ(again.resumed_from, from.stage);
+    EXPECT_TRUE(!again.notes.empty() &&
+                again.notes.back().find("checkpoint '" + from.stage + "'") != std::string::npos);
+    expect_same_run(whole, again);
+  }
+  return stages;
+}
+
+TEST(Checkpoint, ACohesiveCompressionGoesOnFromEveryStageToTheSameBits) {
   // Van der Waals cohesion: the bed settles with cohesion in contact only and then gets the full
   // law back, so the resumed world must be the one of the full law.
   const auto material = testing::soft_luding(1e7, 5.0, 0.2, 1e-17);
   const Settings settings{{"particles", 80}, {"cycles", 1}, {"wall_stiffness_factor", 1}};
-  Checkpoint kept;
-  const LabOutput whole = run_keeping_checkpoint("confined_compression", material, settings, kept);
-  ASSERT_EQ(kept.stage, "piston bed");
-  EXPECT_TRUE(whole.resumed_from.empty());
-  const LabOutput again = resumed("confined_compression", material, settings, kept);
-  EXPECT_EQ(again.resumed_from, "piston bed");
-  ASSERT_FALSE(again.notes.empty());
-  EXPECT_NE(again.notes.front().find("checkpoint 'piston bed'"), std::string::npos);
-  expect_same_run(whole, again);
-  EXPECT_GT(whole.metrics.at("compressibility"), 0.0);
+  const auto stages =
+      expect_resumes_to_the_same_bits("confined_compression", material, settings, {});
+  EXPECT_EQ(stages, (std::vector<std::string>{"piston bed", "load 1", "unload 1", "load 2",
+                                              "final unload"}));
 }
 
-TEST(Checkpoint, RodsInTheWallFrictionTestGoOnToTheSameBits) {
+TEST(Checkpoint, RodsInTheWallFrictionTestGoOnFromEveryStageToTheSameBits) {
   MaterialModel rods = testing::soft_luding();
   rods.shape = particles::make_shape_spec("rod", {{"aspect_ratio", 1.5}}, "shape");
-  const Settings settings{{"particles", 30}};
-  Checkpoint kept;
-  const LabOutput whole = run_keeping_checkpoint("wall_friction", rods, settings, kept);
-  ASSERT_EQ(kept.stage, "piston bed");
-  expect_same_run(whole, resumed("wall_friction", rods, settings, kept));
+  const auto stages =
+      expect_resumes_to_the_same_bits("wall_friction", rods, {{"particles", 30}}, {});
+  ASSERT_GE(stages.size(), 3u);
+  EXPECT_EQ(stages.front(), "piston bed");
+  for (std::size_t k = 1; k < stages.size(); ++k)
+    EXPECT_EQ(stages[k].rfind("turn ", 0), 0u) << stages[k];  // one per normal stress
+}
+
+TEST(Checkpoint, TheTensileTestGoesOnFromEveryStageToTheSameBits) {
+  const auto material = testing::soft_luding(1e7, 5.0, 0.2, 1e-17);
+  const Settings settings{{"particles", 60}, {"wall_stiffness_factor", 1}};
+  EXPECT_EQ(expect_resumes_to_the_same_bits("tensile", material, settings, {}),
+            (std::vector<std::string>{"piston bed", "consolidate", "unload"}));
+}
+
+TEST(Checkpoint, TheShearCellGoesOnFromThePreShearAndAShearStepToTheSameBits) {
+  const Settings settings{{"particles", 120},
+                          {"pre_shear_travel", 1},
+                          {"torque_ramp_time", 0.05},
+                          {"consolidation_time", 0.01}};
+  const auto stages = expect_resumes_to_the_same_bits(
+      "shear_cell", testing::hertz_spheres(0.5), settings, {"pre-shear", "shear step 1.5 kPa"});
+  EXPECT_EQ(stages, (std::vector<std::string>{"pre-shear", "shear step 2 kPa",
+                                              "shear step 1.75 kPa", "shear step 1.5 kPa",
+                                              "shear step 1.25 kPa", "shear step 1 kPa"}));
+}
+
+TEST(Checkpoint, TheDrumGoesOnFromItsBedTheAngleAndASpeedToTheSameBits) {
+  const Settings settings{
+      {"diameter", 25}, {"length", 11}, {"angle_time", 0.1}, {"area_time", 0.05}};
+  const auto stages = expect_resumes_to_the_same_bits(
+      "rotating_drum", testing::hertz_spheres(0.5), settings, {"drum bed", "angle", "area 80 rpm"});
+  EXPECT_EQ(stages, (std::vector<std::string>{"drum bed", "angle", "area 4 rpm", "area 40 rpm",
+                                              "area 80 rpm", "area 105 rpm", "area 116 rpm"}));
+}
+
+TEST(Checkpoint, TheHopperAndTheCompactionGoOnFromTheirStageToTheSameBits) {
+  EXPECT_EQ(expect_resumes_to_the_same_bits("hopper", testing::hertz_spheres(0.5),
+                                            {{"particles", 150}}, {}),
+            (std::vector<std::string>{"hopper bed"}));
+  const Settings compaction{{"particles", 40},  {"phi_start", 0.1},    {"phi_max", 0.6},
+                            {"points", 2},      {"strain_rate", 1e-4}, {"probe_strain", 0.002},
+                            {"yield_probes", 0}};
+  EXPECT_EQ(
+      expect_resumes_to_the_same_bits("compaction", testing::hertz_spheres(0.0), compaction, {}),
+      (std::vector<std::string>{"compacted"}));
 }
 
 TEST(Checkpoint, AStageTheTestNeverReachesOrADamagedRecordIsRefused) {
   const auto material = testing::soft_luding();
   const Settings settings{{"particles", 30}};
-  Checkpoint kept;
-  run_keeping_checkpoint("wall_friction", material, settings, kept);
+  std::vector<Checkpoint> kept;
+  run_keeping_checkpoints("wall_friction", material, settings, kept);
+  ASSERT_FALSE(kept.empty());
+  const Checkpoint bed = kept.front();
   auto refusal = [&](const std::string& test, const Checkpoint& from) {
     try {
       resumed(test, material, settings, from);
@@ -87,16 +155,18 @@ TEST(Checkpoint, AStageTheTestNeverReachesOrADamagedRecordIsRefused) {
     }
     return std::string("accepted");
   };
-  // The packing test has no piston bed to go on from.
-  EXPECT_NE(refusal("packing", kept).find("'piston bed' is not one the packing test"),
+  // A test with stages refuses another's before it runs; the packing test has none at all.
+  EXPECT_NE(refusal("tensile", kept.back()).find("is not one this test goes on from"),
             std::string::npos);
-  Checkpoint damaged = kept;
+  EXPECT_NE(refusal("packing", bed).find("'piston bed' is not one the packing test"),
+            std::string::npos);
+  Checkpoint damaged = bed;
   damaged.state.resize(damaged.state.size() - 9);
   EXPECT_NE(refusal("wall_friction", damaged).find("truncated"), std::string::npos);
   // Another material's laws (a Hertz law keeps no reached overlap: another history size).
   try {
     RunOptions options;
-    options.resume = kept;
+    options.resume = bed;
     run_lab_test("wall_friction", testing::hertz_spheres(0.3), settings, options);
     ADD_FAILURE() << "a checkpoint of other laws was accepted";
   } catch (const InputError& e) {

@@ -68,7 +68,7 @@ TEST(ConfinedCompression, AbsurdPistonStiffnessIsATypedFailure) {
   // A piston law made 1e6 times stiffer after the time step was chosen: the next step re-checks
   // the stability limit and fails with kUnstableTimeStep, naming both numbers.
   const auto m = testing::soft_luding();
-  PistonBed bed = make_piston_bed(m, 150, 0.2, 0.0, {}, {});
+  PistonBed bed = make_piston_bed(m, testing::bare_bed(150), {});
   bed.world.set_wall_law(kWallPiston, 0, simulated_law(m, stiffen_normal(m.wall_law, 1e6)));
   try {
     servo_phase(bed.world, bed.piston, bed.piston, {0, 0, -1}, bed.area, 1000.0,
@@ -81,7 +81,7 @@ TEST(ConfinedCompression, AbsurdPistonStiffnessIsATypedFailure) {
 
 TEST(ConfinedCompression, AbsurdTimeStepIsATypedFailure) {
   // A piston bed stepped at 50 times its critical time step blows up: a typed failure.
-  PistonBed bed = make_piston_bed(testing::soft_luding(), 150, 0.2, 0.0, {}, {});
+  PistonBed bed = make_piston_bed(testing::soft_luding(), testing::bare_bed(150), {});
   bed.world.dt *= 250.0;
   try {
     servo_phase(bed.world, bed.piston, bed.piston, {0, 0, -1}, bed.area, 1000.0,

@@ -81,7 +81,7 @@ TEST(WallFriction, BottomServoStopsAtTheFloor) {
   // makes the servo back the bottom away at full speed: without a limit it sinks by about
   // max_speed * max_time and the powder falls with it; with the floor as its retreat limit it
   // stops within one step of the floor.
-  const PistonBed bed = make_piston_bed(testing::soft_luding(), 100, 0.2, 0.0, {}, {});
+  const PistonBed bed = make_piston_bed(testing::soft_luding(), testing::bare_bed(100), {});
   const ServoSettings servo{0.05, 1e-3, 0.0, 0.0, 1.0, 1e-3, 0.02};
   auto bottom_after = [&](double retreat_limit) {
     sim::World w = bed.world;
