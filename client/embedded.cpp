@@ -3,6 +3,10 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
 #include <iostream>
 #include <random>
 
@@ -16,6 +20,35 @@ std::string random_token() {
   std::string t;
   for (int i = 0; i < 32; ++i) t += "0123456789abcdef"[rd() % 16];
   return t;
+}
+
+sigset_t stop_signals() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  return set;
+}
+
+/// The service whose workers a stop signal ends (one at a time per process).
+std::atomic<EmbeddedService*> signalled_service{nullptr};
+
+/// Takes SIGINT and SIGTERM for the whole process, in one thread started once: they are blocked
+/// in the calling thread before any other starts, so every later thread inherits the block.
+void watch_stop_signals() {
+  static const bool started = [] {
+    const sigset_t set = stop_signals();
+    pthread_sigmask(SIG_BLOCK, &set, nullptr);
+    std::thread([set] {
+      int sig = 0;
+      sigwait(&set, &sig);
+      if (EmbeddedService* service = signalled_service.load()) service->stop_on_signal(sig);
+      std::fflush(nullptr);
+      std::_Exit(128 + sig);
+    }).detach();
+    return true;
+  }();
+  (void)started;
 }
 
 }  // namespace
@@ -57,6 +90,7 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
 
 EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local,
                                  bool verbose) {
+  watch_stop_signals();
   // The work directory holds the campaign's database: a new one is its owner's alone (0700).
   if (std::filesystem::create_directories(workdir))
     std::filesystem::permissions(workdir, std::filesystem::perms::owner_all);
@@ -73,7 +107,10 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
   co.listen = "127.0.0.1:0";
   co.db = db_ = (workdir / "campaign.db").string();
   co.token = random_token();
-  co.grace_seconds = 0.0;  // its workers die with it: no lease of a previous run is still worked on
+  // Its workers die with it: no lease of an earlier run is still worked on, and none was the
+  // job's fault (the run was stopped), so the jobs go back to the queue uncounted, to go on
+  // from their latest checkpoint.
+  co.give_back_leases_at_start = true;
   // Its workers ask over loopback, where an empty poll costs microseconds: a worker that found
   // the queue empty takes a job a tenth of a second after it appears, not a second (with jobs
   // of a fraction of a second, one worker would otherwise run them all while the other waits).
@@ -86,12 +123,31 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
     wo.channel = channel_;
     wo.threads = local.threads;
     wo.id = local.workers == 1 ? "embedded" : "embedded-" + std::to_string(i);
-    workers_.emplace_back([this, wo] { worker::run_worker(wo, flags_); });
+    ++running_;
+    workers_.emplace_back([this, wo] {
+      worker::run_worker(wo, flags_);
+      --running_;
+    });
   }
   stub_ = campaign_stub(channel_);
+  signalled_service = this;
+}
+
+void EmbeddedService::stop_on_signal(int sig) {
+  std::cerr << "\nsignal " << sig
+            << ": giving the running jobs back; the same command goes on from their latest "
+               "checkpoints"
+            << std::endl;
+  flags_.abort = true;
+  // A worker gives its lease back within its Fail deadline (seconds); the simulations it
+  // leaves end with the process.
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (running_ > 0 && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
 }
 
 EmbeddedService::~EmbeddedService() {
+  signalled_service = nullptr;
   if (http_) http_->stop();
   flags_.stop = true;
   for (auto& w : workers_) w.join();

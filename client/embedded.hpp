@@ -3,6 +3,7 @@
 // token) and local workers in this process, talking real gRPC. Used by `demcal run` and
 // `demcal diagnose SPEC`.
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -49,6 +50,11 @@ class EmbeddedService {
   /// its fragment (never sent to the server by a browser).
   std::string serve_http(const std::string& address, std::int64_t id);
 
+  /// SIGINT or SIGTERM `sig` (Ctrl-C, the end of a batch allocation): the workers give their
+  /// leases back at once, uncounted, and return; the caller then ends the process. The next
+  /// run of the same command goes on from the jobs' latest checkpoints.
+  void stop_on_signal(int sig);
+
  private:
   std::string db_;
   std::unique_ptr<server::Coordinator> coordinator_;
@@ -56,6 +62,7 @@ class EmbeddedService {
   rpc::ChannelOptions channel_;
   worker::StopFlags flags_;
   std::vector<std::thread> workers_;
+  std::atomic<int> running_{0};  ///< workers that have not returned
   std::unique_ptr<v1::CampaignService::Stub> stub_;
 };
 

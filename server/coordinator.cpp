@@ -29,7 +29,8 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
                                                             options_.max_attempts,
                                                             options_.grace_seconds,
                                                             {},
-                                                            options_.fsync_every_commit});
+                                                            options_.fsync_every_commit,
+                                                            options_.give_back_leases_at_start});
   if (options_.max_starts < 1 || options_.max_starts > 1000)
     throw std::invalid_argument("--max-starts must lie in [1, 1000]");
   if (!(options_.max_watch_interval >= kMinWatchInterval && options_.max_watch_interval <= 3600))

@@ -31,6 +31,9 @@ struct CoordinatorOptions {
   /// A lease found in the file at start-up expires no sooner than this (nor than a lease)
   /// after start-up: workers that ran on while the coordinator was down reconnect and report.
   double grace_seconds = 30.0;
+  /// The leases found in the file at start-up go back to the queue uncounted instead: its
+  /// workers lived and died with the process that held them (the embedded default).
+  bool give_back_leases_at_start = false;
   int max_attempts = 3;
   /// Sync the SQLite file at every commit (power-cut durability; store.hpp), not only at
   /// checkpoints.

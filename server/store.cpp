@@ -362,6 +362,14 @@ void Store::require_wal(const std::string& path) {
 }
 
 void Store::restore_leases(double opened) {
+  if (limits_.give_back_leases_at_opening) {
+    Statement u(*this,
+                "UPDATE jobs SET state = 'queued', counted = counted - 1, lease_deadline = 0, "
+                "error = 'given back: leased by a worker of an earlier run of this process' "
+                "WHERE state = 'leased'");
+    u.step();
+    return;
+  }
   // The deadlines of the previous run are gone with its clock: a worker still running a job
   // leased before a restart has a whole lease from the opening to report or heartbeat again.
   Statement s(*this, "SELECT id FROM jobs WHERE state = 'leased'");

@@ -107,6 +107,10 @@ struct StoreLimits {
   std::function<double()> clock = {};
   /// synchronous=FULL instead of NORMAL: every commit survives a power cut (see the top).
   bool fsync_every_commit = false;
+  /// The leases found in the file at opening go back to the queue at once, the attempt not
+  /// counted: for a coordinator whose workers lived in the process that wrote the file (the
+  /// embedded default), so that none of them can still be working on its job.
+  bool give_back_leases_at_opening = false;
 };
 
 /// Seconds on the monotonic clock the store's lease deadlines are kept on.
@@ -125,7 +129,7 @@ class Store {
  public:
   /// Opens (creating if needed) and migrates; path ":memory:" for tests. Leases found in the
   /// file get the deadline `opened + max(lease, restart grace)` (opened: steady_seconds()
-  /// unless given).
+  /// unless given), or are given back (StoreLimits::give_back_leases_at_opening).
   explicit Store(const std::string& path, StoreLimits limits = {},
                  std::optional<double> opened = std::nullopt);
   ~Store();

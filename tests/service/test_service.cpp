@@ -1084,6 +1084,80 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
   EXPECT_NE(refused.log().find("bad.yaml:8: material.densty"), std::string::npos) << refused.log();
 }
 
+// The embedded default stopped mid-job, by a signal or killed outright, counts no attempt
+// against the job it was running: on SIGINT its workers give their leases back and it exits
+// 130; after a SIGKILL the next run finds the lease in the file and gives it back at start-up.
+// Interrupted as often as a long campaign spread over sessions is, no job fails for it.
+TEST_F(Service, TheEmbeddedDefaultInterruptedCountsNoAttemptAgainstItsJobs) {
+  const std::string spec = path("interrupted.yaml");
+  std::ofstream(spec) << R"(
+name: interrupted
+material:
+  particle_law:
+    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, phi_f: 0.05, restitution: 0.3}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 0.001}}
+  density: 1500
+tests:
+  - test: wall_friction
+    settings: {particles: 30}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.2, high: 0.4}
+  - {path: wall_law.tangential.mu_s, low: 0.2, high: 0.4}
+design: {type: full_factorial}
+)";
+  const std::string db = path("work/campaign.db");
+  const std::vector<std::string> argv{DEMCAL_CLI_BIN, "run", spec,        "--workdir", path("work"),
+                                      "--workers",    "1",   "--threads", "1"};
+  // Polled while the run creates the file: a file without its tables yet counts as none leased.
+  auto leased = [&] {
+    int n = 0;
+    sqlite3* file = nullptr;
+    sqlite3_stmt* st = nullptr;
+    if (fs::exists(db) &&
+        sqlite3_open_v2(db.c_str(), &file, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK &&
+        sqlite3_prepare_v2(file, "SELECT COUNT(*) FROM jobs WHERE state = 'leased'", -1, &st,
+                           nullptr) == SQLITE_OK &&
+        sqlite3_step(st) == SQLITE_ROW)
+      n = sqlite3_column_int(st, 0);
+    sqlite3_finalize(st);
+    sqlite3_close(file);
+    return n > 0;
+  };
+  auto counted = [&] {
+    std::map<std::int64_t, int> by_job;
+    each_row(db, "SELECT id, counted FROM jobs", [&](sqlite3_stmt* st) {
+      by_job[sqlite3_column_int64(st, 0)] = sqlite3_column_int(st, 1);
+    });
+    return by_job;
+  };
+  {
+    Process run(argv, path("run1.log"));
+    ASSERT_TRUE(wait_until(leased, 60)) << run.log();
+    run.signal(SIGINT);
+    EXPECT_EQ(run.wait_exit(40), 128 + SIGINT) << run.log();
+    EXPECT_NE(run.log().find("giving the running jobs back"), std::string::npos) << run.log();
+  }
+  EXPECT_FALSE(leased());  // given back before the exit
+  for (const auto& [job, n] : counted()) EXPECT_LE(n, 1) << job;
+  {
+    Process run(argv, path("run2.log"));
+    ASSERT_TRUE(wait_until(leased, 60)) << run.log();
+    run.signal(SIGKILL);
+    EXPECT_EQ(run.wait_exit(10), 128 + SIGKILL);
+  }
+  EXPECT_TRUE(leased());  // the killed run's lease is still in the file
+  Process last(argv, path("run3.log"));
+  ASSERT_EQ(last.wait_exit(150), 0) << last.log();
+  int given_back = 0;
+  each_row(db, "SELECT state, counted, attempt, error FROM jobs", [&](sqlite3_stmt* st) {
+    EXPECT_STREQ(reinterpret_cast<const char*>(sqlite3_column_text(st, 0)), "done");
+    EXPECT_EQ(sqlite3_column_int(st, 1), 1);  // only the lease that finished counts
+    given_back += sqlite3_column_int(st, 2) > 1;
+  });
+  EXPECT_GE(given_back, 1);
+}
+
 /// Runs the CLI against the test's coordinator; returns its standard output parsed as JSON.
 nlohmann::json cli_json(const std::string& dir, const std::string& name,
                         const std::vector<std::string>& args, const rpc::ChannelOptions& ch) {

@@ -66,6 +66,40 @@ TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
   std::filesystem::remove(path.string() + "-shm");
 }
 
+TEST(Store, LeasesOfAnEarlierRunOfTheEmbeddedDefaultGoBackUncountedAtOpening) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("demcal_store_give_back_" + std::to_string(::getpid()) + ".db");
+  std::filesystem::remove(path);
+  StoreLimits embedded{10.0, 1};
+  embedded.give_back_leases_at_opening = true;
+  std::int64_t leased = 0;
+  {
+    Store s(path.string(), embedded);
+    s.create_campaign("c", "{}", "{}", jobs(2), 0.0);
+    leased = s.lease("embedded", 1.0)->id;
+    EXPECT_EQ(s.save_checkpoint(leased, 1, "embedded", "piston bed", "bed", 2.0), kOk);
+  }  // the process ends with the job leased (killed)
+  {
+    // One attempt allowed: counted, the lease's expiry would fail the job; given back, it is
+    // leased again with its checkpoint.
+    Store s(path.string(), embedded, /*opened=*/1000.0);
+    EXPECT_EQ(s.counts(1).leased, 0);
+    const auto job = s.job(leased);
+    EXPECT_EQ(job->state, "queued");
+    EXPECT_NE(job->error.find("given back"), std::string::npos) << job->error;
+    EXPECT_EQ(s.reap(2000.0), 0);
+    const auto again = s.lease("embedded", 1001.0);
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->id, leased);
+    EXPECT_EQ(again->attempt, 2);
+    ASSERT_TRUE(s.checkpoint(leased));
+    EXPECT_EQ(s.checkpoint(leased)->stage, "piston bed");
+    EXPECT_EQ(s.complete(leased, 2, "embedded", "{}", 1.0, 1002.0), kOk);
+  }
+  for (const std::string suffix : {"", "-wal", "-shm"})
+    std::filesystem::remove(path.string() + suffix);
+}
+
 std::string file_bytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
