@@ -8,6 +8,7 @@
 // from the world once and uses later belongs in the record: the time step adapts as the run
 // goes, so a servo's hold time or a frame's steps derived again at a later stage would differ.
 #include <algorithm>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,9 @@ class Stages {
     if (at == names_.end())
       throw InputError("checkpoint", "stage '" + stage + "' is not one this test goes on from");
     ByteReader in(options_.resume.state, "checkpoint");
+    if (const auto format = in.get<std::uint32_t>(); format != kFormat)
+      throw InputError("checkpoint", "a record of format " + std::to_string(format) +
+                                         ", this build reads format " + std::to_string(kFormat));
     std::string state;
     in.get(state);
     world.restore_state(state);
@@ -76,6 +80,7 @@ class Stages {
     if (!options_.checkpoint) return;
     options_.checkpoint(names_.at(k), [&] {
       ByteWriter record;
+      record.put(kFormat);
       record.put(world.save_state());
       record.field(out_);
       fields_(record);
@@ -84,6 +89,9 @@ class Stages {
   }
 
  private:
+  /// The record's layout: the world's state, the output, the runner's fields (1: the bed
+  /// alone, without this number).
+  static constexpr std::uint32_t kFormat = 2;
   const RunOptions& options_;
   std::vector<std::string> names_;
   LabOutput& out_;

@@ -163,6 +163,9 @@ TEST(Checkpoint, AStageTheTestNeverReachesOrADamagedRecordIsRefused) {
   Checkpoint damaged = bed;
   damaged.state.resize(damaged.state.size() - 9);
   EXPECT_NE(refusal("wall_friction", damaged).find("truncated"), std::string::npos);
+  Checkpoint other_format = bed;
+  other_format.state[0] = static_cast<char>(other_format.state[0] + 1);
+  EXPECT_NE(refusal("wall_friction", other_format).find("a record of format 3"), std::string::npos);
   // Another material's laws (a Hertz law keeps no reached overlap: another history size).
   try {
     RunOptions options;
