@@ -61,6 +61,26 @@ measurements:
 )" + calibration;
 }
 
+/// Four wall-friction runs of 30 cohesive Luding spheres, a few seconds each: jobs long enough
+/// to be caught running, with stages to checkpoint. `more` is appended (e.g. measurements).
+std::string wall_friction_spec(const std::string& name, const std::string& more) {
+  return "name: " + name + R"(
+material:
+  particle_law:
+    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, phi_f: 0.05, restitution: 0.3}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 0.001}}
+  density: 1500
+tests:
+  - test: wall_friction
+    settings: {particles: 30}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.2, high: 0.4}
+  - {path: wall_law.tangential.mu_s, low: 0.2, high: 0.4}
+design: {type: full_factorial}
+)" + more;
+}
+
 class Service : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -534,24 +554,9 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
 // goes on from it to the result of a run that was never interrupted, to the bit.
 TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
-  const std::string spec = R"(
-name: checkpointed
-material:
-  particle_law:
-    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, phi_f: 0.05, restitution: 0.3}
-    tangential: {model: history, mu_s: 0.3}
-  sizes: {monodisperse: {radius: 0.001}}
-  density: 1500
-tests:
-  - test: wall_friction
-    settings: {particles: 30}
-factors:
-  - {path: particle_law.tangential.mu_s, low: 0.2, high: 0.4}
-  - {path: wall_law.tangential.mu_s, low: 0.2, high: 0.4}
-design: {type: full_factorial}
-measurements:
-  - {metric: wall_friction_angle, value: 20, uncertainty: 1}
-)";
+  const std::string spec = wall_friction_spec("checkpointed",
+                                              "measurements:\n  - {metric: wall_friction_angle, "
+                                              "value: 20, uncertainty: 1}\n");
   std::int64_t id = 0;
   ASSERT_TRUE(submit(spec, &id).ok());
   v1::LeaseRequest lr;
@@ -1090,22 +1095,7 @@ TEST_F(Service, CliRunsACampaignEndToEnd) {
 // Interrupted as often as a long campaign spread over sessions is, no job fails for it.
 TEST_F(Service, TheEmbeddedDefaultInterruptedCountsNoAttemptAgainstItsJobs) {
   const std::string spec = path("interrupted.yaml");
-  std::ofstream(spec) << R"(
-name: interrupted
-material:
-  particle_law:
-    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, phi_f: 0.05, restitution: 0.3}
-    tangential: {model: history, mu_s: 0.3}
-  sizes: {monodisperse: {radius: 0.001}}
-  density: 1500
-tests:
-  - test: wall_friction
-    settings: {particles: 30}
-factors:
-  - {path: particle_law.tangential.mu_s, low: 0.2, high: 0.4}
-  - {path: wall_law.tangential.mu_s, low: 0.2, high: 0.4}
-design: {type: full_factorial}
-)";
+  std::ofstream(spec) << wall_friction_spec("interrupted", "");
   const std::string db = path("work/campaign.db");
   const std::vector<std::string> argv{DEMCAL_CLI_BIN, "run", spec,        "--workdir", path("work"),
                                       "--workers",    "1",   "--threads", "1"};
