@@ -55,12 +55,17 @@ class ByteWriter {
   void field(const std::string& text) { put(text); }
   template <class T>
   void field(const std::vector<T>& values) {
-    if constexpr (std::is_trivially_copyable_v<T>) {
+    if constexpr (std::is_trivially_copyable_v<T>)
       put(values);
-    } else {
-      put<std::uint64_t>(values.size());
-      for (const T& value : values) field(value);
-    }
+    else
+      each(values, [this](const T& value) { field(value); });
+  }
+  /// The count of `values`, then `item(value)` for each: a vector of elements whose fields are
+  /// listed in place (ByteReader::each reads them back).
+  template <class T, class F>
+  void each(const std::vector<T>& values, F item) {
+    put<std::uint64_t>(values.size());
+    for (const T& value : values) item(value);
   }
   template <class K, class V>
   void field(const std::map<K, V>& values) {
@@ -114,12 +119,18 @@ class ByteReader {
   void field(std::string& text) { get(text); }
   template <class T>
   void field(std::vector<T>& values) {
-    if constexpr (std::is_trivially_copyable_v<T>) {
+    if constexpr (std::is_trivially_copyable_v<T>)
       get(values);
-    } else {
-      values.resize(count());
-      for (T& value : values) field(value);
-    }
+    else
+      each(values, [this](T& value) { field(value); });
+  }
+  /// Reads what ByteWriter::each wrote: `values` becomes that many default elements, each
+  /// then handed to `item`.
+  template <class T, class F>
+  void each(std::vector<T>& values, F item) {
+    values.clear();
+    values.resize(count());
+    for (T& value : values) item(value);
   }
   template <class K, class V>
   void field(std::map<K, V>& values) {

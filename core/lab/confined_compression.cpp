@@ -49,15 +49,10 @@ LabOutput ConfinedCompressionTest::run(const MaterialModel& material, const Sett
   const double fs = material.factors().stress;
   const auto stiff_wall =
       simulated_law(material, stiffen_normal(material.wall_law, s.wall_stiffness_factor));
-  PistonBedRequest request;
-  request.particles = static_cast<std::size_t>(s.particles);
-  request.safety = s.time_step_safety;
-  request.servo = s;
-  request.stress_level = s.max_stress * fs;
-  request.set_laws = [&](sim::World& w) {
+  PistonBedRequest request = piston_bed_request(s, s.max_stress * fs, [&](sim::World& w) {
     w.set_wall_law(kWallPiston, 0, stiff_wall);
     w.set_wall_law(kWallBottom, 0, stiff_wall);
-  };
+  });
   request.depending = {"compressibility", "confined_modulus"};
   const int cycles = static_cast<int>(std::lround(s.cycles));
   LabOutput out;

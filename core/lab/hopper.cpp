@@ -213,8 +213,10 @@ LabOutput HopperTest::run(const MaterialModel& material, const Settings& values,
   Hopper hp;
   // The one stage: the settled bed before the gate opens.
   Stages stages(options, {"hopper bed"}, out, [&hp](auto& a) { a.field(hp); });
-  hp.w = make_material_world(material, options);
-  if (stages.resume(hp.w) == 0) {
+  if (stages.resuming()) {
+    hp.w = make_material_world(material, options);
+    stages.resume(hp.w);
+  } else {
     hp = build_hopper(material, s, options, out);
     write_snapshot(hp.w, options, "hopper_settled", out, hp.top);
     stages.reached(0, hp.w);

@@ -107,6 +107,20 @@ struct PistonBedRequest {
   std::vector<std::string> depending;
 };
 
+/// The request of a piston test: its settings' particles, time-step safety and servo settings,
+/// the largest stress it applies (simulated) and its wall laws.
+template <class S>
+PistonBedRequest piston_bed_request(const S& settings, double stress_level,
+                                    std::function<void(sim::World&)> set_laws) {
+  PistonBedRequest request;
+  request.particles = static_cast<std::size_t>(settings.particles);
+  request.safety = settings.time_step_safety;
+  request.stress_level = stress_level;
+  request.servo = settings;
+  request.set_laws = std::move(set_laws);
+  return request;
+}
+
 /// Records the bed's fill and settle phases in `out`, flagging the request's `depending`.
 void add_bed_phases(LabOutput& out, const PistonBed& bed, const PistonBedRequest& request);
 /// Records a servo phase under `name`, flagging `depending` if it did not reach its target.
@@ -132,9 +146,10 @@ template <class S>
 std::size_t start_piston_test(S& stages, const MaterialModel& material,
                               const PistonBedRequest& request, const RunOptions& options,
                               PistonBed& bed, LabOutput& out) {
-  bed.world = make_material_world(material, options);
-  if (request.set_laws) request.set_laws(bed.world);
-  if (const std::size_t next = stages.resume(bed.world)) {
+  if (stages.resuming()) {
+    bed.world = make_material_world(material, options);
+    if (request.set_laws) request.set_laws(bed.world);
+    const std::size_t next = stages.resume(bed.world);
     check_piston(bed);
     return next;
   }

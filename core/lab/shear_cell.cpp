@@ -371,14 +371,15 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
     a.field(locus);
     a.field(ys);
   });
-  c.w = cell_world(material, s, options);
-  std::size_t next = stages.resume(c.w);
-  if (next == 0) {
+  std::size_t next = 1;
+  if (stages.resuming()) {
+    c.w = cell_world(material, s, options);
+    next = stages.resume(c.w);
+  } else {
     c = build_cell(material, s, options, out);
     pre = pre_shear(c, s, options, out);
     write_snapshot(c.w, options, "shear_cell_preshear", out, c.radius);
     stages.reached(0, c.w);
-    next = 1;
   }
   // The shear steps, each from the pre-sheared state (c.w, left as it is); the locus uses the
   // normal stress measured on the floor at the yield point.

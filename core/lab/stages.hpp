@@ -46,6 +46,8 @@ class Stages {
       : options_(options), names_(std::move(names)), out_(out), fields_(std::move(fields)) {}
 
   const std::string& name(std::size_t k) const { return names_.at(k); }
+  /// The run goes on from a checkpoint: resume() then needs the world the test sets up.
+  bool resuming() const { return !options_.resume.stage.empty(); }
   std::size_t size() const { return names_.size(); }
 
   /// The index of the first stage still to reach: 0 for a run from the start. A run resumed
@@ -53,8 +55,8 @@ class Stages {
   /// its laws, its threads), the output and the fields, and the index after that stage; a
   /// stage that is not one of them is refused naming `checkpoint`.
   std::size_t resume(sim::World& world) {
+    if (!resuming()) return 0;
     const std::string& stage = options_.resume.stage;
-    if (stage.empty()) return 0;
     const auto at = std::find(names_.begin(), names_.end(), stage);
     if (at == names_.end())
       throw InputError("checkpoint", "stage '" + stage + "' is not one this test goes on from");

@@ -71,16 +71,12 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   const auto adhesive_law = simulated_law(material, adhesive);
   const auto die_law = simulated_law(material, die);
 
-  PistonBedRequest request;
-  request.particles = static_cast<std::size_t>(s.particles);
-  request.safety = s.time_step_safety;
-  request.servo = s;
-  request.stress_level = s.consolidation_stress * fs;
-  request.set_laws = [&](sim::World& w) {
-    w.set_wall_law(kWallPiston, 0, adhesive_law);
-    w.set_wall_law(kWallBottom, 0, adhesive_law);
-    w.set_wall_law(kWallDie, 0, die_law);
-  };
+  const PistonBedRequest request =
+      piston_bed_request(s, s.consolidation_stress * fs, [&](sim::World& w) {
+        w.set_wall_law(kWallPiston, 0, adhesive_law);
+        w.set_wall_law(kWallBottom, 0, adhesive_law);
+        w.set_wall_law(kWallDie, 0, die_law);
+      });
   LabOutput out;
   PistonBed bed;
   // The heights the servo phases ended at, and whether the consolidation reached its stress.

@@ -40,15 +40,11 @@ LabOutput WallFrictionTest::run(const MaterialModel& material, const Settings& v
   const auto piston_law = simulated_law(material, piston_spec);
   const auto bottom_law = simulated_law(material, bottom_spec);
   const auto& stresses = wall_friction_stresses();
-  PistonBedRequest request;
-  request.particles = static_cast<std::size_t>(s.particles);
-  request.safety = s.time_step_safety;
-  request.servo = s;
-  request.stress_level = stresses.back() * s.stress_factor * fs;
-  request.set_laws = [&](sim::World& w) {
-    w.set_wall_law(kWallPiston, 0, piston_law);
-    w.set_wall_law(kWallBottom, 0, bottom_law);
-  };
+  const PistonBedRequest request =
+      piston_bed_request(s, stresses.back() * s.stress_factor * fs, [&](sim::World& w) {
+        w.set_wall_law(kWallPiston, 0, piston_law);
+        w.set_wall_law(kWallBottom, 0, bottom_law);
+      });
   // The stages: the bed, then each normal stress once turned.
   std::vector<std::string> names{kPistonBedStage};
   for (double sigma_real : stresses)

@@ -197,18 +197,4 @@ void VerletList::build(const std::vector<Vec3>& x, const std::vector<double>& ra
   ++builds_;
 }
 
-void VerletList::save(ByteWriter& out) const {
-  out.put(row_start);
-  out.put(nbr);
-  out.put(x_at_build_);
-  out.put<std::uint64_t>(builds_);
-}
-
-void VerletList::restore(ByteReader& in) {
-  in.get(row_start);
-  in.get(nbr);
-  in.get(x_at_build_);
-  builds_ = in.get<std::uint64_t>();
-}
-
 }  // namespace demcal::neighbour

@@ -31,10 +31,16 @@ class VerletList {
   std::size_t pairs() const { return nbr.size(); }
   std::size_t builds() const { return builds_; }
 
-  /// The list's state for a checkpoint: the rows, the positions of the last build and the build
-  /// count (the buffers a build reuses carry nothing from one build to the next).
-  void save(ByteWriter& out) const;
-  void restore(ByteReader& in);
+  /// The list's state in a checkpoint record (core/common/bytes.hpp): the rows, the positions of
+  /// the last build and the build count (the buffers a build reuses carry nothing from one build
+  /// to the next).
+  template <class A, RecordOf<VerletList> L>
+  friend void record_fields(A& a, L& list) {
+    a.field(list.row_start);
+    a.field(list.nbr);
+    a.field(list.x_at_build_);
+    a.field(list.builds_);
+  }
 
  private:
   std::vector<Vec3> x_at_build_;

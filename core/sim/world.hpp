@@ -125,6 +125,10 @@ class World {
   void grow_law_tables(int n);
   /// Why the arrays of a restored state do not fit together (empty: they do).
   std::string state_mismatch() const;
+  /// The state save_state writes and restore_state reads, handed to `a.field` in record order
+  /// (ByteWriter with a const World, ByteReader with a mutable one; world_state.cpp).
+  template <class A, class W>
+  static void state_fields(A& a, W& w);
   std::vector<contact::ContactLaw> pair_laws_;               // n_materials_^2
   std::vector<std::vector<contact::ContactLaw>> wall_laws_;  // [wall material][particle material]
   std::vector<bool> pair_set_;

@@ -55,7 +55,8 @@ void frame_fields(A& a, F& f) {
   a.field(f.gravity);
 }
 
-void put_shape(ByteWriter& out, const walls::Shape& shape) {
+/// A wall shape in a record: its alternative's index, then the shape (a mesh field by field).
+void shape_field(ByteWriter& out, const walls::Shape& shape) {
   out.put<std::uint8_t>(static_cast<std::uint8_t>(shape.index()));
   std::visit(
       [&](const auto& s) {
@@ -67,18 +68,22 @@ void put_shape(ByteWriter& out, const walls::Shape& shape) {
       shape);
 }
 
-walls::Shape get_shape(ByteReader& in) {
+void shape_field(ByteReader& in, walls::Shape& shape) {
   switch (in.get<std::uint8_t>()) {
     case 0:
-      return in.get<walls::Plane>();
+      shape = in.get<walls::Plane>();
+      return;
     case 1:
-      return in.get<walls::Cylinder>();
+      shape = in.get<walls::Cylinder>();
+      return;
     case 2:
-      return in.get<walls::Disk>();
+      shape = in.get<walls::Disk>();
+      return;
     case 3: {
       walls::Mesh m;
       mesh_fields(in, m);
-      return m;
+      shape = std::move(m);
+      return;
     }
     default:
       throw InputError("checkpoint", "unknown wall shape");
@@ -118,40 +123,42 @@ std::string World::state_mismatch() const {
   return {};
 }
 
+template <class A, class W>
+void World::state_fields(A& a, W& w) {
+  particle_fields(a, w.particles);
+  a.each(w.walls, [&a](auto& wall) {
+    shape_field(a, wall.shape);
+    wall_fields(a, wall);
+  });
+  a.field(w.domain);
+  a.field(w.gravity);
+  a.field(w.dt);
+  a.field(w.adaptive_safety);
+  a.field(w.skin);
+  a.field(w.time);
+  a.field(w.step_count);
+  a.field(w.wall_strides_);
+  a.field(w.skin_);
+  a.field(w.prepared_);
+  a.field(w.list);
+  a.field(w.pair_history);
+  a.field(w.wall_history);
+  a.each(w.wall_reach, [&a](auto& r) {
+    a.field(r.near);
+    shape_field(a, r.shape);
+    a.field(r.range);
+    a.field(r.extent);
+    a.field(r.valid);
+  });
+  frame_fields(a, w.clump_frames);
+}
+
 std::string World::save_state() const {
   ByteWriter out;
   out.put(std::string(kMagic));
   out.put(kVersion);
   out.put(LawShape{n_materials_, pair_stride_});
-  particle_fields(out, particles);
-  out.put<std::uint64_t>(walls.size());
-  for (const auto& w : walls) {
-    put_shape(out, w.shape);
-    wall_fields(out, w);
-  }
-  out.put(domain);
-  out.put(gravity);
-  out.put(dt);
-  out.put(adaptive_safety);
-  out.put(skin);
-  out.put(time);
-  out.put(step_count);
-  out.put(wall_strides_);
-  out.put(skin_);
-  out.put(prepared_);
-  list.save(out);
-  out.put(pair_history);
-  out.put<std::uint64_t>(wall_history.size());
-  for (const auto& h : wall_history) out.put(h);
-  out.put<std::uint64_t>(wall_reach.size());
-  for (const auto& r : wall_reach) {
-    out.put(r.near);
-    put_shape(out, r.shape);
-    out.put(r.range);
-    out.put(r.extent);
-    out.put(r.valid);
-  }
-  frame_fields(out, clump_frames);
+  state_fields(out, *this);
   return out.take();
 }
 
@@ -166,41 +173,11 @@ void World::restore_state(std::string_view state) {
   const auto laws = in.get<LawShape>();
   if (!(laws == LawShape{n_materials_, pair_laws_.empty() ? 0 : pair_laws_[0].history_size()}))
     throw InputError("checkpoint", "made with other contact laws than this run's");
-  // Read into a copy: a damaged record leaves this world as it was. Every count read below is
-  // bounded by the bytes left, as each element takes some.
+  // Read into a copy: a damaged record leaves this world as it was. Every count read is bounded
+  // by the bytes left, as each element takes some.
   World w = *this;
   w.pair_stride_ = laws.pair_stride;
-  particle_fields(in, w.particles);
-  w.walls.clear();
-  for (auto n = in.get<std::uint64_t>(); n > 0; --n) {
-    walls::Wall& wall = w.walls.emplace_back();
-    wall.shape = get_shape(in);
-    wall_fields(in, wall);
-  }
-  in.get(w.domain);
-  in.get(w.gravity);
-  in.get(w.dt);
-  in.get(w.adaptive_safety);
-  in.get(w.skin);
-  in.get(w.time);
-  in.get(w.step_count);
-  in.get(w.wall_strides_);
-  in.get(w.skin_);
-  in.get(w.prepared_);
-  w.list.restore(in);
-  in.get(w.pair_history);
-  w.wall_history.clear();
-  for (auto n = in.get<std::uint64_t>(); n > 0; --n) in.get(w.wall_history.emplace_back());
-  w.wall_reach.clear();
-  for (auto n = in.get<std::uint64_t>(); n > 0; --n) {
-    WallReach& r = w.wall_reach.emplace_back();
-    in.get(r.near);
-    r.shape = get_shape(in);
-    in.get(r.range);
-    in.get(r.extent);
-    in.get(r.valid);
-  }
-  frame_fields(in, w.clump_frames);
+  state_fields(in, w);
   w.clump_frames.q_mid.resize(w.clump_frames.q.size());
   in.expect_end();
   if (const std::string why = w.state_mismatch(); !why.empty()) throw InputError("checkpoint", why);
