@@ -138,6 +138,20 @@ long run_checked(sim::World& world, long steps, const sim::HealthLimits& limits,
   return steps;
 }
 
+namespace {
+
+/// Height of the bed's centre of mass (m).
+double centre_height(const particles::ParticleStore& p) {
+  double mass = 0.0, moment = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    mass += p.mass[i];
+    moment += p.mass[i] * p.x[i].z;
+  }
+  return mass > 0.0 ? moment / mass : 0.0;
+}
+
+}  // namespace
+
 PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limits,
                  double time_factor) {
   const PhaseClock clock(w);
@@ -154,28 +168,52 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
   const double rho = volume > 0.0 ? mass / volume : 0.0;
   const double height = std::max(top - bottom, 0.0);
   const double g = norm(w.gravity);
-  // The bed height the tests start from is read at rest under the bed's own weight: the
-  // reference is the order of that weight stress (solid fraction 0.6 over the column), or the
-  // test's stress level where it is lower.
+  // Two ways to rest, the first met ends the phase:
+  // - quiet: the kinetic stress is small against the order of the bed's weight stress (solid
+  //   fraction 0.6 over the column) or the test's stress level where that is lower; the bed
+  //   height the tests start from is read at rest under the bed's own weight;
+  // - static: the bed no longer sinks (below) and the kinetic stress is small against the
+  //   test's stress level (its weight stress for a test without one): a bed whose structure has
+  //   stopped moving is settled even while its contacts still ring at the level of its weight.
   constexpr double kSolidFraction = 0.6;
   const double weight = kSolidFraction * rho * g * height;
-  const double sigma = spec.rest_stress > 0.0 ? std::min(spec.rest_stress, weight) : weight;
+  const double quiet_stress = spec.rest_stress > 0.0 ? std::min(spec.rest_stress, weight) : weight;
+  const double static_stress = spec.rest_stress > 0.0 ? spec.rest_stress : weight;
   // rho <v^2> < I^2 sigma with <v^2> = 2 KE / M.
-  const double ke_limit =
-      0.5 * mass * spec.rest_inertial_number * spec.rest_inertial_number * sigma / rho;
+  const double ke_per_stress =
+      0.5 * mass * spec.rest_inertial_number * spec.rest_inertial_number / rho;
   // Freshly inserted particles are at rest before they fall: the criterion counts only after
   // the free-fall time of the column they were inserted in.
   const double fall = g > 0.0 ? std::sqrt(2.0 * height / g) : 0.0;
   const double t0 = w.time;
   const long chunk = std::max<long>(200, std::lround(0.002 * time_factor / w.dt));
+  // The bed no longer sinks: its centre of mass moved by less than rest_sink_rate x the bed's
+  // height (twice the centre's height above the lowest particle bottom at the start) per real
+  // second over the last kSinkChecks checks.
+  constexpr std::size_t kSinkChecks = 5;
+  std::vector<std::pair<double, double>> checks;  // (time, centre of mass height) at each check
   bool rest = false;
   while (!rest && w.time - t0 < max_time) {
     run_checked(w, chunk, limits);
-    rest = w.time - t0 >= fall && p.kinetic_energy() < ke_limit;
+    checks.emplace_back(w.time, centre_height(p));
+    bool still = false;
+    if (checks.size() > kSinkChecks) {
+      const auto& [t_then, z_then] = checks[checks.size() - 1 - kSinkChecks];
+      const double real_time = (w.time - t_then) / time_factor;
+      const double bed_height = 2.0 * (checks.back().second - bottom);
+      still =
+          std::abs(checks.back().second - z_then) < spec.rest_sink_rate * bed_height * real_time;
+    }
+    const double ke = p.kinetic_energy();
+    rest = w.time - t0 >= fall &&
+           (ke < ke_per_stress * quiet_stress || (still && ke < ke_per_stress * static_stress));
   }
-  char target[128];
-  std::snprintf(target, sizeof target, "kinetic stress < %.3g^2 x %s (simulated) within %.3g s",
-                spec.rest_inertial_number, stress_text(sigma).c_str(), max_time);
+  char target[200];
+  std::snprintf(target, sizeof target,
+                "kinetic stress < %.3g^2 x %s, or sinking < %.3g x height per s and kinetic "
+                "stress < %.3g^2 x %s (simulated), within %.3g s",
+                spec.rest_inertial_number, stress_text(quiet_stress).c_str(), spec.rest_sink_rate,
+                spec.rest_inertial_number, stress_text(static_stress).c_str(), max_time);
   return clock.stop(w, "settle", target, rest);
 }
 

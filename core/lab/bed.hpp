@@ -18,12 +18,15 @@ struct BedSpec {
   double insert_height =
       0.0;  ///< height of the insertion region (m); 0 = from a loose fraction 0.25
   double time_step_safety = 0.2;  ///< dt = safety * critical time step
-  /// At rest when the kinetic stress of the residual motion, rho_p <v^2> (mass-weighted mean),
-  /// is below rest_inertial_number^2 times the reference stress (docs/lab-tests.md,
-  /// "Settling"): the bed's weight stress, or the test's stress level where that is lower.
+  /// At rest (docs/lab-tests.md, "Settling") when the kinetic stress of the residual motion,
+  /// rho_p <v^2> (mass-weighted mean), is below rest_inertial_number^2 times the reference
+  /// stress: the test's stress level, or the bed's weight stress for a test without one.
   /// 1e-3: the motion carries 1e-6 of that stress (GDR MiDi's quasi-static bound on I).
   double rest_inertial_number = 1e-3;
-  double rest_stress = 0.0;      ///< stress level of the test (Pa, simulated); 0 = the bed's weight
+  double rest_stress = 0.0;  ///< stress level of the test (Pa, simulated); 0 = the bed's weight
+  /// ... and the bed no longer sinks: its centre of mass moved by less than this fraction of the
+  /// bed's height per real second over the last five checks (0.01 s real).
+  double rest_sink_rate = 1e-3;
   double max_settle_time = 2.0;  ///< (s), real: x the material's time factor when simulated
 };
 
