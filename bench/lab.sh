@@ -17,7 +17,7 @@ DEMCAL="$BUILD/client/demcal"
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 source "$root/bench/lab_spec.sh"
-echo "material $MATERIAL ($root/bench/materials/$MATERIAL.yaml), $THREADS threads"
+echo "material $MATERIAL ($root/bench/materials/$MATERIAL.yaml), $THREADS threads, OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}"
 printf "%-22s %9s %8s %10s %12s %7s  %s\n" test particles wall_s steps p-steps/s short metrics
 for n in ${COUNTS//,/ }; do
   for test in ${TESTS:-packing confined_compression tensile wall_friction shear_cell rotating_drum hopper}; do
