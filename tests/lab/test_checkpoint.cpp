@@ -6,6 +6,7 @@
 // `checkpoint`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 
 #include "core/common/error.hpp"
@@ -70,8 +71,9 @@ std::vector<std::string> expect_resumes_to_the_same_bits(const std::string& test
     SCOPED_TRACE(test + " from '" + from.stage + "'");
     const LabOutput again = resumed(test, material, settings, from);
     EXPECT_EQ(again.resumed_from, from.stage);
-    EXPECT_TRUE(!again.notes.empty() &&
-                again.notes.back().find("checkpoint '" + from.stage + "'") != std::string::npos);
+    EXPECT_TRUE(std::any_of(again.notes.begin(), again.notes.end(), [&](const std::string& n) {
+      return n.find("checkpoint '" + from.stage + "'") != std::string::npos;
+    })) << "a note names the stage the run went on from";
     expect_same_run(whole, again);
   }
   return stages;
