@@ -150,6 +150,25 @@ double centre_height(const particles::ParticleStore& p) {
   return mass > 0.0 ? moment / mass : 0.0;
 }
 
+/// The bed's centre of mass at each settling check, and whether the bed has stopped sinking.
+class SinkWatch {
+ public:
+  void record(const sim::World& w) { checks_.emplace_back(w.time, centre_height(w.particles)); }
+  /// The centre of mass moved by less than `rate` x the bed's height (twice the centre's height
+  /// above `bottom`) per real second over the last kChecks checks.
+  bool still(double rate, double bottom, double time_factor) const {
+    if (checks_.size() <= kChecks) return false;
+    const auto& [t_now, z_now] = checks_.back();
+    const auto& [t_then, z_then] = checks_[checks_.size() - 1 - kChecks];
+    const double real_time = (t_now - t_then) / time_factor;
+    return std::abs(z_now - z_then) < rate * 2.0 * (z_now - bottom) * real_time;
+  }
+
+ private:
+  static constexpr std::size_t kChecks = 5;
+  std::vector<std::pair<double, double>> checks_;  // (time, centre of mass height)
+};
+
 }  // namespace
 
 PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limits,
@@ -187,23 +206,12 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
   const double fall = g > 0.0 ? std::sqrt(2.0 * height / g) : 0.0;
   const double t0 = w.time;
   const long chunk = std::max<long>(200, std::lround(0.002 * time_factor / w.dt));
-  // The bed no longer sinks: its centre of mass moved by less than rest_sink_rate x the bed's
-  // height (twice the centre's height above the lowest particle bottom at the start) per real
-  // second over the last kSinkChecks checks.
-  constexpr std::size_t kSinkChecks = 5;
-  std::vector<std::pair<double, double>> checks;  // (time, centre of mass height) at each check
+  SinkWatch sinking;
   bool rest = false;
   while (!rest && w.time - t0 < max_time) {
     run_checked(w, chunk, limits);
-    checks.emplace_back(w.time, centre_height(p));
-    bool still = false;
-    if (checks.size() > kSinkChecks) {
-      const auto& [t_then, z_then] = checks[checks.size() - 1 - kSinkChecks];
-      const double real_time = (w.time - t_then) / time_factor;
-      const double bed_height = 2.0 * (checks.back().second - bottom);
-      still =
-          std::abs(checks.back().second - z_then) < spec.rest_sink_rate * bed_height * real_time;
-    }
+    sinking.record(w);
+    const bool still = sinking.still(spec.rest_sink_rate, bottom, time_factor);
     const double ke = p.kinetic_energy();
     rest = w.time - t0 >= fall &&
            (ke < ke_per_stress * quiet_stress || (still && ke < ke_per_stress * static_stress));
