@@ -31,7 +31,9 @@ struct RunCost {
   std::size_t particles = 0;        ///< particles (clump members counted) at the end
   std::int64_t steps = 0;           ///< all steps of the run
   double simulated_time = 0.0;      ///< (s)
-  double wall_seconds = 0.0;        ///< the whole run, building the bed included
+  /// The whole run, building the bed included; a run resumed from a checkpoint adds the wall
+  /// time of the phases its earlier attempt ran.
+  double wall_seconds = 0.0;
   std::vector<PhaseCost> phases;    ///< in the order they ran
 
   double particle_steps_per_second() const;

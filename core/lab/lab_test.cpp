@@ -93,7 +93,7 @@ LabOutput run_lab_test(const std::string& name, const MaterialModel& material,
     };
   const ProgressScope scope(&options.progress);
   LabOutput out = runner_of(name)(material, settings, run);
-  out.cost.wall_seconds =
+  out.cost.wall_seconds +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (out.resumed_from != options.resume.stage)
     throw InputError("checkpoint", "stage '" + options.resume.stage + "' is not one the " + name +

@@ -75,6 +75,11 @@ std::vector<std::string> expect_resumes_to_the_same_bits(const std::string& test
       return n.find("checkpoint '" + from.stage + "'") != std::string::npos;
     })) << "a note names the stage the run went on from";
     expect_same_run(whole, again);
+    // The run's wall time covers its phases, those of the earlier attempt included, so that its
+    // particle-steps per second are of the steps it counts.
+    double phases_wall = 0.0;
+    for (const auto& phase : again.cost.phases) phases_wall += phase.wall_seconds;
+    EXPECT_GE(again.cost.wall_seconds, phases_wall);
   }
   return stages;
 }
