@@ -14,6 +14,12 @@ double RunCost::particle_steps_per_second() const {
              : 0.0;
 }
 
+double RunCost::phases_wall_seconds() const {
+  double sum = 0.0;
+  for (const auto& p : phases) sum += p.wall_seconds;
+  return sum;
+}
+
 void RunCost::close(const sim::World& world) {
   time_step = world.dt;
   const sim::TimeStepLimit limit = sim::critical_time_step(world);

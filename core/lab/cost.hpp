@@ -34,9 +34,11 @@ struct RunCost {
   /// The whole run, building the bed included; a run resumed from a checkpoint adds the wall
   /// time of the phases its earlier attempt ran.
   double wall_seconds = 0.0;
-  std::vector<PhaseCost> phases;    ///< in the order they ran
+  std::vector<PhaseCost> phases;  ///< in the order they ran
 
   double particle_steps_per_second() const;
+  /// The wall time of the phases: of a resumed run, those its earlier attempt ran included.
+  double phases_wall_seconds() const;
   /// Fills the time step, its limit and the particle count from the world a test ran on, and the
   /// steps and simulated time as the sums over the phases (a test may run phases on copies).
   void close(const sim::World& world);

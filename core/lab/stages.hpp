@@ -72,8 +72,7 @@ class Stages {
     in.expect_end();
     // The run's wall time counts the phases the earlier attempt ran (run_lab_test adds this
     // attempt's), so that its particle-steps per second stay those of the steps it counts.
-    out_.cost.wall_seconds = 0.0;
-    for (const PhaseCost& phase : out_.cost.phases) out_.cost.wall_seconds += phase.wall_seconds;
+    out_.cost.wall_seconds = out_.cost.phases_wall_seconds();
     out_.resumed_from = stage;
     out_.notes.push_back("went on from the checkpoint '" + stage +
                          "': the phases up to it ran in an earlier attempt (their costs are its)");
