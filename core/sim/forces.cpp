@@ -181,7 +181,6 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
   const double range = w.interaction_range();
 
   auto& p = w.particles;
-  const int n = static_cast<int>(p.size());
   const auto& start = w.list.row_start;
   const auto& nbr = w.list.nbr;
   double* hist = w.pair_history.data();
@@ -201,7 +200,7 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
 #pragma omp parallel num_threads(threads)
   {
     const int tid = omp_get_thread_num();
-    const auto [lo, hi] = owned_range(n, tid, threads);
+    const auto [lo, hi] = w.owned_range(tid);
     auto& deferred = w.deferred[tid];
     deferred.clear();
     for (int i = lo; i < hi; ++i) {

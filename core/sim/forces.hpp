@@ -8,12 +8,6 @@
 
 namespace demcal::sim {
 
-/// The particles [lo, hi) thread `tid` of `threads` owns, in every parallel loop of the step.
-inline std::pair<int, int> owned_range(int n, int tid, int threads) {
-  return {static_cast<int>(static_cast<long>(n) * tid / threads),
-          static_cast<int>(static_cast<long>(n) * (tid + 1) / threads)};
-}
-
 /// Work a thread does on the particles it owns, [lo, hi), once their forces are final.
 using OwnedRangeTask = std::function<void(int lo, int hi)>;
 

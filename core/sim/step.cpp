@@ -17,13 +17,12 @@ namespace {
 /// the skin since the last neighbour-list build.
 bool kick_drift(World& w) {
   auto& p = w.particles;
-  const int n = static_cast<int>(p.size());
   const bool clumps = p.clumps.size() > 0;
   const double half_skin = 0.5 * w.effective_skin();
   double worst = 0.0;
 #pragma omp parallel num_threads(w.active_threads()) reduction(max : worst)
   {
-    const auto [lo, hi] = owned_range(n, omp_get_thread_num(), omp_get_num_threads());
+    const auto [lo, hi] = w.owned_range(omp_get_thread_num());
     integrate::kick_drift(p, w.dt, lo, hi);
     if (clumps) integrate::clump_kick_drift(p, w.clump_frames, w.domain, w.gravity, w.dt);
     for (int i = lo; i < hi; ++i) worst = std::max(worst, w.list.displacement2(i, p.x[i]));
@@ -40,6 +39,7 @@ void step(World& w) {
     // first kick below uses the forces of the initial configuration (as LIGGGHTS' setup does).
     w.prepare();
   }
+  if (!w.owners_fit()) w.balance_owners();
   const double half = 0.5 * w.dt;
   auto& p = w.particles;
   const bool clumps = p.clumps.size() > 0;

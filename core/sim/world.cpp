@@ -68,6 +68,39 @@ void World::rebuild_list() {
   list.build(particles.x, particles.radius, domain, interaction_range() + skin_, active_threads(),
              pair_history, pair_stride_, clump_bodies());
   for (auto& reach : wall_reach) reach.valid = false;
+  balance_owners();
+}
+
+void World::balance_owners() {
+  const int active = active_threads();
+  const int n = static_cast<int>(particles.size());
+  owner_bounds_.assign(active + 1, n);
+  owner_bounds_[0] = 0;
+  if (active == 1 || list.row_start.size() != particles.size() + 1) {
+    for (int t = 1; t < active; ++t)
+      owner_bounds_[t] = static_cast<int>(static_cast<long>(n) * t / active);
+    return;
+  }
+  // The work of each particle, summed along the index order; thread t starts at the first
+  // particle with at least t / active of the total before it.
+  const double range = interaction_range();
+  const MinimumImage image(domain);
+  std::vector<long> before(n + 1, 0);
+  for (int i = 0; i < n; ++i) {
+    long work = kOwnerRowCost;
+    for (int k = list.row_start[i]; k < list.row_start[i + 1]; ++k) {
+      const int j = list.nbr[k];
+      const double reach = particles.radius[i] + particles.radius[j] + range;
+      work += norm2(image(particles.x[j] - particles.x[i])) < reach * reach ? kOwnerContactCost : 1;
+    }
+    before[i + 1] = before[i] + work;
+  }
+  int i = 0;
+  for (int t = 1; t < active; ++t) {
+    const long share = before[n] * t / active;
+    while (i < n && before[i] < share) ++i;
+    owner_bounds_[t] = i;
+  }
 }
 
 void World::refresh_wall_reach() {
@@ -164,6 +197,7 @@ void World::prepare() {
   pair_history.clear();
   list.build(particles.x, particles.radius, domain, interaction_range() + skin_, threads,
              pair_history, pair_stride_, clump_bodies());
+  balance_owners();
   clump_frames.reset(particles);
   wall_history.assign(walls.size(), {});
   for (std::size_t w = 0; w < walls.size(); ++w)

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/common/domain.hpp"
@@ -44,6 +45,25 @@ class World {
   }
   double time = 0.0;
   std::int64_t step_count = 0;
+
+  /// The particles [lo, hi) thread `tid` of the active threads owns, in every parallel loop of a
+  /// step: contiguous ranges of about equal work, set at each neighbour-list build
+  /// (balance_owners).
+  std::pair<int, int> owned_range(int tid) const {
+    return {owner_bounds_[tid], owner_bounds_[tid + 1]};
+  }
+  /// Splits the particles into active_threads() contiguous ranges of about equal work: a particle
+  /// costs kOwnerRowCost plus one per pair of its neighbour-list row (its contacts are evaluated
+  /// by its owner; a later owner also adds the forces deferred to it). A function of the list
+  /// alone, so a run and its resumption from a checkpoint split alike.
+  void balance_owners();
+  /// Whether the owners' ranges are of the current particles and thread count.
+  bool owners_fit() const {
+    return owner_bounds_.size() == static_cast<std::size_t>(active_threads()) + 1 &&
+           owner_bounds_.back() == static_cast<int>(particles.size());
+  }
+  static constexpr int kOwnerRowCost = 2;
+  static constexpr int kOwnerContactCost = 8;
 
   /// Contact laws. Particle-particle laws by (material i, material j), symmetric; particle-wall
   /// laws by (wall material, particle material). All particle-particle laws share one composition
@@ -136,6 +156,7 @@ class World {
   int n_materials_ = 0;
   int pair_stride_ = 0;
   std::vector<int> wall_strides_;
+  std::vector<int> owner_bounds_{0, 0};  ///< thread t owns [owner_bounds_[t], owner_bounds_[t + 1])
   double skin_ = 0.0;
   bool prepared_ = false;
 };

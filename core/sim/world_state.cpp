@@ -182,6 +182,7 @@ void World::restore_state(std::string_view state) {
   in.expect_end();
   if (const std::string why = w.state_mismatch(); !why.empty()) throw InputError("checkpoint", why);
   w.deferred.clear();
+  w.balance_owners();
   *this = std::move(w);
 }
 

@@ -109,6 +109,38 @@ TEST(SimThreads, SmallSystemsRunOnFewerThreadsThanAsked) {
   EXPECT_EQ(w.active_threads(), 1);
 }
 
+TEST(SimThreads, OwnersShareTheContactsNotTheCount) {
+  // 400 spheres: the first 200 touch their neighbours in a 10 x 20 square layer, the last 200
+  // lie far apart. Two threads split the work, so the first owns fewer than half the spheres.
+  sim::World w;
+  w.gravity = {};
+  w.dt = 1e-6;
+  w.threads = 2;
+  w.particles_per_thread = 1;
+  w.set_pair_law(
+      0, 0,
+      contact::ContactLaw::from_spec(
+          {{"linear", {{"kn", 1000.0}}}, {"none", {}}, {"history", {{"mu_s", 0.5}}}, {"none", {}}},
+          "law"));
+  const double r = 0.001;
+  for (int i = 0; i < 200; ++i)
+    w.particles.add_sphere({1.99 * r * (i % 10), 1.99 * r * (i / 10), 0}, r, 2500, 0);
+  for (int i = 0; i < 200; ++i) w.particles.add_sphere({0.1 + 0.01 * i, 0, 0}, r, 2500, 0);
+  sim::run(w, 1);
+  ASSERT_EQ(w.active_threads(), 2);
+  const auto [lo0, hi0] = w.owned_range(0);
+  const auto [lo1, hi1] = w.owned_range(1);
+  EXPECT_EQ(lo0, 0);
+  EXPECT_EQ(hi0, lo1);
+  EXPECT_EQ(hi1, 400);
+  EXPECT_LT(hi0, 200) << "the touching layer holds the work";
+  EXPECT_GT(hi0, 100);
+  // One thread owns every sphere.
+  w.threads = 1;
+  sim::run(w, 1);
+  EXPECT_EQ(w.owned_range(0), std::make_pair(0, 400));
+}
+
 TEST(SimDeterminism, SkinDoesNotChangeOneBitBecauseHistorySurvivesRebuilds) {
   const double r = 0.001;
   sim::World small = load(kShearedBed, 1, 0.05 * r), large = load(kShearedBed, 1, 0.6 * r);
