@@ -2,7 +2,6 @@
 // The force stage of the step: gravity, particle-particle and particle-wall contacts, in one
 // parallel region in which each thread owns a contiguous range of particles.
 #include <functional>
-#include <utility>
 
 #include "core/sim/world.hpp"
 

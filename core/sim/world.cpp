@@ -76,19 +76,18 @@ void World::balance_owners() {
   const int n = static_cast<int>(particles.size());
   owner_bounds_.assign(active + 1, n);
   owner_bounds_[0] = 0;
-  if (active == 1 || list.row_start.size() != particles.size() + 1) {
-    for (int t = 1; t < active; ++t)
-      owner_bounds_[t] = static_cast<int>(static_cast<long>(n) * t / active);
-    return;
-  }
-  // The work of each particle, summed along the index order; thread t starts at the first
-  // particle with at least t / active of the total before it.
+  if (active == 1) return;
+  // The work of each particle, summed along the index order (a particle without a list row yet
+  // has its own cost only); thread t starts at the first particle with at least t / active of
+  // the total before it.
+  const bool rows = list.row_start.size() == particles.size() + 1;
   const double range = interaction_range();
   const MinimumImage image(domain);
   std::vector<long> before(n + 1, 0);
   for (int i = 0; i < n; ++i) {
     long work = kOwnerRowCost;
-    for (int k = list.row_start[i]; k < list.row_start[i + 1]; ++k) {
+    const int first = rows ? list.row_start[i] : 0, last = rows ? list.row_start[i + 1] : 0;
+    for (int k = first; k < last; ++k) {
       const int j = list.nbr[k];
       const double reach = particles.radius[i] + particles.radius[j] + range;
       work += norm2(image(particles.x[j] - particles.x[i])) < reach * reach ? kOwnerContactCost : 1;

@@ -53,9 +53,10 @@ class World {
     return {owner_bounds_[tid], owner_bounds_[tid + 1]};
   }
   /// Splits the particles into active_threads() contiguous ranges of about equal work: a particle
-  /// costs kOwnerRowCost plus one per pair of its neighbour-list row (its contacts are evaluated
-  /// by its owner; a later owner also adds the forces deferred to it). A function of the list
-  /// alone, so a run and its resumption from a checkpoint split alike.
+  /// costs kOwnerRowCost, plus 1 per pair of its neighbour-list row and kOwnerContactCost per pair
+  /// of its row within reach (its owner evaluates them; a later owner also adds the forces
+  /// deferred to it). A function of the list alone, so a run and its resumption from a
+  /// checkpoint split alike. One thread owns every particle.
   void balance_owners();
   /// Whether the owners' ranges are of the current particles and thread count.
   bool owners_fit() const {
