@@ -14,6 +14,13 @@
 namespace demcal::diagnose {
 namespace {
 
+/// A value for a sentence, in six significant digits (5e-19 stays 5e-19, not 0.000000).
+std::string number(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
 /// A candidate's augmented design in its extended factor space.
 struct Plan {
   std::string id, cause;
@@ -94,7 +101,7 @@ Plan new_factor_plan(const Problem& p, std::string id, std::string cause,
 Plan size_distribution_plan(const Problem& p) {
   const double low = kSigmaGLow;
   if (!(p.options.sigma_g_max > low))
-    throw InputError("diagnose.sigma_g_max", "must be > " + std::to_string(low));
+    throw InputError("diagnose.sigma_g_max", "must be > " + number(low));
   return new_factor_plan(
       p, "size_distribution",
       "a size distribution: a log-normal number distribution (width sigma_g) instead of one size",
@@ -157,9 +164,9 @@ std::vector<Plan> candidate_plans(const Problem& p) {
       hi = std::min(hi, it->second.second);
     }
     if (!(lo < hi)) continue;
-    plans.push_back(new_factor_plan(
-        p, "fixed:" + path, "a parameter held fixed: " + path + " = " + std::to_string(value), {},
-        {path, doe::Factor{path, lo, hi, doe::Scale::kLog}}, value));
+    plans.push_back(new_factor_plan(p, "fixed:" + path,
+                                    "a parameter held fixed: " + path + " = " + number(value), {},
+                                    {path, doe::Factor{path, lo, hi, doe::Scale::kLog}}, value));
   }
   const auto k = p.design.cols();
   {
@@ -403,8 +410,8 @@ std::vector<MetricRow> baseline_rows(const Problem& p, const Fitted& base,
     row.reachable = m.value >= env.min && m.value <= env.max;
     row.statement = row.reachable ? "within reach of the factor box"
                     : m.value > env.max
-                        ? "above what the factor box reaches (max " + std::to_string(env.max) + ")"
-                        : "below what the factor box reaches (min " + std::to_string(env.min) + ")";
+                        ? "above what the factor box reaches (max " + number(env.max) + ")"
+                        : "below what the factor box reaches (min " + number(env.min) + ")";
     row.predicted = base.all[i].model.predict(base.result.coded);
     doe::AnalysisOptions ao;
     const auto analysis =

@@ -352,7 +352,9 @@ Report expect_hidden_cause_found(const Simulator& sim, const Parameters& truth,
     return r;
   }
   EXPECT_TRUE(c->proposed.count(path)) << path;
-  if (c->proposed.count(path)) EXPECT_NEAR(c->proposed.at(path), truth.at(path), tolerance);
+  if (c->proposed.count(path)) {
+    EXPECT_NEAR(c->proposed.at(path), truth.at(path), tolerance);
+  }
   EXPECT_LT(c->verified_rms, 0.7 * r.baseline_verified_rms);
   return r;
 }
@@ -619,6 +621,56 @@ TEST(Diagnosis, FirstCallRequestsTheBaselineAndEveryCandidatesDesign) {
   }
   EXPECT_DOUBLE_EQ(clusters[4].parameters.at(kSpread), 0.5);
   expect_base_factors_at(clusters[4], 0.0, 0.0, 0.0);
+}
+
+/// As the rolling truth, but what the base factors cannot reach is a parameter the campaign
+/// holds fixed (a wall's Hamaker constant): the runs that do not set it run at the fixed value,
+/// and every decade of it above that value raises both metrics (off the line L, where neither
+/// rolling resistance nor a width of sizes reaches).
+const char* const kWallHamaker = "wall_law.cohesion.hamaker";
+constexpr double kFixedWallHamaker = 5e-19;
+constexpr double kTrueWallHamaker = 2e-18;
+Responses fixed_wall_truth(const Parameters& p, const Switches&) {
+  const auto [a, b, c] = coded_point(p);
+  const auto it = p.find(kWallHamaker);
+  const double decades =
+      std::log10((it != p.end() ? it->second : kFixedWallHamaker) / kFixedWallHamaker);
+  const double l = a + 0.5 * b + 0.3 * c;
+  return {{kSf, 0.60 - 0.02 * l + 0.03 * decades}, {kCn, 5.0 + 0.5 * l + 0.4 * decades}};
+}
+
+TEST(Diagnosis, HiddenValueOfAFixedParameterIsNamedAndRecovered) {
+  auto truth_point = natural_point(0.3, -0.2, 0.1);
+  truth_point[kWallHamaker] = kTrueWallHamaker;
+  const auto ms = targets_at(fixed_wall_truth(truth_point, {}), {kSf, kCn});
+  Problem p = make_problem(fixed_wall_truth, {kSf, kCn}, ms);
+  p.fixed[kWallHamaker] = kFixedWallHamaker;
+  p.options.fixed_span = 10.0;
+  const std::string id = std::string("fixed:") + kWallHamaker;
+  p.options.candidates = {id, "rolling", "size_distribution"};
+
+  // Its runs: the base factorial rows at the fixed value / 10 and at x 10 (docs/diagnosis.md).
+  const auto first = of_group(diagnose::advance(p, {}).requests, id);
+  ASSERT_EQ(first.size(), 8u);
+  int low = 0, high = 0;
+  for (const auto& run : first) {
+    const double v = run.parameters.at(kWallHamaker);
+    low += std::abs(v / (kFixedWallHamaker / 10.0) - 1.0) < 1e-12;
+    high += std::abs(v / (kFixedWallHamaker * 10.0) - 1.0) < 1e-12;
+  }
+  EXPECT_EQ(low, 4);
+  EXPECT_EQ(high, 4);
+
+  const Report r = drive(p, fixed_wall_truth).step.report;
+  EXPECT_EQ(r.state, "done");
+  EXPECT_EQ(r.named_cause, id) << r.conclusion;
+  const CandidateOutcome* c = candidate(r, id);
+  ASSERT_NE(c, nullptr);
+  ASSERT_TRUE(c->proposed.count(kWallHamaker));
+  EXPECT_NEAR(c->proposed.at(kWallHamaker) / kTrueWallHamaker, 1.0, 0.1);
+  EXPECT_LT(c->verified_rms, 0.7 * r.baseline_verified_rms);
+  // The cause states the fixed value as given, not rounded to six decimals.
+  EXPECT_NE(c->cause.find(std::string(kWallHamaker) + " = 5e-19"), std::string::npos) << c->cause;
 }
 
 // --- e) inputs that cannot be diagnosed -----------------------------------------------------
