@@ -11,12 +11,17 @@
 namespace demcal::particles {
 namespace {
 
-/// Hash grid of the spheres already placed, for the overlap check of a candidate.
+/// Hash grid of the spheres already placed (their centres and radii), for the overlap check of a
+/// candidate.
 class PlacementGrid {
  public:
   explicit PlacementGrid(double cell) : cell_(cell) {}
-  void add(std::size_t i, const Vec3& x) { cells_[key(x)].push_back(i); }
-  bool overlaps(const ParticleStore& s, const Vec3& x, double r, double gap) const {
+  void add(const Vec3& x, double r) {
+    cells_[key(x)].push_back(x_.size());
+    x_.push_back(x);
+    r_.push_back(r);
+  }
+  bool overlaps(const Vec3& x, double r, double gap) const {
     const auto c = coords(x);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
@@ -24,11 +29,16 @@ class PlacementGrid {
           const auto it = cells_.find(pack(c[0] + dx, c[1] + dy, c[2] + dz));
           if (it == cells_.end()) continue;
           for (std::size_t j : it->second) {
-            const double min_d = r + s.radius[j] + gap;
-            if (norm2(s.x[j] - x) < min_d * min_d) return true;
+            const double min_d = r + r_[j] + gap;
+            if (norm2(x_[j] - x) < min_d * min_d) return true;
           }
         }
     return false;
+  }
+  /// The cell of x as (z, y, x) integer coordinates: ordering by it stores a bed layer by layer.
+  std::array<std::int64_t, 3> layer_order(const Vec3& x) const {
+    const auto c = coords(x);
+    return {c[2], c[1], c[0]};
   }
 
  private:
@@ -46,7 +56,35 @@ class PlacementGrid {
   }
   double cell_;
   std::unordered_map<std::int64_t, std::vector<std::size_t>> cells_;
+  std::vector<Vec3> x_;
+  std::vector<double> r_;
 };
+
+/// A sphere or clump placed by the insertion, added to the store once all are placed.
+struct Placement {
+  Vec3 centre;
+  Quat orientation;
+  double radius;
+};
+
+/// Adds the placements to the store: as drawn, or (req.cell_order) in the order of their grid
+/// cells, layer by layer (z, then y, then x; drawn order within a cell).
+void add_placed(ParticleStore& store, const InsertRequest& req, const PlacementGrid& grid,
+                const std::vector<Placement>& placed) {
+  std::vector<std::size_t> order(placed.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  if (req.cell_order)
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return grid.layer_order(placed[a].centre) < grid.layer_order(placed[b].centre);
+    });
+  for (std::size_t k : order) {
+    const Placement& p = placed[k];
+    if (req.shape)
+      store.add_clump(p.centre, p.orientation, *req.shape, p.radius, req.density, req.material);
+    else
+      store.add_sphere(p.centre, p.radius, req.density, req.material);
+  }
+}
 
 /// A uniformly random centre for a sphere of radius r that lies wholly inside the region.
 bool random_centre(const Region& region, double r, Rng& rng, Vec3& out) {
@@ -91,20 +129,25 @@ void insert_random(ParticleStore& store, const InsertRequest& req, Rng& rng) {
   }
   const double r_max = max_radius(req.sizes) * largest_member;
   PlacementGrid grid(2.0 * r_max + req.gap);
-  for (std::size_t i = 0; i < store.size(); ++i) grid.add(i, store.x[i]);
+  for (std::size_t i = 0; i < store.size(); ++i) grid.add(store.x[i], store.radius[i]);
   store.reserve(store.size() + req.count * (shape ? shape->size() : 1));
+  std::vector<Placement> placed;
+  placed.reserve(req.count);
   std::vector<Vec3> members;
-  for (std::size_t placed = 0; placed < req.count; ++placed) {
+  while (placed.size() < req.count) {
     const double r = sample_radius(req.sizes, rng);
     bool ok = false;
     for (std::size_t attempt = 0; attempt < req.max_attempts_per_particle && !ok; ++attempt) {
       Vec3 c;
-      if (!random_centre(req.region, r * bounding + req.gap, rng, c))
+      if (!random_centre(req.region, r * bounding + req.gap, rng, c)) {
+        add_placed(store, req, grid, placed);
         throw InputError("insertion.region",
                          "region too small for a particle of radius " + std::to_string(r));
+      }
       if (!shape) {
-        if (grid.overlaps(store, c, r, req.gap)) continue;
-        grid.add(store.add_sphere(c, r, req.density, req.material), c);
+        if (grid.overlaps(c, r, req.gap)) continue;
+        grid.add(c, r);
+        placed.push_back({c, Quat{}, r});
         ok = true;
         continue;
       }
@@ -113,20 +156,23 @@ void insert_random(ParticleStore& store, const InsertRequest& req, Rng& rng) {
       bool free = true;
       for (std::size_t k = 0; k < shape->size() && free; ++k) {
         members.push_back(c + q.rotate(shape->offsets[k] * r));
-        free = !grid.overlaps(store, members.back(), shape->radii[k] * r, req.gap);
+        free = !grid.overlaps(members.back(), shape->radii[k] * r, req.gap);
       }
       if (!free) continue;
-      const std::size_t b = store.add_clump(c, q, *shape, r, req.density, req.material);
-      for (std::size_t k = 0; k < shape->size(); ++k)
-        grid.add(store.clumps.first[b] + k, members[k]);
+      for (std::size_t k = 0; k < shape->size(); ++k) grid.add(members[k], shape->radii[k] * r);
+      placed.push_back({c, q, r});
       ok = true;
     }
-    if (!ok)
-      throw InputError("insertion.count", "could place only " + std::to_string(placed) + " of " +
-                                              std::to_string(req.count) +
+    if (!ok) {
+      // What was placed stays placed: a caller may let the bed settle and insert the rest.
+      add_placed(store, req, grid, placed);
+      throw InputError("insertion.count", "could place only " + std::to_string(placed.size()) +
+                                              " of " + std::to_string(req.count) +
                                               " particles without overlap; enlarge the region or "
                                               "insert fewer");
+    }
   }
+  add_placed(store, req, grid, placed);
 }
 
 void insert_lattice(ParticleStore& store, const Vec3& origin, double spacing, int nx, int ny,

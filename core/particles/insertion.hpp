@@ -32,11 +32,19 @@ struct InsertRequest {
   /// volume-equivalent radius, the orientation uniformly random.
   std::optional<ClumpTemplate> shape;
   std::size_t max_attempts_per_particle = 2000;
+  /// Store the placed particles in the order of their cells, layer by layer (z, then y, then x),
+  /// instead of the order they were drawn. The positions are the same; the memory order follows
+  /// space, so each thread's contiguous range of particles (docs/engine.md, "Threads") is a slab
+  /// of the bed. For beds that will run on more than one thread.
+  bool cell_order = false;
+  /// Spheres the request adds (a clump counts its members).
+  std::size_t spheres() const { return count * (shape ? shape->size() : 1); }
 };
 
 /// Random sequential insertion: each new sphere (or clump) is placed at a uniformly random
 /// position inside the region where it overlaps neither the region border (a clump: its
-/// bounding sphere) nor any sphere already in `store`.
+/// bounding sphere) nor any sphere already in `store`; stored as drawn or in cell order
+/// (InsertRequest::cell_order).
 /// Throws InputError when the region cannot take `count` spheres (too dense for random insertion).
 void insert_random(ParticleStore& store, const InsertRequest& request, Rng& rng);
 

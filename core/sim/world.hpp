@@ -37,9 +37,10 @@ class World {
   static constexpr int kParticlesPerThread = 2000;
   /// The threads a step runs on: `threads`, or fewer so that each has particles_per_thread.
   /// Results are bitwise identical for a given number of active threads.
-  int active_threads() const {
-    const auto by_size =
-        particles.size() / static_cast<std::size_t>(std::max(1, particles_per_thread));
+  int active_threads() const { return active_threads_for(particles.size()); }
+  /// The threads a step of `count` particles would run on.
+  int active_threads_for(std::size_t count) const {
+    const auto by_size = count / static_cast<std::size_t>(std::max(1, particles_per_thread));
     return static_cast<int>(
         std::clamp<std::size_t>(by_size, 1, static_cast<std::size_t>(std::max(1, threads))));
   }

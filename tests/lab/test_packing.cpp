@@ -1,11 +1,14 @@
 // packing (seed 000 §2.7.1, §3.1): cohesionless mono-sized pouring gives 0.57-0.64; frictionless
 // spheres pour to random close packing, frictional ones looser; every preparation method runs
 // (material.preparation); with van der Waals cohesion (cluster formation) the solid fraction
-// falls as the particle size falls (Fig. 14).
+// falls as the particle size falls (Fig. 14). A bed that will run on several threads is stored
+// layer by layer.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 
+#include "core/lab/bed.hpp"
 #include "lab_test_util.hpp"
 
 namespace demcal::lab {
@@ -34,6 +37,28 @@ TEST(Packing, CohesionlessPouringIsRandomPacking) {
 // (phi ~0.59, Z ~4.5-5; Silbert, Soft Matter 6 (2010) 2918). Sampled two diameters from the walls;
 // measured at 500 particles: 0.642, Z 5.92 without friction, 0.588, Z 4.80 with mu 0.5 (1,500
 // particles: 0.644, Z 6.17 and 0.590, Z 4.81).
+/// How often the z cell (one largest diameter) of a filled bed's spheres goes down along the store.
+int layer_descents(int threads) {
+  RunOptions options;
+  options.threads = threads;
+  sim::World w = make_material_world(cohesionless(), options);
+  w.particles_per_thread = 100;
+  const particles::CylinderRegion column{{0, 0, 0}, 0.004, 0.0, 0.02};
+  Rng rng(3);
+  fill_region(w, material_insert_request(cohesionless(), column, 400), rng, 0.2, 1.0);
+  int descents = 0;
+  for (std::size_t i = 1; i < w.particles.size(); ++i)
+    descents += std::floor(w.particles.x[i].z / 1e-3) < std::floor(w.particles.x[i - 1].z / 1e-3);
+  return descents;
+}
+
+TEST(Packing, ABedForSeveralThreadsIsStoredLayerByLayer) {
+  // Two threads on 400 spheres (100 a thread at least): each owns a slab of the column.
+  EXPECT_EQ(layer_descents(2), 0);
+  // One thread keeps the order the spheres were drawn in.
+  EXPECT_GT(layer_descents(1), 50);
+}
+
 TEST(Packing, FrictionlessPouringIsRandomClosePacking) {
   const Settings settings{{"particles", 500}, {"wall_margin", 2}};
   const auto smooth = run_lab_test("packing", testing::hertz_spheres(0.0), settings, {});

@@ -2,7 +2,11 @@
 // regions, the error for a request too dense for random insertion, and lattices with jitter.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "core/common/error.hpp"
 #include "core/particles/insertion.hpp"
@@ -90,6 +94,12 @@ TEST(ParticlesInsertion, TooDenseRequestThrows) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.where(), "insertion.count");
     EXPECT_NE(std::string(e.what()).find("of 2000"), std::string::npos) << e.what();
+    // The spheres placed before it gave up stay in the store, as many as the message says.
+    EXPECT_NE(std::string(e.what()).find("only " + std::to_string(s.size()) + " of"),
+              std::string::npos)
+        << e.what();
+    EXPECT_GT(s.size(), 20u);
+    EXPECT_GE(min_gap(s), -1e-15);
   }
   // A region narrower than one sphere is a different error.
   req.region = BoxRegion{{0, 0, 0}, {0.001, 0.01, 0.01}};
@@ -101,6 +111,46 @@ TEST(ParticlesInsertion, TooDenseRequestThrows) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.where(), "insertion.region");
   }
+}
+
+/// The store's spheres as (z, y, x, r) tuples, sorted: the set placed, whatever the order.
+std::vector<std::array<double, 4>> placed_set(const ParticleStore& s) {
+  std::vector<std::array<double, 4>> out;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    out.push_back({s.x[i].z, s.x[i].y, s.x[i].x, s.radius[i]});
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(ParticlesInsertion, CellOrderStoresTheSameSpheresLayerByLayer) {
+  InsertRequest req;
+  req.region = CylinderRegion{{0, 0, 0}, 0.01, 0.0, 0.08};
+  req.sizes = DiscreteClasses{{9e-4, 1e-3, 1.1e-3}, {0.3, 0.4, 0.3}};
+  req.count = 800;
+  req.density = 2500;
+  ParticleStore drawn, ordered;
+  Rng rng_a(5), rng_b(5);
+  insert_random(drawn, req, rng_a);
+  req.cell_order = true;
+  insert_random(ordered, req, rng_b);
+  // The same spheres at the same places, bit for bit; the draw itself is unchanged.
+  ASSERT_EQ(ordered.size(), drawn.size());
+  EXPECT_EQ(placed_set(ordered), placed_set(drawn));
+  EXPECT_EQ(rng_a.uniform(), rng_b.uniform());
+  // Stored by layers of the placement grid's cell (the largest diameter): the z cell never
+  // decreases along the store, and within a layer the y cell never decreases. The drawn order
+  // goes down again hundreds of times.
+  const double cell = 2.0 * 1.1e-3;
+  auto layer = [&](const ParticleStore& s, std::size_t i) {
+    return std::array<long, 2>{static_cast<long>(std::floor(s.x[i].z / cell)),
+                               static_cast<long>(std::floor(s.x[i].y / cell))};
+  };
+  int drawn_descents = 0;
+  for (std::size_t i = 1; i < ordered.size(); ++i) {
+    EXPECT_LE(layer(ordered, i - 1), layer(ordered, i)) << "sphere " << i;
+    drawn_descents += layer(drawn, i)[0] < layer(drawn, i - 1)[0];
+  }
+  EXPECT_GT(drawn_descents, 200);
 }
 
 TEST(ParticlesInsertion, LatticeSpacingAndJitter) {
