@@ -34,7 +34,7 @@ class World {
   /// Below a few thousand particles a step is too short to pay for the barriers between threads
   /// (docs/engine.md, "Threads"); tests of the threaded paths set it to 1.
   int particles_per_thread = kParticlesPerThread;
-  static constexpr int kParticlesPerThread = 2000;
+  static constexpr int kParticlesPerThread = 1000;
   /// The threads a step runs on: `threads`, or fewer so that each has particles_per_thread.
   /// Results are bitwise identical for a given number of active threads.
   int active_threads() const { return active_threads_for(particles.size()); }
