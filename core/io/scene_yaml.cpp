@@ -97,8 +97,7 @@ void read_particles(const YamlNode& n, sim::World& world, double density, Rng& r
     req.sizes = read_size_distribution((*r)["sizes"]);
     req.density = density;
     req.gap = r->number("gap", 0.0);
-    req.cell_order = world.active_threads_for(world.particles.size() + req.spheres()) > 1;
-    particles::insert_random(world.particles, req, rng);
+    sim::insert_random(world, req, rng);
   } else {
     n.fail("particles need one of: lattice, random, list, data_file");
   }

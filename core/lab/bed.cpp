@@ -62,12 +62,10 @@ void fill_region(sim::World& w, particles::InsertRequest req, Rng& rng, double s
   constexpr double kPause = 0.1;  // real seconds
   const double pause = kPause * time_factor;
   const std::size_t goal = w.particles.units() + req.count;
-  // A bed that will run on several threads is stored in cell order: each thread's range a slab.
-  req.cell_order = w.active_threads_for(w.particles.size() + req.spheres()) > 1;
   for (int round = 1;; ++round) {
     req.count = goal - w.particles.units();
     try {
-      particles::insert_random(w.particles, req, rng);
+      sim::insert_random(w, req, rng);
     } catch (const InputError&) {
       if (round == rounds) throw;
     }

@@ -12,6 +12,7 @@
 #include "core/contact/contact_law.hpp"
 #include "core/integrate/rigid_body.hpp"
 #include "core/neighbour/verlet_list.hpp"
+#include "core/particles/insertion.hpp"
 #include "core/particles/particle_store.hpp"
 #include "core/walls/wall.hpp"
 
@@ -162,5 +163,10 @@ class World {
   double skin_ = 0.0;
   bool prepared_ = false;
 };
+
+/// Random sequential insertion into the world's store (particles::insert_random), stored in cell
+/// order when the grown bed will run on more than one thread (docs/engine.md, "Particle order"),
+/// as drawn otherwise.
+void insert_random(World& world, particles::InsertRequest request, Rng& rng);
 
 }  // namespace demcal::sim

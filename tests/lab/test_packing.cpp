@@ -31,12 +31,6 @@ TEST(Packing, CohesionlessPouringIsRandomPacking) {
   EXPECT_GT(out.metrics.at("coordination_number"), 4.0);
 }
 
-// Random close packing of frictionless mono-sized spheres: phi = 0.637 (Scott & Kilgour, J. Phys.
-// D 2 (1969) 863) to 0.64 with the isostatic coordination number 6 (O'Hern et al., Phys. Rev. E
-// 68 (2003) 011306). Friction (mu = 0.5) jams the pour looser, near random loose packing
-// (phi ~0.59, Z ~4.5-5; Silbert, Soft Matter 6 (2010) 2918). Sampled two diameters from the walls;
-// measured at 500 particles: 0.642, Z 5.92 without friction, 0.588, Z 4.80 with mu 0.5 (1,500
-// particles: 0.644, Z 6.17 and 0.590, Z 4.81).
 /// How often the z cell (one largest diameter) of a filled bed's spheres goes down along the store.
 int layer_descents(int threads) {
   RunOptions options;
@@ -59,6 +53,12 @@ TEST(Packing, ABedForSeveralThreadsIsStoredLayerByLayer) {
   EXPECT_GT(layer_descents(1), 50);
 }
 
+// Random close packing of frictionless mono-sized spheres: phi = 0.637 (Scott & Kilgour, J. Phys.
+// D 2 (1969) 863) to 0.64 with the isostatic coordination number 6 (O'Hern et al., Phys. Rev. E
+// 68 (2003) 011306). Friction (mu = 0.5) jams the pour looser, near random loose packing
+// (phi ~0.59, Z ~4.5-5; Silbert, Soft Matter 6 (2010) 2918). Sampled two diameters from the walls;
+// measured at 500 particles: 0.642, Z 5.92 without friction, 0.588, Z 4.80 with mu 0.5 (1,500
+// particles: 0.644, Z 6.17 and 0.590, Z 4.81).
 TEST(Packing, FrictionlessPouringIsRandomClosePacking) {
   const Settings settings{{"particles", 500}, {"wall_margin", 2}};
   const auto smooth = run_lab_test("packing", testing::hertz_spheres(0.0), settings, {});
