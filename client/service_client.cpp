@@ -294,6 +294,8 @@ void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std
       << "\n";
   if (c.intervals_size()) out << "\n  parameters predicted within tolerance:\n";
   for (const auto& i : c.intervals()) out << "    " << i.statement() << "\n";
+  if (c.trade_offs_size()) out << "\n  factors the data fix only in combination:\n";
+  for (const auto& t : c.trade_offs()) out << "    " << t.statement() << "\n";
   print_rounds(out, c.rounds());
   out << "  verification: " << c.verification_state() << ", " << c.simulations()
       << " simulation(s) added by the calibration\n  " << c.conclusion() << "\n";

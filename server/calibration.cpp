@@ -258,6 +258,21 @@ void add_intervals(v1::CalibrateReply& reply, const Loaded& l,
   }
 }
 
+void add_trade_offs(v1::CalibrateReply& reply, const Loaded& l,
+                    const calib::CalibrationResult& proposal) {
+  for (const auto& t : proposal.trade_offs) {
+    auto* o = reply.add_trade_offs();
+    o->set_factor_a(l.plan.factors[t.a].path);
+    o->set_factor_b(l.plan.factors[t.b].path);
+    o->set_correlation(t.correlation);
+    o->set_a_from(t.from(0));
+    o->set_b_from(t.from(1));
+    o->set_a_to(t.to(0));
+    o->set_b_to(t.to(1));
+    o->set_statement(t.statement);
+  }
+}
+
 void set_proposed(v1::CalibrateReply& reply, const Loaded& l, const Eigen::VectorXd& natural) {
   for (std::size_t f = 0; f < l.plan.factors.size(); ++f) {
     (*reply.mutable_proposed())[l.plan.factors[f].path] = natural(Eigen::Index(f));
@@ -373,6 +388,7 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
     set_proposed(reply, l, d.proposal.natural);
   }
   add_intervals(reply, l, d.proposal);
+  add_trade_offs(reply, l, d.proposal);
   std::vector<std::int64_t> queued;
   if (request.verify() && d.step == calib::NextStep::kVerify)
     queued = queue_rounds(store, row, l, d);

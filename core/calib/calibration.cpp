@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "core/common/error.hpp"
@@ -174,40 +175,58 @@ bool predicted_within(const CalibrationProblem& problem, const Eigen::VectorXd& 
   return true;
 }
 
-std::vector<ParameterInterval> parameter_intervals(const CalibrationProblem& problem,
-                                                   const Eigen::VectorXd& optimum,
-                                                   std::uint64_t seed) {
-  constexpr int kSamples = 4000;
-  const auto k = static_cast<Eigen::Index>(problem.factors.size());
-  std::vector<ParameterInterval> out(problem.factors.size());
-  for (std::size_t i = 0; i < out.size(); ++i) out[i].name = problem.factors[i].name;
-  for (const auto& m : problem.metrics) {
-    if (!(tolerance(m) > 0.0)) {
-      for (auto& p : out) p.statement = "no interval: " + m.name + " has no uncertainty or noise";
-      return out;
-    }
-  }
-  Eigen::VectorXd lo = Eigen::VectorXd::Constant(k, 2.0), hi = Eigen::VectorXd::Constant(k, -2.0);
+constexpr int kIntervalSamples = 4000;
+
+/// The first metric with neither an uncertainty nor a known noise: nothing can be said to
+/// match it.
+const MetricTarget* without_tolerance(const CalibrationProblem& problem) {
+  for (const auto& m : problem.metrics)
+    if (!(tolerance(m) > 0.0)) return &m;
+  return nullptr;
+}
+
+/// The optimum and the points of a seeded uniform sample of the box that the surrogates predict
+/// within tolerance of every target (coded); none when some metric has no tolerance.
+std::vector<Eigen::VectorXd> matching_points(const CalibrationProblem& problem,
+                                             const Eigen::VectorXd& optimum, std::uint64_t seed) {
+  std::vector<Eigen::VectorXd> points;
+  if (without_tolerance(problem)) return points;
   Rng rng(seed);
-  for (int s = 0; s <= kSamples; ++s) {
+  for (int s = 0; s <= kIntervalSamples; ++s) {
     Eigen::VectorXd x = optimum;
     if (s > 0)
-      for (Eigen::Index i = 0; i < k; ++i) x(i) = 2.0 * rng.uniform() - 1.0;
-    if (!predicted_within(problem, x)) continue;
-    lo = lo.cwiseMin(x);
-    hi = hi.cwiseMax(x);
+      for (Eigen::Index i = 0; i < x.size(); ++i) x(i) = 2.0 * rng.uniform() - 1.0;
+    if (predicted_within(problem, x)) points.push_back(std::move(x));
+  }
+  return points;
+}
+
+std::vector<ParameterInterval> parameter_intervals(const CalibrationProblem& problem,
+                                                   const std::vector<Eigen::VectorXd>& points) {
+  std::vector<ParameterInterval> out(problem.factors.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i].name = problem.factors[i].name;
+  if (const MetricTarget* m = without_tolerance(problem)) {
+    for (auto& p : out) p.statement = "no interval: " + m->name + " has no uncertainty or noise";
+    return out;
+  }
+  if (points.empty()) {
+    for (auto& p : out)
+      p.statement = "no interval: no point of the box is predicted within tolerance";
+    return out;
   }
   for (std::size_t i = 0; i < out.size(); ++i) {
+    const auto c = Eigen::Index(i);
+    double lo = points.front()(c), hi = lo;
+    for (const auto& x : points) {
+      lo = std::min(lo, x(c));
+      hi = std::max(hi, x(c));
+    }
     auto& p = out[i];
     const auto& f = problem.factors[i];
-    if (lo(Eigen::Index(i)) > hi(Eigen::Index(i))) {
-      p.statement = "no interval: no point of the box is predicted within tolerance";
-      continue;
-    }
     p.available = true;
-    p.low = f.to_natural(lo(Eigen::Index(i)));
-    p.high = f.to_natural(hi(Eigen::Index(i)));
-    p.fraction = 0.5 * (hi(Eigen::Index(i)) - lo(Eigen::Index(i)));
+    p.low = f.to_natural(lo);
+    p.high = f.to_natural(hi);
+    p.fraction = 0.5 * (hi - lo);
     p.pinned = p.fraction <= kPinnedFraction;
     const std::string range = "[" + statement_number(p.low) + ", " + statement_number(p.high) +
                               "] (" + std::to_string(std::lround(100.0 * p.fraction)) +
@@ -216,6 +235,61 @@ std::vector<ParameterInterval> parameter_intervals(const CalibrationProblem& pro
                            : f.name + " is not pinned by the data: anything in " + range +
                                  " is predicted within tolerance";
   }
+  return out;
+}
+
+std::string pair_point(const std::string& a, double va, const std::string& b, double vb) {
+  return a + " " + statement_number(va) + ", " + b + " " + statement_number(vb);
+}
+
+/// The trade-off of factors i and j over the matching points, when their coded values are
+/// correlated by at least kTradeOffCorrelation: the valley's ends are the matching points
+/// farthest apart along the principal axis of the pair's covariance.
+std::optional<TradeOff> trade_off(const CalibrationProblem& problem,
+                                  const std::vector<Eigen::VectorXd>& points, std::size_t i,
+                                  std::size_t j) {
+  Eigen::MatrixXd xy(Eigen::Index(points.size()), 2);
+  for (std::size_t p = 0; p < points.size(); ++p)
+    xy.row(Eigen::Index(p)) << points[p](Eigen::Index(i)), points[p](Eigen::Index(j));
+  const Eigen::MatrixXd centred = xy.rowwise() - xy.colwise().mean();
+  const Eigen::Matrix2d cov = centred.transpose() * centred / double(points.size() - 1);
+  if (!(cov(0, 0) > 0.0 && cov(1, 1) > 0.0)) return std::nullopt;
+  const double r = cov(0, 1) / std::sqrt(cov(0, 0) * cov(1, 1));
+  if (!(std::abs(r) >= kTradeOffCorrelation)) return std::nullopt;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(cov);
+  const Eigen::VectorXd along = centred * eigen.eigenvectors().col(1);  // the largest eigenvalue
+  Eigen::Index first = 0, last = 0;
+  along.minCoeff(&first);
+  along.maxCoeff(&last);
+  if (xy(first, 0) > xy(last, 0)) std::swap(first, last);
+  const auto& fa = problem.factors[i];
+  const auto& fb = problem.factors[j];
+  TradeOff t;
+  t.a = i;
+  t.b = j;
+  t.correlation = r;
+  t.from = {fa.to_natural(xy(first, 0)), fb.to_natural(xy(first, 1))};
+  t.to = {fa.to_natural(xy(last, 0)), fb.to_natural(xy(last, 1))};
+  t.statement = fa.name + " and " + fb.name + " trade off: the sets predicted within tolerance " +
+                "form a valley from " + pair_point(fa.name, t.from(0), fb.name, t.from(1)) +
+                " to " + pair_point(fa.name, t.to(0), fb.name, t.to(1)) + " (correlation " +
+                statement_number(std::round(100.0 * r) / 100.0) + "), where " + fb.name +
+                (r < 0.0 ? " falls" : " rises") + " as " + fa.name +
+                " rises: the data fix a combination of the two, not each; a metric that they "
+                "move differently would separate them";
+  return t;
+}
+
+std::vector<TradeOff> trade_offs(const CalibrationProblem& problem,
+                                 const std::vector<Eigen::VectorXd>& points,
+                                 const std::vector<ParameterInterval>& intervals) {
+  std::vector<TradeOff> out;
+  if (points.size() < std::size_t(kTradeOffMinPoints)) return out;
+  for (std::size_t i = 0; i < problem.factors.size(); ++i)
+    for (std::size_t j = i + 1; j < problem.factors.size(); ++j) {
+      if (intervals[i].pinned && intervals[j].pinned) continue;
+      if (auto t = trade_off(problem, points, i, j)) out.push_back(std::move(*t));
+    }
   return out;
 }
 
@@ -321,7 +395,9 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const Calibration
     state_reach(o);
     out.metrics.push_back(o);
   }
-  out.intervals = parameter_intervals(problem, out.coded, options.seed);
+  const auto points = matching_points(problem, out.coded, options.seed);
+  out.intervals = parameter_intervals(problem, points);
+  out.trade_offs = trade_offs(problem, points, out.intervals);
   return out;
 }
 

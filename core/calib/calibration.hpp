@@ -92,12 +92,28 @@ struct ParameterInterval {
 /// A factor whose matching values span more than this fraction of its range is not pinned.
 constexpr double kPinnedFraction = 0.5;
 
+/// Two factors the data fix only in combination. Over the matching points of ParameterInterval's
+/// sample, their coded values are correlated by at least kTradeOffCorrelation: the equally good
+/// sets form a valley along which one compensates the other, as the (mu_s, mu_r) pairs that all
+/// give the same angle of repose (seed 001 §4.2, Fig. 13). Stated for a pair of which at least
+/// one factor is not pinned, when at least kTradeOffMinPoints points match.
+struct TradeOff {
+  std::size_t a = 0, b = 0; ///< factor indices, a < b
+  double correlation = 0.0; ///< Pearson, of the matching points' coded values
+  Eigen::Vector2d from = Eigen::Vector2d::Zero();  ///< (a, b) natural, the valley's end at low a
+  Eigen::Vector2d to = Eigen::Vector2d::Zero();    ///< (a, b) natural, its end at high a
+  std::string statement;    ///< plain words: the valley and what would separate the two
+};
+constexpr double kTradeOffCorrelation = 0.8;
+constexpr int kTradeOffMinPoints = 20;
+
 struct CalibrationResult {
   Eigen::VectorXd coded;
   Eigen::VectorXd natural;
   double objective = 0.0;
   std::vector<MetricOutcome> metrics;
   std::vector<ParameterInterval> intervals;  ///< one per factor
+  std::vector<TradeOff> trade_offs;          ///< pairs of factors the data do not pin apart
 };
 
 /// A number as the calibration's statements print it (6 significant digits).

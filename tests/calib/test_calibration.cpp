@@ -2,6 +2,7 @@
 // parameters, predict every metric there, and say when a target is out of reach.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "core/calib/calibration.hpp"
@@ -149,11 +150,93 @@ TEST(Calibration, IntervalsPinWhatTheDataDecidesAndWarnAboutTheRest) {
   const auto& b = r.intervals[1];
   EXPECT_FALSE(b.pinned);
   EXPECT_NE(b.statement.find("B is not pinned by the data"), std::string::npos) << b.statement;
+  // B is free, not traded against A: no valley.
+  EXPECT_TRUE(r.trade_offs.empty());
   // Without an uncertainty or noise there is no tolerance to judge by, and it says so.
   p.metrics[0].uncertainty.reset();
   const CalibrationResult none = calibrate(p, {});
   EXPECT_FALSE(none.intervals[0].available);
   EXPECT_NE(none.intervals[0].statement.find("no uncertainty or noise"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace demcal::calib
+
+namespace demcal::calib {
+namespace {
+
+/// One metric per entry, linear in the two coded factors of a 2^2 design: y = c0 + ca a + cb b.
+CalibrationProblem two_factor_problem(const std::vector<std::array<double, 5>>& metrics) {
+  // Seed 001 §4.2's box: sliding and rolling friction of the granules.
+  const std::vector<doe::Factor> box{{"mu_s", 0.27, 0.8, doe::Scale::kLinear},
+                                     {"mu_r", 0.2, 0.5, doe::Scale::kLinear}};
+  const doe::Design d = doe::full_factorial(2);
+  CalibrationProblem p{box, {}};
+  for (std::size_t i = 0; i < metrics.size(); ++i) {
+    const auto& [c0, ca, cb, target, uncertainty] = metrics[i];
+    Eigen::VectorXd y(d.runs());
+    for (int r = 0; r < d.runs(); ++r) y(r) = c0 + ca * d.coded(r, 0) + cb * d.coded(r, 1);
+    MetricTarget m;
+    m.name = "m" + std::to_string(i);
+    m.model = doe::fit_model(d.coded, y, doe::ModelKind::kMain);
+    m.target = target;
+    m.uncertainty = uncertainty;
+    p.metrics.push_back(m);
+  }
+  return p;
+}
+
+TEST(Calibration, AngleAloneLeavesAValleyOfFrictionPairs) {
+  // An angle that both frictions raise equally (coded): every pair on a + b = 0 gives the
+  // target, from (mu_s 0.27, mu_r 0.5) to (0.8, 0.2), as the three pairs of seed 001 §4.2.
+  const CalibrationResult r = calibrate(two_factor_problem({{40.0, 5.0, 5.0, 40.0, 0.5}}), {});
+  ASSERT_EQ(r.intervals.size(), 2u);
+  EXPECT_FALSE(r.intervals[0].pinned);
+  EXPECT_FALSE(r.intervals[1].pinned);
+  ASSERT_EQ(r.trade_offs.size(), 1u);
+  const TradeOff& t = r.trade_offs[0];
+  EXPECT_EQ(t.a, 0u);
+  EXPECT_EQ(t.b, 1u);
+  EXPECT_LT(t.correlation, -0.95);
+  // The valley's ends are matching points of a 4000-point sample: within its band (|a + b| <=
+  // 0.1 coded) and near the corners.
+  EXPECT_NEAR(t.from(0), 0.27, 0.05);
+  EXPECT_NEAR(t.from(1), 0.5, 0.03);
+  EXPECT_NEAR(t.to(0), 0.8, 0.05);
+  EXPECT_NEAR(t.to(1), 0.2, 0.03);
+  EXPECT_NE(t.statement.find("mu_s and mu_r trade off"), std::string::npos) << t.statement;
+  EXPECT_NE(t.statement.find("mu_r falls as mu_s rises"), std::string::npos) << t.statement;
+}
+
+TEST(Calibration, FactorsThatRiseTogetherAreAValleyToo) {
+  // Friction raises the metric, rolling friction lowers it: equally good sets on a = b.
+  const CalibrationResult r = calibrate(two_factor_problem({{40.0, 5.0, -5.0, 40.0, 0.5}}), {});
+  ASSERT_EQ(r.trade_offs.size(), 1u);
+  EXPECT_GT(r.trade_offs[0].correlation, 0.95);
+  EXPECT_NEAR(r.trade_offs[0].from(1), 0.2, 0.03);
+  EXPECT_NEAR(r.trade_offs[0].to(1), 0.5, 0.03);
+  EXPECT_NE(r.trade_offs[0].statement.find("mu_r rises as mu_s rises"), std::string::npos);
+}
+
+TEST(Calibration, AMetricTheyMoveDifferentlyClosesTheValley) {
+  // The angle of the valley above and an area at high speed that rolling friction lowers (seed
+  // 001 §4.3: the area method at 105 and 116 rpm told the pairs apart). Truth: coded (0.6,
+  // -0.6), angle 40, area 60 + 4 (0.6) + 4 (0.6) = 64.8.
+  const CalibrationResult r = calibrate(
+      two_factor_problem({{40.0, 5.0, 5.0, 40.0, 0.5}, {60.0, 4.0, -4.0, 64.8, 0.5}}), {});
+  EXPECT_TRUE(r.trade_offs.empty());
+  ASSERT_EQ(r.intervals.size(), 2u);
+  EXPECT_TRUE(r.intervals[0].pinned);
+  EXPECT_TRUE(r.intervals[1].pinned);
+  EXPECT_NEAR(r.natural(0), 0.27 + 0.265 * 1.6, 0.01);
+  EXPECT_NEAR(r.natural(1), 0.35 - 0.15 * 0.6, 0.005);
+}
+
+TEST(Calibration, TooFewMatchingPointsStateNoValley) {
+  // A band so narrow that fewer than kTradeOffMinPoints of the sample fall in it: too few to
+  // read a direction from, so no trade-off is claimed.
+  const CalibrationResult r = calibrate(two_factor_problem({{40.0, 500.0, 500.0, 40.0, 0.5}}), {});
+  EXPECT_TRUE(r.trade_offs.empty());
 }
 
 }  // namespace

@@ -1294,6 +1294,48 @@ TEST_F(Service, AnExportLargerThanAGrpcMessageArrivesWhole) {
   for (const auto& j : exported.at("jobs")) EXPECT_EQ(j.at("cost").at("phases").size(), 5000u);
 }
 
+TEST_F(Service, ACalibrationStatesTheFactorsTheDataFixOnlyInCombination) {
+  // Results through the real worker protocol, no physics: a solid fraction that both factors
+  // raise equally, so every set on the box's anti-diagonal matches 0.6 +- 0.02. The two centre
+  // runs differ by 0.002: the noise is their pure error, not Lenth's estimate from the effects.
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  // 2^2 + 2 centre runs, factors mu_s [0.1, 0.5] and e [0.2, 0.6]
+  ASSERT_TRUE(submit(tiny_spec(30, 2), &id).ok());
+  int centre_runs = 0;
+  for (int k = 0; k < 6; ++k) {
+    v1::LeaseRequest lr;
+    lr.set_worker("fake");
+    v1::LeaseReply lease;
+    ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
+    ASSERT_TRUE(lease.has_job());
+    const auto& p = lease.job().parameters();
+    const double a = (p.at("particle_law.tangential.mu_s") - 0.3) / 0.2;
+    const double b = (p.at("particle_law.normal.restitution") - 0.4) / 0.2;
+    v1::CompleteRequest c;
+    c.set_job_id(lease.job().job_id());
+    c.set_attempt(lease.job().attempt());
+    c.set_worker("fake");
+    const bool centre = std::abs(a) < 1e-9 && std::abs(b) < 1e-9;
+    (*c.mutable_metrics())["solid_fraction"] =
+        0.6 + 0.1 * a + 0.1 * b + (centre ? 0.002 * centre_runs++ : 0.0);
+    (*c.mutable_metrics())["coordination_number"] = 4.0;
+    v1::CompleteReply cr;
+    ASSERT_TRUE(workers_stub_->Complete(ctx().get(), c, &cr).ok());
+  }
+  ASSERT_TRUE(campaign_done(id));
+  const auto cal =
+      cli_json(dir_, "calibrate", {"calibrate", std::to_string(id), "--format", "json"}, channel_);
+  ASSERT_EQ(cal.at("trade_offs").size(), 1u) << cal.dump();
+  const auto& t = cal.at("trade_offs").at(0);
+  EXPECT_EQ(t.at("factor_a"), "particle_law.tangential.mu_s");
+  EXPECT_EQ(t.at("factor_b"), "particle_law.normal.restitution");
+  EXPECT_LT(t.at("correlation").get<double>(), -0.9);
+  EXPECT_LT(t.at("a_from").get<double>(), t.at("a_to").get<double>());
+  EXPECT_GT(t.at("b_from").get<double>(), t.at("b_to").get<double>());
+  EXPECT_NE(t.at("statement").get<std::string>().find("trade off"), std::string::npos);
+}
+
 TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;

@@ -415,6 +415,9 @@
     }
     s.appendChild(el('p', {}, 'Conclusion: ' + (cal.conclusion || cal.verification_state)));
     s.appendChild(table(['factor', 'proposed'], cal.factor_paths.map((f, i) => [f, fmt(cal.proposed_values[i], 6)])));
+    const identifiability = (cal.intervals || []).map((i) => i.statement)
+      .concat((cal.trade_offs || []).map((t) => t.statement));
+    if (identifiability.length) s.appendChild(el('ul', { class: 'identifiability' }, identifiability.map((text) => el('li', {}, text))));
     s.appendChild(table(['metric', 'measured', 'predicted', 'simulated', 'error', 'tolerance', 'within'], cal.metrics.map((m) => [
       m.metric, fmt(m.target), fmt(m.predicted), m.simulated_available ? fmt(m.simulated) : '-', pct(m.relative_error), fmt(m.tolerance, 3),
       m.simulated_available ? (m.within ? 'yes' : 'no') : '-',
