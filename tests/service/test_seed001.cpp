@@ -5,6 +5,9 @@
 // job the way a worker does.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -12,11 +15,14 @@
 #include "client/spec_yaml.hpp"
 #include "core/lab/lab_test.hpp"
 #include "core/lab/rotating_drum.hpp"
+#include "process.hpp"
 #include "rpc/material_convert.hpp"
 #include "server/convert.hpp"
 
 namespace demcal::test {
 namespace {
+
+namespace fs = std::filesystem;
 
 std::string example() {
   std::ifstream in(std::string(DEMCAL_SOURCE_DIR) + "/examples/seed001_granules.yaml");
@@ -72,11 +78,18 @@ TEST(Seed001Example, PlansWithTheSeedsMeasurementsAndOneDrumPerSurface) {
   EXPECT_NEAR(double(lab::drum_bed(s, model.simulated_sizes(), "s").particles), 2e5, 2e4);
 }
 
-TEST(Seed001Example, SmallVariantRunsADrumOfTheSeedsGranules) {
+/// The example at lambda 30,000 (443 granules a drum, D/d 15), the drum at 40 rpm for a short
+/// angle window, the die with 100 granules; `calibration` appended when not empty.
+std::string small_variant(const std::string& calibration = "") {
   std::string text = replaced(example(), "factor: 64}", "factor: 30000}");
   text = replaced(text, "rpm: 4, time_step_safety: 0.6,",
                   "rpm: 40, angle_time: 0.1, area_time: 0.02, time_step_safety: 0.6,");
-  const auto file = cli::parse_campaign_spec(text, "small.yaml");
+  text = replaced(text, "particles: 26000,", "particles: 100,");
+  return text + calibration;
+}
+
+TEST(Seed001Example, SmallVariantRunsADrumOfTheSeedsGranules) {
+  const auto file = cli::parse_campaign_spec(small_variant(), "small.yaml");
   std::vector<server::NewJob> jobs;
   server::plan_campaign(file.spec, jobs);
   const auto job = find_job(jobs, "drum_coated", 5);  // the centre point
@@ -96,6 +109,35 @@ TEST(Seed001Example, SmallVariantRunsADrumOfTheSeedsGranules) {
   EXPECT_GT(out.metrics.at("csa_occupied_4"), 35.0);
   EXPECT_LT(out.metrics.at("csa_occupied_4"), 65.0);
   EXPECT_EQ(out.metrics.at("centrifuging_116"), 0.0);
+}
+
+TEST(Seed001Example, SmallVariantRunsEndToEndOnTheEmbeddedDefault) {
+  // `demcal run` of the small variant with two local workers: 25 design jobs, the effect table of
+  // each of the five responses, and one verification round (one job per test instance).
+  const fs::path dir = fs::temp_directory_path() / ("demcal_seed001_" + std::to_string(getpid()));
+  Process run =
+      embedded_run(DEMCAL_CLI_BIN, dir, small_variant("calibration: {rounds: 1, stages: 1}\n"));
+  ASSERT_EQ(run.wait_exit(900), 0) << run.log();
+  const std::string out = run.log();
+  for (const char* header : {"== compression.confined_modulus (5 of 5 runs) ==",
+                             "== drum_ptfe.dynamic_angle_of_repose (5 of 5 runs) ==",
+                             "== drum_pp.dynamic_angle_of_repose (5 of 5 runs) ==",
+                             "== drum_aluminium.dynamic_angle_of_repose (5 of 5 runs) ==",
+                             "== drum_coated.dynamic_angle_of_repose (5 of 5 runs) =="})
+    EXPECT_NE(out.find(header), std::string::npos) << header << "\n" << out;
+  EXPECT_NE(out.find("verification: done, 5 simulation(s) added by the calibration"),
+            std::string::npos)
+      << out;
+  // Each measured value against what the box reaches, by instance.
+  for (const auto& [response, target] :
+       std::vector<std::pair<std::string, std::string>>{
+           {"compression.confined_modulus", "45.4"},
+           {"drum_ptfe.dynamic_angle_of_repose", "31.9"},
+           {"drum_coated.dynamic_angle_of_repose", "34.6"}})
+    EXPECT_NE(out.find("target " + target + " of " + response), std::string::npos)
+        << response << "\n"
+        << out;
+  fs::remove_all(dir);
 }
 
 }  // namespace
