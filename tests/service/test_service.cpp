@@ -182,6 +182,25 @@ class Service : public ::testing::Test {
     return r;
   }
 
+  /// Leases the next job as worker "fake" and completes it with what `fill` writes into the
+  /// request (metrics, cost): a result through the real worker protocol, no physics.
+  void complete_fake_job(
+      const std::function<void(const v1::JobSpec&, v1::CompleteRequest&)>& fill) {
+    v1::LeaseRequest lr;
+    lr.set_worker("fake");
+    v1::LeaseReply lease;
+    ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
+    ASSERT_TRUE(lease.has_job());
+    v1::CompleteRequest c;
+    c.set_job_id(lease.job().job_id());
+    c.set_attempt(lease.job().attempt());
+    c.set_worker("fake");
+    fill(lease.job(), c);
+    v1::CompleteReply cr;
+    const auto st = workers_stub_->Complete(ctx().get(), c, &cr);
+    ASSERT_TRUE(st.ok()) << st.error_message();
+  }
+
   bool campaign_done(std::int64_t id) {
     v1::GetRequest req;
     req.set_id(id);
@@ -1265,27 +1284,16 @@ TEST_F(Service, AnExportLargerThanAGrpcMessageArrivesWhole) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
   ASSERT_TRUE(submit(tiny_spec(30), &id).ok());  // 4 jobs
-  for (int k = 0; k < 4; ++k) {
-    v1::LeaseRequest lr;
-    lr.set_worker("fake");
-    v1::LeaseReply lease;
-    ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
-    ASSERT_TRUE(lease.has_job());
-    v1::CompleteRequest c;
-    c.set_job_id(lease.job().job_id());
-    c.set_attempt(lease.job().attempt());
-    c.set_worker("fake");
-    (*c.mutable_metrics())["solid_fraction"] = 0.55 + 0.01 * k;
-    (*c.mutable_metrics())["coordination_number"] = 4.0;
-    for (int p = 0; p < 5000; ++p) {
-      auto* phase = c.mutable_cost()->add_phases();
-      phase->set_name("phase " + std::to_string(p) + std::string(200, '.'));
-      phase->set_steps(p);
-    }
-    v1::CompleteReply cr;
-    const auto st = workers_stub_->Complete(ctx().get(), c, &cr);
-    ASSERT_TRUE(st.ok()) << st.error_message();
-  }
+  for (int k = 0; k < 4; ++k)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec&, v1::CompleteRequest& c) {
+      (*c.mutable_metrics())["solid_fraction"] = 0.55 + 0.01 * k;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+      for (int p = 0; p < 5000; ++p) {
+        auto* phase = c.mutable_cost()->add_phases();
+        phase->set_name("phase " + std::to_string(p) + std::string(200, '.'));
+        phase->set_steps(p);
+      }
+    }));
   ASSERT_TRUE(campaign_done(id));
   const auto exported =
       cli_json(dir_, "export", {"export", std::to_string(id), "--format", "json"}, channel_);
@@ -1303,26 +1311,16 @@ TEST_F(Service, ACalibrationStatesTheFactorsTheDataFixOnlyInCombination) {
   // 2^2 + 2 centre runs, factors mu_s [0.1, 0.5] and e [0.2, 0.6]
   ASSERT_TRUE(submit(tiny_spec(30, 2), &id).ok());
   int centre_runs = 0;
-  for (int k = 0; k < 6; ++k) {
-    v1::LeaseRequest lr;
-    lr.set_worker("fake");
-    v1::LeaseReply lease;
-    ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
-    ASSERT_TRUE(lease.has_job());
-    const auto& p = lease.job().parameters();
-    const double a = (p.at("particle_law.tangential.mu_s") - 0.3) / 0.2;
-    const double b = (p.at("particle_law.normal.restitution") - 0.4) / 0.2;
-    v1::CompleteRequest c;
-    c.set_job_id(lease.job().job_id());
-    c.set_attempt(lease.job().attempt());
-    c.set_worker("fake");
-    const bool centre = std::abs(a) < 1e-9 && std::abs(b) < 1e-9;
-    (*c.mutable_metrics())["solid_fraction"] =
-        0.6 + 0.1 * a + 0.1 * b + (centre ? 0.002 * centre_runs++ : 0.0);
-    (*c.mutable_metrics())["coordination_number"] = 4.0;
-    v1::CompleteReply cr;
-    ASSERT_TRUE(workers_stub_->Complete(ctx().get(), c, &cr).ok());
-  }
+  for (int k = 0; k < 6; ++k)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+      const auto& p = job.parameters();
+      const double a = (p.at("particle_law.tangential.mu_s") - 0.3) / 0.2;
+      const double b = (p.at("particle_law.normal.restitution") - 0.4) / 0.2;
+      const bool centre = std::abs(a) < 1e-9 && std::abs(b) < 1e-9;
+      (*c.mutable_metrics())["solid_fraction"] =
+          0.6 + 0.1 * a + 0.1 * b + (centre ? 0.002 * centre_runs++ : 0.0);
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+    }));
   ASSERT_TRUE(campaign_done(id));
   const auto cal =
       cli_json(dir_, "calibrate", {"calibrate", std::to_string(id), "--format", "json"}, channel_);
