@@ -310,6 +310,15 @@ TEST_F(ReportBrowser, StaticReportDrawsEveryPlotWithTheNumbersOfTheCli) {
   // the verified errors, the calibration rounds, the packing test's metrics.
   expect_every_plot_drawn(page, effects_, 2 * 6 + 2 + 2 + 1);
   expect_effects_in_page(page.dom, effects_);
+  // What the data pin: one statement per factor (four), and one per trade-off, under the
+  // proposed set.
+  const auto list = page.dom.find("class=\"identifiability\"");
+  ASSERT_NE(list, std::string::npos);
+  const std::string items = page.dom.substr(list, page.dom.find("</ul>", list) - list);
+  std::size_t statements = 0;
+  for (auto at = items.find("<li>"); at != std::string::npos; at = items.find("<li>", at + 1))
+    ++statements;
+  EXPECT_GE(statements, 4u) << items;
   EXPECT_EQ(page.dom.find("data-plot=\"curve:"), std::string::npos)
       << "packing has no curves to draw";
   screenshot(url, dir_ / "report.png");
