@@ -4,11 +4,13 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "client/commands.hpp"
 #include "client/json_out.hpp"
 #include "client/markdown.hpp"
+#include "client/study_journal.hpp"
 #include "core/io/csv.hpp"
 #include "core/lab/lab_spec.hpp"
 #include "core/lab/study.hpp"
@@ -145,12 +147,26 @@ void run_lab_study(const StudyOptions& opt) {
   const bool by_scale = !opt.scale.empty();
   const auto values =
       by_scale ? parse_list(opt.scale, "--scale") : parse_list(opt.particles, "--particles");
-  const auto r = lab::run_study(
-      spec.test, spec.material, spec.settings, spec.options,
-      by_scale ? lab::StudyAxis::kScaleFactor : lab::StudyAxis::kParticles, values, opt.seeds);
-  const nlohmann::json j = study_json(r, spec.test);
+  std::optional<StudyJournalFile> kept;
   if (!opt.out_dir.empty()) {
     std::filesystem::create_directories(opt.out_dir);
+    std::ifstream text(opt.spec);
+    std::stringstream spec_text;
+    spec_text << text.rdbuf();
+    kept.emplace(std::filesystem::path(opt.out_dir) / "replicates.jsonl",
+                 nlohmann::json{{"spec", spec_text.str()},
+                                {"axis", by_scale ? "scale_factor" : "particles"},
+                                {"threads", opt.threads}});
+    if (kept->runs_read() > 0)
+      std::cerr << "study: " << kept->runs_read() << " finished run(s) read from "
+                << opt.out_dir << "/replicates.jsonl\n";
+  }
+  const auto r = lab::run_study(
+      spec.test, spec.material, spec.settings, spec.options,
+      by_scale ? lab::StudyAxis::kScaleFactor : lab::StudyAxis::kParticles, values, opt.seeds,
+      kept ? kept->journal() : lab::StudyJournal{});
+  const nlohmann::json j = study_json(r, spec.test);
+  if (!opt.out_dir.empty()) {
     std::ofstream(opt.out_dir + "/study.json") << j.dump(2) << "\n";
     write_study_csv(r, opt.out_dir);
   }

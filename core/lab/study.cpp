@@ -65,7 +65,8 @@ std::optional<std::size_t> converged_index(const std::vector<StudyRun>& runs,
 
 StudyResult run_study(const std::string& test, const MaterialModel& material,
                       const Settings& settings, const RunOptions& options, StudyAxis axis,
-                      const std::vector<double>& values, int seeds) {
+                      const std::vector<double>& values, int seeds,
+                      const StudyJournal& journal) {
   if (values.size() < 2) throw InputError("study", "give at least two values");
   if (seeds < 1 || seeds > kMaxStudySeeds)
     throw InputError("study.seeds", "must be in [1, " + std::to_string(kMaxStudySeeds) + "]");
@@ -105,9 +106,14 @@ StudyResult run_study(const std::string& test, const MaterialModel& material,
     for (int k = 0; k < seeds; ++k) {
       RunOptions o = options;
       o.seed = options.seed + static_cast<std::uint64_t>(k);
+      if (auto done = journal.find ? journal.find(v, o.seed) : std::nullopt) {
+        run.replicates.push_back(std::move(*done));
+        continue;
+      }
       LabOutput out = run_lab_test(test, m, s, o);
       run.replicates.push_back(
           {o.seed, std::move(out.metrics), std::move(out.flags), out.cost.wall_seconds});
+      if (journal.add) journal.add(v, run.replicates.back());
     }
     run.particles = counted ? s["particles"] : run.replicates.front().metrics.at("particles");
     summarise(run);

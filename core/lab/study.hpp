@@ -11,6 +11,7 @@
 // |mean_j - mean_i| <= sqrt(sd_i^2 + sd_j^2), no run of either flagged for it. The chosen value is
 // the latest of those over the test's catalogued metrics, when every one has converged.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <set>
 #include <string>
@@ -54,14 +55,24 @@ struct StudyResult {
   std::optional<double> chosen;
 };
 
+/// Where a study keeps its finished runs as they finish, so that an interrupted study goes on
+/// where it stopped: `find` gives the replicate of a value and seed run before (none: run it),
+/// `add` is told each replicate the study has just run. Both may be empty.
+struct StudyJournal {
+  std::function<std::optional<StudyReplicate>(double value, std::uint64_t seed)> find;
+  std::function<void(double value, const StudyReplicate& replicate)> add;
+};
+
 /// The most seeds a study runs per value.
 inline constexpr int kMaxStudySeeds = 10;
 
 /// Runs `test` at every value with seeds options.seed, options.seed + 1, ... (`seeds` of them,
-/// 1 to kMaxStudySeeds). For kScaleFactor the material's scaling law must not be kNone.
+/// 1 to kMaxStudySeeds), taking the replicates `journal` already holds instead of running them
+/// again. For kScaleFactor the material's scaling law must not be kNone.
 StudyResult run_study(const std::string& test, const MaterialModel& material,
                       const Settings& settings, const RunOptions& options, StudyAxis axis,
-                      const std::vector<double>& values, int seeds = 1);
+                      const std::vector<double>& values, int seeds = 1,
+                      const StudyJournal& journal = {});
 
 /// The convergence rule of the header comment for one metric of finished runs: the index of the
 /// first run from which every later run agrees with it; empty if none does (one run never does).

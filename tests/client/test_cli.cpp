@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/common/rng.hpp"
 #include "tests/common/command.hpp"
@@ -107,6 +108,59 @@ TEST(Cli, AnalyzeFindsTheActiveEffectsOfACsv) {
   for (const auto& name : active) interaction_found |= name.find("AC") != std::string::npos;
   EXPECT_TRUE(interaction_found) << "the chain holding AC must be flagged";
   EXPECT_FALSE(active.count("D") || active.count("E")) << "inactive factors stay unflagged";
+  fs::remove_all(dir);
+}
+
+/// The lines of a text file.
+std::vector<std::string> file_lines(const fs::path& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(Cli, LabStudyGoesOnWhereItStopped) {
+  const fs::path dir = scratch_dir("study");
+  const auto write_spec = [&](const std::string& name, double mu_s) {
+    std::ofstream(dir / name) << "test: packing\nseed: 1\nthreads: 1\nmaterial:\n"
+                              << "  particle_law:\n"
+                              << "    normal: {model: hertz, youngs_modulus: 5.0e6, restitution: 0.3}\n"
+                              << "    tangential: {model: history, mu_s: " << mu_s << "}\n"
+                              << "  sizes: {monodisperse: {radius: 5.0e-4}}\n  density: 2500\n";
+    return (dir / name).string();
+  };
+  const std::string spec = write_spec("spec.yaml", 0.3);
+  const std::string out = (dir / "out").string();
+  const std::string study = "lab study " + spec + " --particles 60,120 --seeds 2 --out " + out;
+  const Result first = demcal(study);
+  ASSERT_EQ(first.exit_code, 0) << first.out;
+  const fs::path journal = dir / "out" / "replicates.jsonl";
+  const auto lines = file_lines(journal);
+  ASSERT_EQ(lines.size(), 5u);  // the study's name, then one line per value and seed
+  const auto before = nlohmann::json::parse(std::ifstream(dir / "out" / "study.json"));
+  // Interrupted during the third run's line: two runs kept, the cut line dropped, two run again.
+  {
+    std::ofstream cut(journal, std::ios::trunc);
+    cut << lines[0] << "\n" << lines[1] << "\n" << lines[2] << "\n" << lines[3].substr(0, 20);
+  }
+  const Result resumed = demcal(study);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.out;
+  EXPECT_NE(resumed.out.find("2 finished run(s) read"), std::string::npos) << resumed.out;
+  EXPECT_NE(resumed.out.find("replicates.jsonl:4: a run cut short"), std::string::npos);
+  EXPECT_EQ(file_lines(journal).size(), 5u);
+  const auto after = nlohmann::json::parse(std::ifstream(dir / "out" / "study.json"));
+  // The 60-particle runs are the kept ones, wall times included; the 120-particle runs ran
+  // again to the same metrics.
+  EXPECT_EQ(after["runs"][0]["replicates"], before["runs"][0]["replicates"]);
+  EXPECT_EQ(after["runs"][1]["metrics"], before["runs"][1]["metrics"]);
+  // Another spec into the same directory is refused, and the runs kept stay as they were.
+  const auto kept = file_lines(journal);
+  const Result other = demcal("lab study " + write_spec("other.yaml", 0.5) +
+                              " --particles 60,120 --seeds 2 --out " + out);
+  EXPECT_NE(other.exit_code, 0);
+  EXPECT_NE(other.out.find("replicates.jsonl: holds the runs of another study"), std::string::npos)
+      << other.out;
+  EXPECT_EQ(file_lines(journal), kept);
   fs::remove_all(dir);
 }
 

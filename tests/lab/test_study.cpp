@@ -32,6 +32,43 @@ TEST(Study, ParticleCountsReportEveryMetric) {
   }
 }
 
+TEST(Study, RunsTheJournalHoldsAreTakenInsteadOfRunAgain) {
+  RunOptions o;
+  o.seed = 3;
+  std::vector<std::pair<double, StudyReplicate>> added;
+  const StudyJournal record{
+      {}, [&](double v, const StudyReplicate& r) { added.emplace_back(v, r); }};
+  const auto first = run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120}, 2,
+                               record);
+  ASSERT_EQ(added.size(), 4u);  // every value and seed, as they finish
+  EXPECT_EQ(added[1].first, 60.0);
+  EXPECT_EQ(added[1].second.seed, 4u);
+  EXPECT_EQ(added[3].first, 120.0);
+  // A journal that holds the 60-particle runs (marked by their wall time): those are taken, the
+  // 120-particle runs are run and added again, and the study comes out the same.
+  std::vector<std::pair<double, StudyReplicate>> again;
+  const StudyJournal half{[&](double v, std::uint64_t seed) -> std::optional<StudyReplicate> {
+                            for (auto [value, r] : added)
+                              if (value == v && r.seed == seed && v == 60.0) {
+                                r.wall_seconds = 1e6;
+                                return r;
+                              }
+                            return std::nullopt;
+                          },
+                          [&](double v, const StudyReplicate& r) { again.emplace_back(v, r); }};
+  const auto second = run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120}, 2,
+                                half);
+  ASSERT_EQ(again.size(), 2u);
+  EXPECT_EQ(again[0].first, 120.0);
+  EXPECT_EQ(second.runs[0].replicates[0].wall_seconds, 1e6);
+  EXPECT_NE(second.runs[1].replicates[0].wall_seconds, 1e6);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(second.runs[i].metrics, first.runs[i].metrics);
+    EXPECT_EQ(second.runs[i].spread, first.runs[i].spread);
+  }
+  EXPECT_EQ(second.converged_from, first.converged_from);
+}
+
 TEST(Study, ScaleFactorsKeepTheRealSystem) {
   auto m = glass();
   m.scaling = contact::ScalingLaw::kKottlan2018;
