@@ -10,7 +10,7 @@
 # PART area: the area method (§3.2.3, eq. 20) for the three pairs, 1 s per speed (the seed: 6 s
 #   at 4-80 rpm, 3 s at 105 and 116 rpm), at lambda = LAMBDA.
 # PART compression: the confined modulus of the Table 3 stiffness (bench/seed001/
-#   compression_table3.yaml, 300 particles, lambda 27).
+#   compression_table3.yaml, 1,000 particles: the size its confined modulus converged from, lambda 27).
 # PART pairs takes SEED=2 (3, ...) for a replicate of each run with another bed.
 # Each run prints its wall time; results are JSON in OUT_DIR. Not part of ctest (minutes each).
 set -euo pipefail
