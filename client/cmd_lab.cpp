@@ -158,13 +158,13 @@ void run_lab_study(const StudyOptions& opt) {
                                 {"axis", by_scale ? "scale_factor" : "particles"},
                                 {"threads", opt.threads}});
     if (kept->runs_read() > 0)
-      std::cerr << "study: " << kept->runs_read() << " finished run(s) read from "
-                << opt.out_dir << "/replicates.jsonl\n";
+      std::cerr << "study: " << kept->runs_read() << " finished run(s) read from " << opt.out_dir
+                << "/replicates.jsonl\n";
   }
-  const auto r = lab::run_study(
-      spec.test, spec.material, spec.settings, spec.options,
-      by_scale ? lab::StudyAxis::kScaleFactor : lab::StudyAxis::kParticles, values, opt.seeds,
-      kept ? kept->journal() : lab::StudyJournal{});
+  const auto r =
+      lab::run_study(spec.test, spec.material, spec.settings, spec.options,
+                     by_scale ? lab::StudyAxis::kScaleFactor : lab::StudyAxis::kParticles, values,
+                     opt.seeds, kept ? kept->journal() : lab::StudyJournal{});
   const nlohmann::json j = study_json(r, spec.test);
   if (!opt.out_dir.empty()) {
     std::ofstream(opt.out_dir + "/study.json") << j.dump(2) << "\n";

@@ -98,11 +98,11 @@ constexpr double kPinnedFraction = 0.5;
 /// give the same angle of repose (seed 001 §4.2, Fig. 13). Stated for a pair of which at least
 /// one factor is not pinned, when at least kTradeOffMinPoints points match.
 struct TradeOff {
-  std::size_t a = 0, b = 0; ///< factor indices, a < b
-  double correlation = 0.0; ///< Pearson, of the matching points' coded values
+  std::size_t a = 0, b = 0;  ///< factor indices, a < b
+  double correlation = 0.0;  ///< Pearson, of the matching points' coded values
   Eigen::Vector2d from = Eigen::Vector2d::Zero();  ///< (a, b) natural, the valley's end at low a
   Eigen::Vector2d to = Eigen::Vector2d::Zero();    ///< (a, b) natural, its end at high a
-  std::string statement;    ///< plain words: the valley and what would separate the two
+  std::string statement;  ///< plain words: the valley and what would separate the two
 };
 constexpr double kTradeOffCorrelation = 0.8;
 constexpr int kTradeOffMinPoints = 20;

@@ -65,8 +65,7 @@ std::optional<std::size_t> converged_index(const std::vector<StudyRun>& runs,
 
 StudyResult run_study(const std::string& test, const MaterialModel& material,
                       const Settings& settings, const RunOptions& options, StudyAxis axis,
-                      const std::vector<double>& values, int seeds,
-                      const StudyJournal& journal) {
+                      const std::vector<double>& values, int seeds, const StudyJournal& journal) {
   if (values.size() < 2) throw InputError("study", "give at least two values");
   if (seeds < 1 || seeds > kMaxStudySeeds)
     throw InputError("study.seeds", "must be in [1, " + std::to_string(kMaxStudySeeds) + "]");

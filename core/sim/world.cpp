@@ -215,8 +215,7 @@ void World::remove_particles(const std::vector<char>& flags) {
 
 void insert_random(World& world, particles::InsertRequest request, Rng& rng) {
   // Each thread's contiguous range is then a slab of the bed.
-  request.cell_order =
-      world.active_threads_for(world.particles.size() + request.spheres()) > 1;
+  request.cell_order = world.active_threads_for(world.particles.size() + request.spheres()) > 1;
   particles::insert_random(world.particles, request, rng);
 }
 

@@ -122,11 +122,12 @@ std::vector<std::string> file_lines(const fs::path& path) {
 TEST(Cli, LabStudyGoesOnWhereItStopped) {
   const fs::path dir = scratch_dir("study");
   const auto write_spec = [&](const std::string& name, double mu_s) {
-    std::ofstream(dir / name) << "test: packing\nseed: 1\nthreads: 1\nmaterial:\n"
-                              << "  particle_law:\n"
-                              << "    normal: {model: hertz, youngs_modulus: 5.0e6, restitution: 0.3}\n"
-                              << "    tangential: {model: history, mu_s: " << mu_s << "}\n"
-                              << "  sizes: {monodisperse: {radius: 5.0e-4}}\n  density: 2500\n";
+    std::ofstream(dir / name)
+        << "test: packing\nseed: 1\nthreads: 1\nmaterial:\n"
+        << "  particle_law:\n"
+        << "    normal: {model: hertz, youngs_modulus: 5.0e6, restitution: 0.3}\n"
+        << "    tangential: {model: history, mu_s: " << mu_s << "}\n"
+        << "  sizes: {monodisperse: {radius: 5.0e-4}}\n  density: 2500\n";
     return (dir / name).string();
   };
   const std::string spec = write_spec("spec.yaml", 0.3);

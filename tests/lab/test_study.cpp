@@ -36,10 +36,10 @@ TEST(Study, RunsTheJournalHoldsAreTakenInsteadOfRunAgain) {
   RunOptions o;
   o.seed = 3;
   std::vector<std::pair<double, StudyReplicate>> added;
-  const StudyJournal record{
-      {}, [&](double v, const StudyReplicate& r) { added.emplace_back(v, r); }};
-  const auto first = run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120}, 2,
-                               record);
+  const StudyJournal record{{},
+                            [&](double v, const StudyReplicate& r) { added.emplace_back(v, r); }};
+  const auto first =
+      run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120}, 2, record);
   ASSERT_EQ(added.size(), 4u);  // every value and seed, as they finish
   EXPECT_EQ(added[1].first, 60.0);
   EXPECT_EQ(added[1].second.seed, 4u);
@@ -56,8 +56,8 @@ TEST(Study, RunsTheJournalHoldsAreTakenInsteadOfRunAgain) {
                             return std::nullopt;
                           },
                           [&](double v, const StudyReplicate& r) { again.emplace_back(v, r); }};
-  const auto second = run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120}, 2,
-                                half);
+  const auto second =
+      run_study("packing", glass(), {}, o, StudyAxis::kParticles, {60, 120}, 2, half);
   ASSERT_EQ(again.size(), 2u);
   EXPECT_EQ(again[0].first, 120.0);
   EXPECT_EQ(second.runs[0].replicates[0].wall_seconds, 1e6);

@@ -4,7 +4,6 @@
 // so D/d = 15 and 443 granules; the drum turned at 40 rpm for a short angle window) runs one drum
 // job the way a worker does.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <filesystem>
@@ -129,8 +128,7 @@ TEST(Seed001Example, SmallVariantRunsEndToEndOnTheEmbeddedDefault) {
             std::string::npos)
       << out;
   // Each measured value against what the box reaches, by instance.
-  for (const auto& [response, target] :
-       std::vector<std::pair<std::string, std::string>>{
+  for (const auto& [response, target] : std::vector<std::pair<std::string, std::string>>{
            {"compression.confined_modulus", "45.4"},
            {"drum_ptfe.dynamic_angle_of_repose", "31.9"},
            {"drum_coated.dynamic_angle_of_repose", "34.6"}})

@@ -182,20 +182,28 @@ class Service : public ::testing::Test {
     return r;
   }
 
-  /// Leases the next job as worker "fake" and completes it with what `fill` writes into the
-  /// request (metrics, cost): a result through the real worker protocol, no physics.
-  void complete_fake_job(
-      const std::function<void(const v1::JobSpec&, v1::CompleteRequest&)>& fill) {
+  /// Leases the next job as `worker` into `job` and starts its result `c` (job, attempt,
+  /// worker): a result through the real worker protocol, no physics.
+  void lease_request(const std::string& worker, v1::JobSpec& job, v1::CompleteRequest& c) {
     v1::LeaseRequest lr;
-    lr.set_worker("fake");
+    lr.set_worker(worker);
     v1::LeaseReply lease;
     ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
     ASSERT_TRUE(lease.has_job());
+    job = lease.job();
+    c.set_job_id(job.job_id());
+    c.set_attempt(job.attempt());
+    c.set_worker(worker);
+  }
+
+  /// Leases the next job as worker "fake" and completes it with what `fill` writes into the
+  /// request (metrics, cost).
+  void complete_fake_job(
+      const std::function<void(const v1::JobSpec&, v1::CompleteRequest&)>& fill) {
+    v1::JobSpec job;
     v1::CompleteRequest c;
-    c.set_job_id(lease.job().job_id());
-    c.set_attempt(lease.job().attempt());
-    c.set_worker("fake");
-    fill(lease.job(), c);
+    ASSERT_NO_FATAL_FAILURE(lease_request("fake", job, c));
+    fill(job, c);
     v1::CompleteReply cr;
     const auto st = workers_stub_->Complete(ctx().get(), c, &cr);
     ASSERT_TRUE(st.ok()) << st.error_message();
@@ -740,15 +748,9 @@ TEST_F(Service, AResultsCurvesAreCheckedStoredAndExported) {
   start_server();
   std::int64_t id = 0;
   ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
-  v1::LeaseRequest lr;
-  lr.set_worker("w");
-  v1::LeaseReply lease;
-  ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
-  ASSERT_TRUE(lease.has_job());
+  v1::JobSpec job;
   v1::CompleteRequest good;
-  good.set_job_id(lease.job().job_id());
-  good.set_attempt(lease.job().attempt());
-  good.set_worker("w");
+  ASSERT_NO_FATAL_FAILURE(lease_request("w", job, good));
   (*good.mutable_metrics())["solid_fraction"] = 0.6;
   auto* curve = good.add_series();
   curve->set_name("stress_strain");
