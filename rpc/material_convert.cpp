@@ -105,6 +105,10 @@ lab::MaterialModel job_material(const v1::JobSpec& job) {
   return model;
 }
 
+std::uint64_t job_seed(const v1::JobSpec& job) {
+  return job.seed() ? job.seed() : 1;
+}
+
 lab::Settings to_settings(const google::protobuf::Map<std::string, double>& settings) {
   return lab::Settings(settings.begin(), settings.end());
 }

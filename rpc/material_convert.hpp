@@ -2,6 +2,7 @@
 // The one conversion between the proto material (demcal.v1.Material) and the core's
 // lab::MaterialModel, used by the coordinator (validation of factor paths and bounds) and by
 // the worker (building the job's material). Metadata only: links no physics.
+#include <cstdint>
 #include <map>
 #include <string>
 
@@ -19,6 +20,9 @@ lab::MaterialModel to_material_model(const v1::Material& material, const std::st
 /// The material of a job: its base material with the job's parameters set (factor values and
 /// fixed parameters).
 lab::MaterialModel job_material(const v1::JobSpec& job);
+
+/// The simulation seed of a job: its seed, or 1 when it has none.
+std::uint64_t job_seed(const v1::JobSpec& job);
 
 lab::Settings to_settings(const google::protobuf::Map<std::string, double>& settings);
 

@@ -2,6 +2,7 @@
 
 #include <google/protobuf/util/json_util.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -16,6 +17,7 @@
 #include "rpc/material_convert.hpp"
 #include "server/calibration.hpp"
 #include "server/diagnosis.hpp"
+#include "server/run_key.hpp"
 
 namespace demcal::server {
 
@@ -87,6 +89,12 @@ v1::JobSpec instance_job(const v1::CampaignSpec& spec, const v1::LabTest& t,
   job.set_seed(seed);
   job.set_threads(t.threads());
   return job;
+}
+
+/// A job to store: the planned job's payload with its run key.
+NewJob new_job(int std_order, int run_order, const std::string& instance, const std::string& kind,
+               const v1::JobSpec& job) {
+  return {std_order, run_order, instance, kind, to_json(job), run_key(job)};
 }
 
 /// Checks an instance name: responses are "<name>.<metric>", so no dots, and a name a shell and
@@ -361,10 +369,8 @@ std::vector<NewJob> design_jobs(const v1::CampaignSpec& spec, const CampaignPlan
     for (const auto& t : spec.tests()) {
       const std::uint64_t seed = design_seed(t, spec.design(), design, r) +
                                  (pinned ? 0 : static_cast<std::uint64_t>(stage_offset));
-      v1::JobSpec job = instance_job(spec, t, spec.material(), parameters, seed);
-      job.set_campaign_id(0);
-      jobs.push_back(
-          {r + 1, design.run_order[std::size_t(r)], instance_name(t), kind, to_json(job)});
+      jobs.push_back(new_job(r + 1, design.run_order[std::size_t(r)], instance_name(t), kind,
+                             instance_job(spec, t, spec.material(), parameters, seed)));
     }
   }
   return jobs;
@@ -377,8 +383,8 @@ std::vector<NewJob> jobs_at(const v1::CampaignSpec& spec, const v1::Material& ma
   int order = 0;
   for (const auto& t : spec.tests())
     jobs.push_back(
-        {std_order, ++order, instance_name(t), kind,
-         to_json(instance_job(spec, t, material, parameters, base_seed(t) + seed_offset))});
+        new_job(std_order, ++order, instance_name(t), kind,
+                instance_job(spec, t, material, parameters, base_seed(t) + seed_offset)));
   return jobs;
 }
 
@@ -437,6 +443,7 @@ v1::Progress progress_message(const CampaignRow& row, const Counts& c, double no
   p.set_done(c.done);
   p.set_failed(c.failed);
   p.set_cancelled(c.cancelled);
+  p.set_reused(c.reused);
   p.set_total(c.total());
   const double end = row.finished > 0 ? row.finished : now;
   const double elapsed = std::max(0.0, end - row.created);
@@ -483,6 +490,9 @@ v1::JobResult job_message(const JobRow& job) {
   const auto flags = nlohmann::json::parse(job.flags_json);  // items() refers to it
   for (const auto& [k, v] : flags.items()) (*r.mutable_flags())[k] = v.get<std::string>();
   from_json(job.cost_json, *r.mutable_cost());
+  r.set_run_key(job.run_key.key);
+  r.set_reused_from(job.reused_from);
+  r.set_reused_journal(job.reused_journal);
   return r;
 }
 
@@ -500,6 +510,21 @@ std::string series_json(const google::protobuf::RepeatedPtrField<v1::Series>& se
                      {"rows", std::move(rows)}};
   }
   return out.dump();
+}
+
+google::protobuf::RepeatedPtrField<v1::Series> series_from_json(const std::string& json) {
+  google::protobuf::RepeatedPtrField<v1::Series> out;
+  if (json.empty()) return out;
+  const auto curves = nlohmann::json::parse(json);
+  for (auto it = curves.begin(); it != curves.end(); ++it) {
+    const auto& curve = it.value();
+    auto* s = out.Add();
+    s->set_name(it.key());
+    for (const auto& column : curve.at("columns")) s->add_columns(column.get<std::string>());
+    for (const auto& row : curve.at("rows"))
+      for (const auto& value : row) s->add_values(value.get<double>());
+  }
+  return out;
 }
 
 std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
@@ -537,11 +562,21 @@ std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
   j["state"] = row.state;
   j["spec"] = nlohmann::json::parse(row.spec_json);
   j["design"] = nlohmann::json::parse(plan_to_json(plan));
+  j["reused"] =
+      std::count_if(jobs.begin(), jobs.end(), [](const JobRow& job) { return job.reused(); });
   for (const auto& job : jobs) {
-    nlohmann::json o = {
-        {"job_id", job.id},   {"std_order", job.std_order}, {"test", job.test},
-        {"kind", job.kind},   {"state", job.state},         {"attempt", job.attempt},
-        {"error", job.error}, {"worker", job.worker},       {"wall_seconds", job.wall_seconds}};
+    nlohmann::json o = {{"job_id", job.id},
+                        {"std_order", job.std_order},
+                        {"test", job.test},
+                        {"kind", job.kind},
+                        {"state", job.state},
+                        {"attempt", job.attempt},
+                        {"error", job.error},
+                        {"worker", job.worker},
+                        {"wall_seconds", job.wall_seconds},
+                        {"run_key", job.run_key.key},
+                        {"reused_from", job.reused_from},
+                        {"reused_journal", job.reused_journal}};
     if (job.metrics_json) {
       o["metrics"] = nlohmann::json::parse(*job.metrics_json);
       o["flags"] = nlohmann::json::parse(job.flags_json);

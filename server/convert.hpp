@@ -63,5 +63,7 @@ std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
 
 /// A result's curves as stored: {name: {"columns": [...], "rows": [[...], ...]}}; "" for none.
 std::string series_json(const google::protobuf::RepeatedPtrField<v1::Series>& series);
+/// The curves stored by series_json() as messages again.
+google::protobuf::RepeatedPtrField<v1::Series> series_from_json(const std::string& json);
 
 }  // namespace demcal::server

@@ -8,6 +8,7 @@
 #include "rpc/channel.hpp"
 #include "server/auth.hpp"
 #include "server/reflection.hpp"
+#include "server/run_key.hpp"
 
 namespace demcal::server {
 
@@ -31,6 +32,8 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
                                                             {},
                                                             options_.fsync_every_commit,
                                                             options_.give_back_leases_at_start});
+  // Jobs of a file from before run keys get theirs, so that later jobs can take their results.
+  store_->fill_run_keys(payload_run_key);
   if (options_.max_starts < 1 || options_.max_starts > 1000)
     throw std::invalid_argument("--max-starts must lie in [1, 1000]");
   if (!(options_.max_watch_interval >= kMinWatchInterval && options_.max_watch_interval <= 3600))

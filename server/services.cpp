@@ -2,21 +2,20 @@
 
 #include <spdlog/spdlog.h>
 
-#include <algorithm>
-#include <cctype>
 #include <chrono>
-#include <cmath>
 #include <nlohmann/json.hpp>
-#include <set>
 #include <thread>
 
 #include "core/common/error.hpp"
+#include "core/lab/protocol.hpp"
 #include "rpc/effects_convert.hpp"
+#include "rpc/result_check.hpp"
 #include "server/analysis.hpp"
 #include "server/auth.hpp"
 #include "server/calibration.hpp"
 #include "server/convert.hpp"
 #include "server/diagnosis.hpp"
+#include "server/journal.hpp"
 
 namespace demcal::server {
 
@@ -315,21 +314,48 @@ grpc::Status CampaignServiceImpl::Export(grpc::ServerContext* ctx, const v1::Exp
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   const std::string format = req->format().empty() ? "json" : req->format();
-  if (format != "json" && format != "csv")
-    return {grpc::StatusCode::INVALID_ARGUMENT, "format: expected csv or json"};
+  if (format != "json" && format != "csv" && format != "journal")
+    return {grpc::StatusCode::INVALID_ARGUMENT, "format: expected csv, json or journal"};
   if (req->series() && format != "json")
     return {grpc::StatusCode::INVALID_ARGUMENT, "series: only with format json"};
+  if (req->jobs_size() > 0 && format != "journal")
+    return {grpc::StatusCode::INVALID_ARGUMENT, "jobs: only with format journal"};
   std::string content;
   try {
-    const auto series =
-        req->series() ? store_.series(row->id) : std::map<std::int64_t, std::string>{};
-    content = export_campaign(*row, plan_from_json(row->design_json), store_.jobs(row->id),
-                              calibration_rounds(store_, *row), format,
-                              req->series() ? &series : nullptr);
+    if (format == "journal") {
+      content = export_journal(*row, store_.jobs(row->id), store_.series(row->id),
+                               {req->jobs().begin(), req->jobs().end()});
+    } else {
+      const auto series =
+          req->series() ? store_.series(row->id) : std::map<std::int64_t, std::string>{};
+      content = export_campaign(*row, plan_from_json(row->design_json), store_.jobs(row->id),
+                                calibration_rounds(store_, *row), format,
+                                req->series() ? &series : nullptr);
+    }
   } catch (const std::exception& e) {
     return internal(e);
   }
   return write_in_pieces(content, format, *writer, *ctx);
+}
+
+grpc::Status CampaignServiceImpl::ImportRuns(grpc::ServerContext* ctx,
+                                             const v1::ImportRunsRequest* req,
+                                             v1::ImportRunsReply* reply) {
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  try {
+    const ImportCounts counts = import_runs(store_, *req);
+    reply->set_kept(counts.kept);
+    reply->set_known(counts.known);
+    reply->set_other_protocol(counts.other_protocol);
+    reply->set_protocol(lab::kProtocolVersion);
+    spdlog::info("journal runs imported: {} new, {} held already, {} of another lab protocol",
+                 counts.kept, counts.known, counts.other_protocol);
+    return grpc::Status::OK;
+  } catch (const InputError& e) {
+    return invalid(e);
+  } catch (const std::exception& e) {
+    return internal(e);
+  }
 }
 
 // ---- WorkerService ----
@@ -373,84 +399,10 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* ctx, const v1::He
   return grpc::Status::OK;
 }
 
-namespace {
-
-/// A name of a series or column: 1-64 characters of [a-z0-9_] (any case).
-bool series_name_ok(const std::string& name) {
-  return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-  });
-}
-
-/// The curves of a result: at most 32 series, each with a distinct valid name, 1-16 valid
-/// columns and at most 2,000 full rows of finite values.
-std::string series_error(const google::protobuf::RepeatedPtrField<v1::Series>& series) {
-  constexpr int kMaxSeries = 32, kMaxColumns = 16, kMaxRows = 2000;
-  if (series.size() > kMaxSeries) return "series: more than 32";
-  std::set<std::string> names;
-  for (int i = 0; i < series.size(); ++i) {
-    const auto& s = series[i];
-    const std::string where = "series[" + std::to_string(i) + "]";
-    if (!series_name_ok(s.name())) return where + ".name: 1-64 characters of [A-Za-z0-9_]";
-    if (!names.insert(s.name()).second) return where + ".name: " + s.name() + " given twice";
-    if (s.columns_size() < 1 || s.columns_size() > kMaxColumns)
-      return where + ".columns: 1 to 16 expected";
-    for (const auto& c : s.columns())
-      if (!series_name_ok(c)) return where + ".columns: 1-64 characters of [A-Za-z0-9_] each";
-    if (s.values_size() % s.columns_size() != 0)
-      return where + ".values: not a whole number of rows of " + std::to_string(s.columns_size());
-    if (s.values_size() / s.columns_size() > kMaxRows)
-      return where + ".values: more than 2000 rows";
-    for (int k = 0; k < s.values_size(); ++k)
-      if (!std::isfinite(s.values(k)))
-        return where + ".values[" + std::to_string(k) + "]: must be finite";
-  }
-  return {};
-}
-
-/// Checks a result before it is stored: every metric value finite and the metrics bounded in
-/// number and name length, the wall time finite and >= 0; a flag names a reported metric; texts
-/// and the phase list of the cost block bounded, its numbers finite and not negative. Empty when
-/// valid. (A NaN would be stored as null and break every later analysis of the campaign.)
-std::string result_error(const v1::CompleteRequest& req) {
-  constexpr std::size_t kMaxText = 2000, kMaxPhases = 10000, kMaxMetrics = 10000, kMaxName = 200;
-  if (static_cast<std::size_t>(req.metrics_size()) > kMaxMetrics) return "metrics: more than 10000";
-  for (const auto& [metric, value] : req.metrics()) {
-    if (metric.empty() || metric.size() > kMaxName)
-      return "metrics: a name is empty or longer than 200 characters";
-    if (!std::isfinite(value)) return "metrics." + metric + ": must be finite";
-  }
-  if (!std::isfinite(req.wall_seconds()) || req.wall_seconds() < 0.0)
-    return "wall_seconds: must be finite and >= 0";
-  for (const auto& [metric, reason] : req.flags()) {
-    if (!req.metrics().contains(metric))
-      return "flags." + metric + ": flags a metric the result does not report";
-    if (reason.size() > kMaxText) return "flags." + metric + ": longer than 2000 characters";
-  }
-  if (std::string e = series_error(req.series()); !e.empty()) return e;
-  const auto& c = req.cost();
-  auto bad = [](double v) { return !std::isfinite(v) || v < 0.0; };
-  if (bad(c.time_step()) || bad(c.simulated_time()) || bad(c.wall_seconds()) ||
-      bad(c.particle_steps_per_second()) || c.steps() < 0 || c.particles() < 0)
-    return "cost: numbers must be finite and >= 0";
-  if (c.time_step_limit().size() > kMaxText) return "cost.time_step_limit: too long";
-  if (static_cast<std::size_t>(c.phases_size()) > kMaxPhases) return "cost.phases: more than 10000";
-  for (int i = 0; i < c.phases_size(); ++i) {
-    const auto& p = c.phases(i);
-    if (bad(p.simulated_time()) || bad(p.wall_seconds()) || p.steps() < 0)
-      return "cost.phases[" + std::to_string(i) + "]: numbers must be finite and >= 0";
-    if (p.name().size() > kMaxText || p.target().size() > kMaxText)
-      return "cost.phases[" + std::to_string(i) + "]: text too long";
-  }
-  return {};
-}
-
-}  // namespace
-
 grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::CompleteRequest* req,
                                          v1::CompleteReply*) {
   if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
-  if (const std::string error = result_error(*req); !error.empty())
+  if (const std::string error = rpc::result_error(*req); !error.empty())
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
   std::map<std::string, double> metrics(req->metrics().begin(), req->metrics().end());
   const nlohmann::json flags(

@@ -74,6 +74,8 @@ class CampaignServiceImpl final : public v1::CampaignService::Service {
                         v1::DiagnoseReply*) override;
   grpc::Status Export(grpc::ServerContext*, const v1::ExportRequest*,
                       grpc::ServerWriter<v1::ExportReply>*) override;
+  grpc::Status ImportRuns(grpc::ServerContext*, const v1::ImportRunsRequest*,
+                          v1::ImportRunsReply*) override;
 
  private:
   Store& store_;

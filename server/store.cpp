@@ -151,6 +151,27 @@ const std::vector<const char*>& migrations() {
         state BLOB NOT NULL,
         stored REAL NOT NULL);
       )sql",
+      // 8: run keys and the lab protocol version each was computed under (server/run_key.hpp;
+      // NULL until the coordinator computes those of older jobs at opening), results taken from an
+      // earlier run with the same key instead of simulated (the source job, or the journal line),
+      // and the runs read from journals.
+      R"sql(
+      ALTER TABLE jobs ADD COLUMN run_key TEXT;
+      ALTER TABLE jobs ADD COLUMN run_protocol INTEGER NOT NULL DEFAULT 0;
+      CREATE INDEX jobs_run_key ON jobs (run_key, state);
+      ALTER TABLE results ADD COLUMN reused_from INTEGER NOT NULL DEFAULT 0;
+      ALTER TABLE results ADD COLUMN reused_journal TEXT NOT NULL DEFAULT '';
+      CREATE TABLE journal_runs (
+        run_key TEXT PRIMARY KEY,
+        attempt INTEGER NOT NULL,
+        metrics_json TEXT NOT NULL,
+        wall_seconds REAL NOT NULL,
+        flags_json TEXT NOT NULL,
+        cost_json TEXT NOT NULL,
+        series_json TEXT NOT NULL,
+        source TEXT NOT NULL,
+        imported REAL NOT NULL);
+      )sql",
   };
   return m;
 }
@@ -470,12 +491,13 @@ std::vector<std::int64_t> Store::insert_job_rows(std::int64_t campaign_id,
                                                  std::size_t end) {
   std::vector<std::int64_t> ids;
   Statement s(*this,
-              "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state) "
-              "VALUES (?, ?, ?, ?, ?, ?, 'queued')");
+              "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state, "
+              "run_key, run_protocol) VALUES (?, ?, ?, ?, ?, ?, 'queued', ?, ?)");
   for (std::size_t i = first; i < end; ++i) {
     const auto& job = jobs[i];
     s.bind(1, campaign_id).bind(2, job.std_order).bind(3, job.run_order).bind(4, job.test);
-    s.bind(5, job.kind).bind(6, job.payload).step();
+    s.bind(5, job.kind).bind(6, job.payload).bind(7, job.run_key.key);
+    s.bind(8, job.run_key.protocol).step();
     s.reset();
     ids.push_back(sqlite3_last_insert_rowid(db_));
   }
@@ -517,13 +539,15 @@ std::vector<CampaignRow> Store::campaigns() {
 Counts Store::counts(std::int64_t campaign_id, const std::string& kind) {
   Guard lock(*this);
   Statement s(*this,
-              "SELECT state, COUNT(*) FROM jobs WHERE campaign_id = ? AND (? = '' OR kind = ?) "
-              "GROUP BY state");
+              "SELECT j.state, COUNT(*), SUM(r.reused_from != 0 OR r.reused_journal != '') "
+              "FROM jobs j LEFT JOIN results r ON r.job_id = j.id "
+              "WHERE j.campaign_id = ? AND (? = '' OR j.kind = ?) GROUP BY j.state");
   s.bind(1, campaign_id).bind(2, kind).bind(3, kind);
   Counts c;
   while (s.step()) {
     const std::string st = s.text(0);
     const std::int64_t n = s.i64(1);
+    c.reused += s.i64(2);  // NULL (0) for the states without results
     if (st == "queued") c.queued = n;
     if (st == "leased") c.leased = n;
     if (st == "done") c.done = n;
@@ -538,7 +562,9 @@ constexpr const char* kJobColumns =
     "SELECT j.id, j.campaign_id, j.std_order, j.run_order, j.test, j.kind, j.state, j.payload, "
     "j.worker, j.error, j.attempt, j.counted, j.lease_deadline, r.metrics_json, "
     "COALESCE(r.wall_seconds, 0), j.finished, COALESCE(r.flags_json, '{}'), "
-    "COALESCE(r.cost_json, '{}') FROM jobs j LEFT JOIN results r ON r.job_id = j.id";
+    "COALESCE(r.cost_json, '{}'), COALESCE(j.run_key, ''), COALESCE(r.attempt, 0), "
+    "COALESCE(r.reused_from, 0), COALESCE(r.reused_journal, ''), j.run_protocol "
+    "FROM jobs j LEFT JOIN results r ON r.job_id = j.id";
 }
 
 template <class S>
@@ -562,6 +588,10 @@ JobRow read_job(const S& s) {
   j.finished = s.f64(15);
   j.flags_json = s.text(16);
   j.cost_json = s.text(17);
+  j.run_key = {s.text(18), s.i32(22)};
+  j.result_attempt = s.i32(19);
+  j.reused_from = s.i64(20);
+  j.reused_journal = s.text(21);
   return j;
 }
 
@@ -682,15 +712,74 @@ std::vector<CalibrationStageRow> Store::calibration_stages(std::int64_t campaign
   return out;
 }
 
+std::optional<std::pair<std::int64_t, std::string>> Store::next_queued() {
+  Statement s(*this,
+              "SELECT j.id, COALESCE(j.run_key, '') FROM jobs j "
+              "JOIN campaigns c ON c.id = j.campaign_id "
+              "WHERE j.state = 'queued' AND c.state = 'running' AND c.ready = 1 AND "
+              "(COALESCE(j.run_key, '') = '' OR NOT EXISTS (SELECT 1 FROM jobs t "
+              "WHERE t.run_key = j.run_key AND t.state = 'leased')) "
+              "ORDER BY j.campaign_id, j.kind, j.run_order, j.id LIMIT 1");
+  if (!s.step()) return std::nullopt;
+  return std::pair{s.i64(0), s.text(1)};
+}
+
+bool Store::take_finished_run(std::int64_t job_id, const std::string& key) {
+  const double stored = server::wall_seconds();
+  // The first job that finished the run, in any campaign: its result, series and provenance
+  // (attempt, worker) are copied, the source named.
+  std::int64_t source = 0;
+  {
+    Statement s(*this,
+                "SELECT id FROM jobs WHERE run_key = ? AND state = 'done' AND id != ? "
+                "ORDER BY id LIMIT 1");
+    s.bind(1, key).bind(2, job_id);
+    if (s.step()) source = s.i64(0);
+  }
+  if (source != 0) {
+    Statement r(*this,
+                "INSERT INTO results (job_id, attempt, worker, metrics_json, wall_seconds, stored, "
+                "flags_json, cost_json, reused_from) SELECT ?, attempt, worker, metrics_json, "
+                "wall_seconds, ?, flags_json, cost_json, ? FROM results WHERE job_id = ?");
+    r.bind(1, job_id).bind(2, stored).bind(3, source).bind(4, source).step();
+    Statement c(*this,
+                "INSERT INTO result_series (job_id, series_json) SELECT ?, series_json "
+                "FROM result_series WHERE job_id = ?");
+    c.bind(1, job_id).bind(2, source).step();
+  } else {
+    Statement r(*this,
+                "INSERT INTO results (job_id, attempt, worker, metrics_json, wall_seconds, stored, "
+                "flags_json, cost_json, reused_journal) SELECT ?, attempt, '', metrics_json, "
+                "wall_seconds, ?, flags_json, cost_json, source FROM journal_runs "
+                "WHERE run_key = ?");
+    r.bind(1, job_id).bind(2, stored).bind(3, key).step();
+    if (sqlite3_changes(db_) == 0) return false;
+    Statement c(*this,
+                "INSERT INTO result_series (job_id, series_json) SELECT ?, series_json "
+                "FROM journal_runs WHERE run_key = ? AND series_json != ''");
+    c.bind(1, job_id).bind(2, key).step();
+  }
+  Statement u(*this, "UPDATE jobs SET state = 'done', finished = ?, error = '' WHERE id = ?");
+  u.bind(1, stored).bind(2, job_id).step();
+  Statement d(*this, "DELETE FROM checkpoints WHERE job_id = ?");
+  d.bind(1, job_id).step();
+  return true;
+}
+
 std::optional<JobRow> Store::lease(const std::string& worker, double now) {
   Guard lock(*this);
   Transaction tx(*this);
-  Statement s(*this,
-              "SELECT j.id FROM jobs j JOIN campaigns c ON c.id = j.campaign_id "
-              "WHERE j.state = 'queued' AND c.state = 'running' AND c.ready = 1 "
-              "ORDER BY j.campaign_id, j.kind, j.run_order, j.id LIMIT 1");
-  if (!s.step()) return std::nullopt;
-  const std::int64_t id = s.i64(0);
+  bool reused = false;
+  auto next = next_queued();
+  for (; next && !next->second.empty() && take_finished_run(next->first, next->second);
+       next = next_queued())
+    reused = true;
+  if (reused) finish_campaigns(server::wall_seconds());
+  if (!next) {
+    tx.commit();
+    return std::nullopt;
+  }
+  const std::int64_t id = next->first;
   Statement u(*this,
               "UPDATE jobs SET state = 'leased', attempt = attempt + 1, counted = counted + 1, "
               "worker = ? WHERE id = ? AND state = 'queued'");
@@ -703,6 +792,43 @@ std::optional<JobRow> Store::lease(const std::string& worker, double now) {
   deadlines_[id] = now + limits_.lease_seconds;
   job.lease_deadline = deadlines_[id];
   return job;
+}
+
+int Store::import_runs(const std::vector<FinishedRun>& runs) {
+  Guard lock(*this);
+  Transaction tx(*this);
+  const double imported = server::wall_seconds();
+  int added = 0;
+  Statement s(*this,
+              "INSERT OR IGNORE INTO journal_runs (run_key, attempt, metrics_json, wall_seconds, "
+              "flags_json, cost_json, series_json, source, imported) "
+              "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  for (const auto& run : runs) {
+    s.bind(1, run.run_key).bind(2, run.attempt).bind(3, run.metrics_json);
+    s.bind(4, run.wall_seconds).bind(5, run.flags_json).bind(6, run.cost_json);
+    s.bind(7, run.series_json).bind(8, run.source).bind(9, imported).step();
+    added += sqlite3_changes(db_);
+    s.reset();
+  }
+  tx.commit();
+  return added;
+}
+
+void Store::fill_run_keys(const std::function<RunKey(const std::string& payload)>& key_of) {
+  Guard lock(*this);
+  Transaction tx(*this);
+  std::vector<std::pair<std::int64_t, std::string>> missing;
+  {
+    Statement s(*this, "SELECT id, payload FROM jobs WHERE run_key IS NULL");
+    while (s.step()) missing.emplace_back(s.i64(0), s.text(1));
+  }
+  Statement u(*this, "UPDATE jobs SET run_key = ?, run_protocol = ? WHERE id = ?");
+  for (const auto& [id, payload] : missing) {
+    const RunKey key = key_of(payload);
+    u.bind(1, key.key).bind(2, key.protocol).bind(3, id).step();
+    u.reset();
+  }
+  tx.commit();
 }
 
 LeaseAnswer Store::check_lease(std::int64_t job_id, int attempt, const std::string& worker,

@@ -11,6 +11,7 @@
 // BEGIN IMMEDIATE for every write so that two writers never deadlock on a lock upgrade.
 //
 // Job state machine:  queued --Lease--> leased --Complete--> done
+//                      queued --Lease finds a finished run of its run key--> done (reused)
 //                                       leased --Fail(retryable) / lease expired--> queued
 //                                                  (failed once the attempt cap is reached)
 //                                       leased --Fail(not retryable)--> failed
@@ -34,6 +35,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace demcal::server {
@@ -46,12 +48,21 @@ struct CampaignRow {
   double created = 0.0, finished = 0.0;  ///< unix seconds; finished 0 while running
 };
 
+/// What identifies a job's result (server/run_key.hpp): a hash of everything that determines it,
+/// and the lab protocol version it was computed under.
+struct RunKey {
+  std::string key;   ///< empty: none (the job is never reused)
+  int protocol = 0;  ///< 0: none
+  bool operator==(const RunKey&) const = default;
+};
+
 struct NewJob {
   int std_order = 0;  ///< 1-based design row; 0 for a verification job
   int run_order = 0;
   std::string test;
   std::string kind = "design";  ///< design | verify | stage:<n> | diagnose:<group>
   std::string payload;          ///< JobSpec as JSON (without id and attempt)
+  RunKey run_key;
 };
 
 struct JobRow {
@@ -66,6 +77,22 @@ struct JobRow {
   double finished = 0.0;
   std::string flags_json = "{}";  ///< metric -> why it cannot be trusted
   std::string cost_json = "{}";   ///< the run's cost block (demcal.v1.RunCost as JSON)
+  RunKey run_key;
+  int result_attempt = 0;        ///< the lease that ran the stored result (a reused one's source's)
+  std::int64_t reused_from = 0;  ///< the result was taken from this job's (0: not from a job)
+  std::string reused_journal;    ///< the result was taken from this journal line (FILE:LINE)
+  bool reused() const { return reused_from != 0 || !reused_journal.empty(); }
+};
+
+/// A finished run read from a journal, kept for the jobs with its run key.
+struct FinishedRun {
+  std::string run_key;
+  int attempt = 0;  ///< the lease that ran it
+  std::string metrics_json;
+  double wall_seconds = 0.0;
+  std::string flags_json = "{}", cost_json = "{}";
+  std::string series_json;  ///< empty: none
+  std::string source;       ///< where it was read: FILE:LINE
 };
 
 /// One round of the sequential calibration: its proposal as JSON (server/calibration.cpp).
@@ -92,6 +119,7 @@ struct CheckpointRow {
 
 struct Counts {
   std::int64_t queued = 0, leased = 0, done = 0, failed = 0, cancelled = 0;
+  std::int64_t reused = 0;  ///< of done: results taken from an earlier run with the same run key
   std::int64_t total() const { return queued + leased + done + failed + cancelled; }
 };
 
@@ -172,8 +200,17 @@ class Store {
   std::vector<CalibrationStageRow> calibration_stages(std::int64_t campaign_id);
 
   /// The next queued job (oldest campaign first, then run order), leased to `worker` until
-  /// `now + lease` (`now` on the monotonic clock, as for the calls below).
+  /// `now + lease` (`now` on the monotonic clock, as for the calls below). A queued job whose run
+  /// key has a finished run (a done job of any campaign, else a run kept by import_runs) is not
+  /// leased: it takes that result, marked as reused, and the next is looked at. A queued job whose
+  /// run key another job is running waits for that run's result.
   std::optional<JobRow> lease(const std::string& worker, double now);
+  /// Keeps runs read from a journal for the jobs with their run keys; a key held already keeps
+  /// the run it has. Returns how many were new.
+  int import_runs(const std::vector<FinishedRun>& runs);
+  /// Sets the run key of every job that has none yet (jobs of a file from before run keys) to
+  /// `key_of(payload)`; an empty key marks a job that is never reused.
+  void fill_run_keys(const std::function<RunKey(const std::string& payload)>& key_of);
   /// Extends the current, unexpired lease held by `worker`.
   LeaseAnswer heartbeat(std::int64_t job_id, int attempt, const std::string& worker, double now);
   /// Stores the result of the current, unexpired lease held by `worker` exactly once; a retry
@@ -233,6 +270,11 @@ class Store {
   std::vector<std::int64_t> insert_jobs(std::int64_t campaign_id, const std::vector<NewJob>& jobs);
   bool requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason, bool retryable,
                        double now);
+  /// The next queued job a worker may take (see lease()): its id and run key.
+  std::optional<std::pair<std::int64_t, std::string>> next_queued();
+  /// Gives the queued job the result of a finished run with run key `key` (see lease()); false
+  /// when there is none. Inside a transaction.
+  bool take_finished_run(std::int64_t job_id, const std::string& key);
 
   /// Finalises the cached statements and closes the connection.
   void close();

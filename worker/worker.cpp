@@ -145,7 +145,7 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
   try {
     lab::RunOptions ro;
     ro.threads = job_threads(job, threads);
-    ro.seed = job.seed() ? job.seed() : 1;
+    ro.seed = rpc::job_seed(job);
     ro.progress = [&progress, &stop](double f) {
       progress = f;
       stop.check();

@@ -256,6 +256,105 @@ TEST(Store, OnlyTheLeaseHolderMayHeartbeatCompleteOrFailIt) {
   EXPECT_EQ(s.complete(a->id, 1, "w1", "{}", 0.5, 2.0), kOk);
 }
 
+/// A design job of run key `key` (a run key stands for what determines the result; here a name).
+NewJob keyed_job(int run_order, const std::string& key) {
+  return {run_order, run_order, "packing", "design", "{}", {key, 1}};
+}
+
+TEST(Store, AQueuedJobTakesTheResultOfAFinishedJobWithItsRunKeyInAnyCampaign) {
+  Store s(":memory:");
+  const auto first = s.create_campaign("a", "{}", "{}", {keyed_job(1, "k1")}, 0.0);
+  const auto a = s.lease("w1", 1.0);
+  ASSERT_TRUE(a);
+  const std::string flags = R"({"x":"phase 'settle' did not reach rest"})";
+  const std::string cost = R"({"steps":"12"})";
+  const std::string series = R"({"curve":{"columns":["t"],"rows":[[0.5]]}})";
+  EXPECT_EQ(s.complete(a->id, 1, "w1", R"({"x":1})", 2.5, 2.0, flags, cost, series), kOk);
+  EXPECT_EQ(s.campaign(first)->state, "done");
+  // A second campaign asks for the same run and one of its own: the worker gets only the new one.
+  const auto second =
+      s.create_campaign("b", "{}", "{}", {keyed_job(1, "k1"), keyed_job(2, "k2")}, 3.0);
+  const auto b = s.lease("w2", 4.0);
+  ASSERT_TRUE(b);
+  EXPECT_EQ(b->run_key.key, "k2");
+  const auto jobs = s.jobs(second);
+  const JobRow& reused = jobs[0];
+  EXPECT_EQ(reused.state, "done");
+  EXPECT_EQ(reused.attempt, 0);  // never leased: not simulated
+  EXPECT_TRUE(reused.reused());
+  EXPECT_EQ(reused.reused_from, a->id);
+  EXPECT_EQ(*reused.metrics_json, R"({"x":1})");
+  EXPECT_EQ(reused.flags_json, flags);
+  EXPECT_EQ(reused.cost_json, cost);
+  EXPECT_EQ(reused.wall_seconds, 2.5);
+  EXPECT_EQ(reused.result_attempt, 1);  // the source's attempt, which ran it
+  EXPECT_EQ(s.series(second).at(reused.id), series);
+  EXPECT_EQ(s.counts(second).reused, 1);
+  EXPECT_EQ(s.counts(second).done, 1);
+  EXPECT_EQ(s.counts(first).reused, 0);
+  EXPECT_EQ(s.complete(b->id, 1, "w2", R"({"x":2})", 1.0, 5.0), kOk);
+  EXPECT_EQ(s.campaign(second)->state, "done");
+  EXPECT_FALSE(s.job(b->id)->reused());
+  // A campaign all of whose runs are held is done at the next lease, with nothing leased.
+  const auto third = s.create_campaign("c", "{}", "{}", {keyed_job(1, "k2")}, 6.0);
+  EXPECT_FALSE(s.lease("w3", 7.0));
+  EXPECT_EQ(s.campaign(third)->state, "done");
+  EXPECT_EQ(s.jobs(third)[0].reused_from, b->id);
+  // A job without a run key is never given another's result.
+  s.create_campaign("d", "{}", "{}", {keyed_job(1, "")}, 8.0);
+  EXPECT_TRUE(s.lease("w4", 9.0));
+}
+
+TEST(Store, AJobWaitsWhileAnotherJobRunsItsRunKey) {
+  Store s(":memory:", {10.0, 3});
+  const auto id = s.create_campaign(
+      "c", "{}", "{}", {keyed_job(1, "k"), keyed_job(2, "k"), keyed_job(3, "other")}, 0.0);
+  const auto a = s.lease("w1", 1.0);
+  ASSERT_TRUE(a);
+  const auto b = s.lease("w2", 1.0);  // the second "k" waits for the first's result
+  ASSERT_TRUE(b);
+  EXPECT_EQ(b->run_key.key, "other");
+  EXPECT_FALSE(s.lease("w3", 1.0));
+  // The running one fails and goes back to the queue: the waiting one may run now.
+  EXPECT_EQ(s.fail(a->id, 1, "w1", "worker error", true, false, 2.0), kOk);
+  const auto c = s.lease("w3", 3.0);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->run_key.key, "k");
+  EXPECT_EQ(s.complete(c->id, c->attempt, "w3", R"({"x":3})", 1.0, 4.0), kOk);
+  EXPECT_EQ(s.complete(b->id, 1, "w2", R"({"x":4})", 1.0, 4.0), kOk);
+  EXPECT_FALSE(s.lease("w1", 5.0));  // the other "k" takes the result
+  EXPECT_EQ(s.campaign(id)->state, "done");
+  EXPECT_EQ(s.counts(id).reused, 1);
+  EXPECT_EQ(s.counts(id).done, 3);
+}
+
+TEST(Store, RunsOfAJournalAreTakenByTheJobsOfTheirKeysAndNeverReplaceARunHeld) {
+  Store s(":memory:");
+  const std::string series = R"({"curve":{"columns":["t"],"rows":[[1.0]]}})";
+  const FinishedRun run{"k1",         2, R"({"x":7})", 3.0, "{}", R"({"steps":"5"})", series,
+                        "old.jsonl:2"};
+  EXPECT_EQ(s.import_runs({run}), 1);
+  FinishedRun other = run;
+  other.metrics_json = R"({"x":8})";
+  other.source = "new.jsonl:2";
+  EXPECT_EQ(s.import_runs({other}), 0);  // the key is held: the run held stays
+  const auto id = s.create_campaign("c", "{}", "{}", {keyed_job(1, "k1")}, 0.0);
+  EXPECT_FALSE(s.lease("w", 1.0));
+  const JobRow job = s.jobs(id)[0];
+  EXPECT_EQ(job.state, "done");
+  EXPECT_EQ(job.reused_from, 0);
+  EXPECT_EQ(job.reused_journal, "old.jsonl:2");
+  EXPECT_EQ(*job.metrics_json, R"({"x":7})");
+  EXPECT_EQ(job.result_attempt, 2);
+  EXPECT_EQ(job.cost_json, R"({"steps":"5"})");
+  EXPECT_EQ(s.series(id).at(job.id), series);
+  EXPECT_EQ(s.campaign(id)->state, "done");
+  // A later job of that key takes it from the job that holds it now.
+  const auto later = s.create_campaign("d", "{}", "{}", {keyed_job(1, "k1")}, 2.0);
+  EXPECT_FALSE(s.lease("w", 3.0));
+  EXPECT_EQ(s.jobs(later)[0].reused_from, job.id);
+}
+
 TEST(Store, ACampaignOfManyBatchesIsInsertedWholeInRunOrder) {
   Store s(":memory:");
   const int n = 3 * static_cast<int>(Store::kInsertBatch) + 5;
@@ -462,7 +561,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 7);
+    EXPECT_EQ(Store::latest_schema_version(), 8);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
@@ -484,6 +583,14 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
     EXPECT_EQ(js[0].cost_json, "{}");
     EXPECT_TRUE(s.series(1).empty());  // a result from before curves: none stored
     EXPECT_EQ(s.result_count(1), 1);
+    EXPECT_FALSE(js[0].reused());  // a result from before reuse: simulated
+    // A job from before run keys gets its key when the coordinator computes it (here: a name).
+    s.fill_run_keys([](const std::string& payload) {
+      return RunKey{payload == R"({"p":1})" ? "old-key" : "", 1};
+    });
+    EXPECT_EQ(s.job(1)->run_key, (RunKey{"old-key", 1}));
+    s.fill_run_keys([](const std::string&) { return RunKey{"not asked", 1}; });
+    EXPECT_EQ(s.job(1)->run_key.key, "old-key");  // computed once
 
     const auto ids = s.add_jobs(1, {{1, 1, "packing", "diagnose:shape", "{}"}});
     ASSERT_EQ(ids.size(), 1u);
