@@ -13,6 +13,7 @@
 #include "client/study_journal.hpp"
 #include "core/io/csv.hpp"
 #include "core/lab/lab_spec.hpp"
+#include "core/lab/stage_cache.hpp"
 #include "core/lab/study.hpp"
 
 namespace demcal::cli {
@@ -21,6 +22,7 @@ namespace {
 struct LabOptions {
   std::string spec;
   std::string out_dir;
+  std::string stage_cache;
   int threads = 0;
 };
 
@@ -31,6 +33,8 @@ void run_lab(const LabOptions& opt) {
     std::filesystem::create_directories(opt.out_dir);
     spec.options.snapshot_dir = opt.out_dir;
   }
+  if (!opt.stage_cache.empty())
+    spec.options.stage_cache = std::make_shared<const lab::StageCache>(opt.stage_cache);
   const auto& test = lab::find_lab_info(spec.test);
   const lab::LabOutput out =
       lab::run_lab_test(spec.test, spec.material, spec.settings, spec.options);
@@ -213,6 +217,9 @@ void add_lab_command(CLI::App& app) {
   run->add_option("--out", opt->out_dir,
                   "directory for metrics.json, series CSV and VTK snapshots");
   run->add_option("--threads", opt->threads, "override the spec's thread count");
+  run->add_option("--stage-cache", opt->stage_cache,
+                  "directory where runs keep the stages other runs start from (e.g. the bed a "
+                  "confined compression conditioned, for a tensile test)");
   run->callback([opt] { run_lab(*opt); });
   auto sopt = std::make_shared<StudyOptions>();
   auto* study = lab->add_subcommand(

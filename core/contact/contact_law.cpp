@@ -92,16 +92,6 @@ double ContactLaw::reached_stiffness(double r_eff, double delta_max) const {
       normal);
 }
 
-bool ContactLaw::keeps_reached_overlap() const {
-  return std::visit(
-      [](const auto& n) {
-        return requires {
-          n.reached_stiffness(1.0, 0.0);
-        };
-      },
-      normal);
-}
-
 ContactLaw ContactLaw::from_spec(const ContactLawSpec& spec, const std::string& where) {
   return {make_model<NormalModel>(spec.normal, where + ".normal"),
           make_model<CohesionModel>(spec.cohesion, where + ".cohesion"),

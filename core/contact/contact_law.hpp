@@ -51,8 +51,6 @@ struct ContactLaw {
   /// max_stiffness() for a normal model whose un-/reloading stiffness grows with the overlap
   /// (Luding); max_stiffness() for the others.
   double reached_stiffness(double r_eff, double delta_max) const;
-  /// True when the normal model keeps the largest overlap reached as history[0] (Luding).
-  bool keeps_reached_overlap() const;
   /// Builds a law from its spec; errors name the field path below `where`.
   static ContactLaw from_spec(const ContactLawSpec& spec, const std::string& where);
 };
@@ -92,6 +90,7 @@ inline PairOutput evaluate(const N& nm, const C& cm, const T& tm, const R& rm, c
   }
   const NormalResult nr = nm.force(in, history + H::kNormal);
   out.fn = nr.fn - f_coh;
+  out.stiffness = nr.k_step;
   const double f_coulomb = std::max(0.0, out.fn + nr.f_adhesive + f_coh);
   out.ft = tm.force(in, nr, f_coulomb, history + H::kTangential);
   out.rolling_torque = rm.torque(in, nr, f_coulomb, history + H::kRolling);

@@ -29,15 +29,20 @@ struct NormalResult {
                           ///< for the Coulomb criterion as seed 000 eq. 18 does (N)
   double k_ref = 0.0;     ///< the stiffness tangential and rolling stiffness ratios refer to (N/m)
   double gamma_n = 0.0;   ///< normal damping coefficient (kg/s)
+  /// The steepest slope of the force-overlap curve the contact can follow from where it is, for
+  /// the time step (sim/time_step.hpp): the tangent of an elastic law, the larger of the
+  /// un-/reloading and adhesive slopes of a hysteretic one (N/m).
+  double k_step = 0.0;
 };
 
 struct PairOutput {
-  double fn = 0.0;      ///< total normal force, > 0 repulsive (N)
-  Vec3 force;           ///< force on i (N); j receives -force
-  Vec3 ft;              ///< tangential part of `force` (N)
-  Vec3 torque_i;        ///< (N m)
-  Vec3 torque_j;        ///< (N m)
-  Vec3 rolling_torque;  ///< rolling-resistance part of torque_i (N m)
+  double fn = 0.0;         ///< total normal force, > 0 repulsive (N)
+  double stiffness = 0.0;  ///< NormalResult::k_step of a contact; 0 out of contact (N/m)
+  Vec3 force;              ///< force on i (N); j receives -force
+  Vec3 ft;                 ///< tangential part of `force` (N)
+  Vec3 torque_i;           ///< (N m)
+  Vec3 torque_j;           ///< (N m)
+  Vec3 rolling_torque;     ///< rolling-resistance part of torque_i (N m)
 };
 
 /// Removes the normal component of a history vector and restores its length: the history is

@@ -26,13 +26,15 @@ void RunCost::close(const sim::World& world) {
   critical_time_step = limit.critical;
   char text[384];
   if (world.adaptive_safety > 0.0) {
-    const sim::TimeStepLimit reached = sim::reached_time_step(world);
+    const sim::TimeStepLimit fresh = sim::fresh_contact_time_step(world);
     std::snprintf(text, sizeof text,
-                  "re-tuned every %d steps to %.3g x %s at the overlaps reached (%.4g s), at most "
-                  "%.3g x its largest stiffness's bound (%.4g s); at the end %.3g x the latter",
-                  sim::World::kRetuneSteps, world.adaptive_safety, reached.basis.c_str(),
-                  reached.critical, sim::kStableFraction, limit.critical,
-                  world.dt / limit.critical);
+                  "%.3g x sqrt(m*/k) of the stiffest contact in use (shrinks at once, grows by "
+                  "at most %.3g x every %d steps), at most %.3g x the bound of a fresh contact, "
+                  "%s (%.4g s); at the end %.4g s, %.3g x the bound at the laws' largest "
+                  "stiffness (%.4g s)",
+                  sim::kStableFraction, sim::World::kStepGrowth, sim::World::kRetuneSteps,
+                  world.adaptive_safety, fresh.basis.c_str(), fresh.critical, world.dt,
+                  world.dt / limit.critical, limit.critical);
   } else {
     std::snprintf(text, sizeof text, "%.3g x %s (%.4g s)", world.dt / limit.critical,
                   limit.basis.c_str(), limit.critical);

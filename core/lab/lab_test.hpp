@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,8 @@
 #include "core/model/material.hpp"
 
 namespace demcal::lab {
+
+class StageCache;
 
 struct Series {
   std::vector<std::string> columns;
@@ -59,6 +62,9 @@ struct RunOptions {
   /// Go on from this checkpoint instead of simulating up to its stage (empty stage: start
   /// afresh). run_lab_test refuses one whose stage the test never reached.
   Checkpoint resume;
+  /// Where runs keep the stages other runs can start from (core/lab/stage_cache.hpp); none:
+  /// every run computes its own.
+  std::shared_ptr<const StageCache> stage_cache;
 };
 
 /// Runs a test by name: validates the settings, runs, and checks that every catalogued metric

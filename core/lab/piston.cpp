@@ -192,8 +192,9 @@ PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest&
   b.world = make_die_world(material, spec, options);
   b.filled = fill_clock.stop(b.world, "fill", "all particles inserted", true);
   sim::World& w = b.world;
-  if (request.set_laws) request.set_laws(w);
-  // The piston shares the bottom's law; add it (far above) so the time step covers its law.
+  if (request.set_laws) request.set_laws(w, 1.0);
+  // The piston shares the bottom's law; added far above, it touches nothing while the bed
+  // settles.
   b.radius = die_radius(w);
   b.area = M_PI * b.radius * b.radius;
   const double top = metrics_top(w);
@@ -202,6 +203,11 @@ PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest&
   w.dt = sim::adapted_time_step(w, request.safety);
   b.built = prepare_and_settle(w, material, spec, b.limits, top, options.seed);
   b.h0 = metrics_top(w);
+  // Stiff piston and bottom for the loads; the step follows the stiffer contacts at once.
+  if (request.set_laws && request.wall_stiffness_factor != 1.0) {
+    request.set_laws(w, request.wall_stiffness_factor);
+    w.dt = sim::adapted_time_step(w, request.safety);
+  }
   auto& disk = std::get<walls::Disk>(w.walls[b.piston].shape);
   disk.centre.z = b.h0;
   w.walls[b.piston].pivot = disk.centre;

@@ -101,8 +101,14 @@ struct PistonBedRequest {
   double stress_level = 0.0;
   /// The test's servo settings, for PistonBed::servo at stress_level (none when it is 0).
   PistonServoSettings servo{};
-  /// Replaces wall laws (e.g. stiff or adhesive piston and bottom).
-  std::function<void(sim::World&)> set_laws;
+  /// Replaces wall laws (e.g. stiff or adhesive piston and bottom) with the normal stiffness of
+  /// piston and bottom times the given factor (World::change_wall_law, so a settled bed keeps
+  /// its contacts' history).
+  std::function<void(sim::World&, double stiffness_factor)> set_laws;
+  /// The factor set_laws gets once the bed has settled, for the servo phases (seed 000 §2.7.2:
+  /// 30, so that particles do not escape past the piston); the bed settles at factor 1, on
+  /// walls as stiff as the material's own wall law.
+  double wall_stiffness_factor = 1.0;
   /// The metrics read from the settled state (its height): flagged if settling fell short.
   std::vector<std::string> depending;
 };
@@ -111,13 +117,14 @@ struct PistonBedRequest {
 /// the largest stress it applies (simulated) and its wall laws.
 template <class S>
 PistonBedRequest piston_bed_request(const S& settings, double stress_level,
-                                    std::function<void(sim::World&)> set_laws) {
+                                    std::function<void(sim::World&, double)> set_laws) {
   PistonBedRequest request;
   request.particles = static_cast<std::size_t>(settings.particles);
   request.safety = settings.time_step_safety;
   request.stress_level = stress_level;
   request.servo = settings;
   request.set_laws = std::move(set_laws);
+  request.wall_stiffness_factor = settings.wall_stiffness_factor;
   return request;
 }
 
@@ -126,9 +133,9 @@ void add_bed_phases(LabOutput& out, const PistonBed& bed, const PistonBedRequest
 /// Records a servo phase under `name`, flagging `depending` if it did not reach its target.
 void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string& name,
                      const std::vector<std::string>& depending);
-/// Builds the die world, lets `set_laws` replace wall laws, sets dt = safety * critical over all
-/// laws, settles relative to the stress level, adds the piston at the bed top and sets its
-/// servo.
+/// Builds the die world, lets `set_laws` replace wall laws (stiffness factor 1), settles relative
+/// to the stress level with the adapted time step, stiffens piston and bottom by the request's
+/// wall_stiffness_factor, adds the piston at the bed top and sets its servo.
 PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
                           const RunOptions& options);
 
@@ -148,7 +155,8 @@ std::size_t start_piston_test(S& stages, const MaterialModel& material,
                               PistonBed& bed, LabOutput& out) {
   if (stages.resuming()) {
     bed.world = make_material_world(material, options);
-    if (request.set_laws) request.set_laws(bed.world);
+    // Every stage runs on the stiffened piston and bottom.
+    if (request.set_laws) request.set_laws(bed.world, request.wall_stiffness_factor);
     const std::size_t next = stages.resume(bed.world);
     check_piston(bed);
     return next;

@@ -7,6 +7,6 @@
 // result of the old protocol is taken for a run of the new one.
 namespace demcal::lab {
 
-inline constexpr int kProtocolVersion = 1;
+inline constexpr int kProtocolVersion = 2;
 
 }  // namespace demcal::lab

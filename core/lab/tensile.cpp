@@ -1,17 +1,21 @@
 // tensile (seed 000 §2.7.3, eq. 34-35).
-// Phases: settle in the die with adhesive piston and bottom (the wall law stiffened by
-// wall_stiffness_factor, A_H times eq. 34, k2 times eq. 35) and a frictionless, non-cohesive die
-// wall; the piston (StressServo) consolidates to consolidation_stress and unloads to
-// unload_stress; then it is pulled up at constant speed. The tensile stress on the piston is
+// Phases: the confined compression protocol conditions the bed (core/lab/confinement.hpp: settle,
+// load to consolidation_stress, `cycles` unload-reload cycles, final unload to final_stress),
+// or the stage cache hands over the bed a run of the same material, settings and seed
+// conditioned so (seed 000 §2.7.3: "loading the pre-compressed powder as well as the piston at
+// its last position from the confined compression test"); then piston and bottom become
+// adhesive (the wall law stiffened by wall_stiffness_factor, A_H times eq. 34, k2 times eq. 35)
+// and the die wall frictionless and non-cohesive; the piston (StressServo) unloads to
+// unload_stress and is pulled up at constant speed. The tensile stress on the piston is
 // sigma_t = -F_z / A (F_z: the particles' force on it); the fracture is the peak of sigma_t over
 // the pull, and the tensile strength is that peak less the weight of the powder still stuck to
 // the piston at the end of the pull, over A (seed 000 §2.7.3, Fig. 10-11).
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
+#include "core/lab/confinement.hpp"
 #include "core/lab/lab_test.hpp"
-#include "core/lab/piston.hpp"
-#include "core/lab/stages.hpp"
 #include "core/model/tensile_settings.hpp"
 
 namespace demcal::lab {
@@ -30,6 +34,20 @@ double real_radius_um(const MaterialModel& m) {
     r /= w;
   }
   return r * m.size_scale * 1e6;
+}
+
+/// The confined compression settings that condition the tensile bed.
+ConfinedCompressionSettings conditioning_settings(const TensileSettings& s) {
+  ConfinedCompressionSettings c;
+  static_cast<PistonServoSettings&>(c) = s;
+  c.particles = s.particles;
+  c.time_step_safety = s.time_step_safety;
+  c.max_stress = s.consolidation_stress;
+  c.min_stress = s.min_stress;
+  c.final_stress = s.final_stress;
+  c.cycles = s.cycles;
+  c.wall_stiffness_factor = s.wall_stiffness_factor;
+  return c;
 }
 
 }  // namespace
@@ -62,55 +80,67 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
         adhesive.normal.params.count("k2_ratio") ? adhesive.normal.params["k2_ratio"] : 5.0;
     adhesive.normal.params["k2_ratio"] = std::min(1e4, k2 * f_k2);
   }
-  // The die: frictionless and without cohesion, it only stabilises the sample.
+  // The die: frictionless and without cohesion, it only stabilises the sample. Its slots keep
+  // their models with the forces set to zero, so the conditioned bed keeps its wall contacts.
   contact::ContactLawSpec die = material.wall_law;
-  die.cohesion = {"none", {}};
-  die.rolling = {"none", {}};
+  if (die.cohesion.model == "van_der_waals") die.cohesion.params["hamaker"] = 0.0;
+  if (die.rolling.model != "none") die.rolling.params["mu_r"] = 0.0;
   die.tangential.params["mu_s"] = 0.0;
   if (die.normal.model == "luding") die.normal.params["kc_ratio"] = 0.0;
   const auto adhesive_law = simulated_law(material, adhesive);
   const auto die_law = simulated_law(material, die);
 
-  const PistonBedRequest request =
-      piston_bed_request(s, s.consolidation_stress * fs, [&](sim::World& w) {
-        w.set_wall_law(kWallPiston, 0, adhesive_law);
-        w.set_wall_law(kWallBottom, 0, adhesive_law);
-        w.set_wall_law(kWallDie, 0, die_law);
-      });
+  // The bed the confined compression protocol conditioned (seed 000 §2.7.3), from the stage
+  // cache when a run of the same material, settings and seed kept it.
+  const ConfinedCompressionSettings cs = conditioning_settings(s);
+  PistonBedRequest request = confinement_request(material, cs);
+  request.depending = {"tensile_strength"};
+  std::vector<std::string> names = confinement_stages(static_cast<int>(std::lround(cs.cycles)));
+  names.push_back("unload");
+  const std::size_t unload_stage = names.size() - 1;
   LabOutput out;
-  PistonBed bed;
-  // The heights the servo phases ended at, and whether the consolidation reached its stress.
-  struct Loaded {
-    double consolidated_z = 0.0, unloaded_z = 0.0;
-    bool consolidated = false;
-  } loaded;
-  Stages stages(options, {kPistonBedStage, "consolidate", "unload"}, out, [&](auto& a) {
-    a.field(bed);
-    a.field(loaded);
+  Confinement c;
+  double unloaded_z = 0.0;
+  Stages stages(options, names, out, [&](auto& a) {
+    a.field(c);
+    a.field(unloaded_z);
   });
-  const std::size_t next = start_piston_test(stages, material, request, options, bed, out);
-  sim::World& w = bed.world;
-  const ServoSettings& servo = bed.servo;
-  auto phase = [&](std::size_t stage, double target_real) {
+  std::size_t next = 0;
+  std::optional<PistonBed> kept;
+  if (!stages.resuming()) kept = cached_conditioned_bed(material, cs, options);
+  if (kept) {
+    c.bed = std::move(*kept);
+    next = unload_stage;
+    out.notes.push_back(
+        "the bed conditioned by the confined compression protocol was taken from the stage cache "
+        "(" +
+        options.stage_cache->directory().string() +
+        "): its phases ran in an earlier run, which reached every target");
+  } else {
+    next = start_piston_test(stages, material, request, options, c.bed, out);
+    run_confinement(
+        c, [&](std::size_t stage) { stages.reached(stage, c.bed.world); }, next, material, cs,
+        options, out, [](std::size_t) { return std::vector<std::string>{"tensile_strength"}; },
+        0.8);
+    next = std::max(next, unload_stage);
+  }
+  sim::World& w = c.bed.world;
+  w.change_wall_law(kWallPiston, 0, adhesive_law);
+  w.change_wall_law(kWallBottom, 0, adhesive_law);
+  w.change_wall_law(kWallDie, 0, die_law);
+  const ServoSettings& servo = c.bed.servo;
+  if (next <= unload_stage) {
     ServoSettings ps = servo;
-    ps.tolerance = std::max(servo.tolerance * target_real, 2e-3 * s.consolidation_stress) * fs;
-    const ServoPhase r = servo_phase(w, bed.piston, bed.piston, {0, 0, -1}, bed.area,
-                                     target_real * fs, ps, bed.limits);
-    add_servo_phase(out, r, stages.name(stage), {"tensile_strength"});
-    return r;
-  };
-  if (next <= 1) {
-    const ServoPhase consolidated = phase(1, s.consolidation_stress);
-    loaded.consolidated_z = consolidated.position;
-    loaded.consolidated = consolidated.reached;
-    stages.reached(1, w);
-  }
-  if (next <= 2) {
-    loaded.unloaded_z = phase(2, s.unload_stress).position;
-    if (options.progress) options.progress(0.5);
+    ps.tolerance = std::max(servo.tolerance * s.unload_stress, 2e-3 * s.consolidation_stress) * fs;
+    const ServoPhase r = servo_phase(w, c.bed.piston, c.bed.piston, {0, 0, -1}, c.bed.area,
+                                     s.unload_stress * fs, ps, c.bed.limits);
+    add_servo_phase(out, r, "unload", {"tensile_strength"});
+    unloaded_z = r.position;
+    if (options.progress) options.progress(0.85);
     write_snapshot(w, options, "consolidated", out);
-    stages.reached(2, w);
+    stages.reached(unload_stage, w);
   }
+  const PistonBed& bed = c.bed;
 
   // Pull-off at constant speed.
   const auto& p = w.particles;
@@ -119,7 +149,7 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   d_mean /= static_cast<double>(p.size());
   const double v = s.pull_speed > 0.0 ? s.pull_speed : 0.5 * servo.max_speed;
   const double travel = s.pull_distance * d_mean;
-  const double h_start = loaded.unloaded_z;
+  const double h_start = unloaded_z;
   auto& piston = w.walls[bed.piston];
   piston.velocity = {0, 0, v};
   Series series{{"time_s", "displacement_m", "strain", "tensile_stress_kPa"}, {}};
@@ -170,8 +200,8 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   out.series["fracture"] = Series{
       {"peak_stress_kPa", "peak_strain", "stuck_weight_stress_kPa", "consolidated_height_m",
        "unloaded_height_m", "consolidation_reached", "wall_hamaker_factor", "wall_k2_factor"},
-      {{peak / fs / 1e3, peak_strain, stuck_stress / fs / 1e3, loaded.consolidated_z,
-        loaded.unloaded_z, loaded.consolidated ? 1.0 : 0.0, f_ah, f_k2}}};
+      {{peak / fs / 1e3, peak_strain, stuck_stress / fs / 1e3, c.done.h1, unloaded_z,
+        c.reached ? 1.0 : 0.0, f_ah, f_k2}}};
   out.cost.close(w);
   return out;
 }

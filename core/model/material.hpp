@@ -51,6 +51,12 @@ struct MaterialModel {
   void validate() const;
 };
 
+/// Everything of the model that can change a simulation, as text: every slot's model and given
+/// parameters, the size distribution, density, scaling, shape and preparation (numbers to 17
+/// digits). Two models with the same identity simulate alike; the key of work that runs share
+/// (core/lab/stage_cache.hpp).
+std::string material_identity(const MaterialModel& model);
+
 struct ParameterInfo {
   std::string path, unit;
   double lo, hi;  ///< valid range

@@ -12,20 +12,30 @@ namespace demcal::lab {
 
 struct TensileSettings : PistonServoSettings {
   static constexpr const char* kName = "tensile";
-  double particles, time_step_safety, consolidation_stress, unload_stress, pull_speed,
-      pull_distance, wall_stiffness_factor, wall_hamaker_factor, wall_k2_factor;
+  double particles, time_step_safety, consolidation_stress, min_stress, final_stress, cycles,
+      unload_stress, pull_speed, pull_distance, wall_stiffness_factor, wall_hamaker_factor,
+      wall_k2_factor;
 
-  static std::array<contact::ParamInfo<TensileSettings>, 18> table() {
+  static std::array<contact::ParamInfo<TensileSettings>, 21> table() {
     using S = TensileSettings;
-    return with_piston_rows(std::array<contact::ParamInfo<S>, 9>{
+    return with_piston_rows(std::array<contact::ParamInfo<S>, 12>{
         {{"particles", "-", 20, 1e7, 300, "number of particles", &S::particles},
          {"time_step_safety", "-", 0.01, 1.0, 0.2, "time step as a fraction of the critical one",
           &S::time_step_safety},
          {"consolidation_stress", "Pa", 1.0, 1e9, 15000.0,
-          "piston stress that consolidates the bed (real; seed 000: 15 kPa)",
+          "max_stress of the confined compression that conditions the bed (real; seed 000: "
+          "15 kPa)",
           &S::consolidation_stress},
+         {"min_stress", "Pa", 0.0, 1e9, 500.0,
+          "unload stress of the conditioning's cycles (real; as confined_compression)",
+          &S::min_stress},
+         {"final_stress", "Pa", 0.0, 1e9, 100.0,
+          "stress of the conditioning's final unload (real; as confined_compression)",
+          &S::final_stress},
+         {"cycles", "-", 1, 50, 5,
+          "unload-reload cycles of the conditioning (as confined_compression)", &S::cycles},
          {"unload_stress", "Pa", 0.0, 1e9, 50.0,
-          "stress the piston is unloaded to before pulling (real; 'close to zero')",
+          "stress the adhesive piston is unloaded to before pulling (real; 'close to zero')",
           &S::unload_stress},
          {"pull_speed", "m/s", 0.0, 100.0, 0.0,
           "constant pull-off speed; 0 = half the servo speed limit", &S::pull_speed},
@@ -41,7 +51,10 @@ struct TensileSettings : PistonServoSettings {
           "k2,wall / k2 of piston and bottom; 0 = seed 000 eq. 35 with r_real in [5, 50] um",
           &S::wall_k2_factor}}});
   }
-  void finalize(const std::string&) {}
+  void finalize(const std::string& where) {
+    if (min_stress >= consolidation_stress)
+      throw InputError(where + ".min_stress", "must be < consolidation_stress");
+  }
 };
 
 /// Seed 000 eq. 34: A_H,wall / A_H = 10 + 90 (r_real - 5) / 45, r_real in um (clamped to the
@@ -55,8 +68,9 @@ double wall_k2_ratio_eq35(double r_real_um);
 struct TensileTest {
   static LabTestInfo info() {
     return {"tensile",
-            "bed consolidated in the die by an adhesive piston (eq. 34-35), unloaded, and pulled "
-            "apart at constant slow speed inside a frictionless non-cohesive die wall",
+            "bed conditioned in the die by the confined compression protocol, then held by an "
+            "adhesive piston and bottom (eq. 34-35), unloaded, and pulled apart at constant slow "
+            "speed inside a frictionless non-cohesive die wall",
             "seed 000 §2.7.3 (eq. 34-35, Fig. 10-11)",
             {{"tensile_strength", "kPa",
               "peak tensile stress on the piston less the weight of the powder stuck to it, over "

@@ -35,8 +35,8 @@ struct Wrench {
 /// Adds the contact forces of wall `wall_index` to the particles [lo, hi) and their reaction to
 /// `on_wall`.
 template <class N, class C, class T, class R>
-void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wall, const N&,
-                 const C&, const T&, const R&) {
+void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wall, double& rate2,
+                 const N&, const C&, const T&, const R&) {
   using Law = TypedLaw<N, C, T, R>;
   constexpr int kStride = contact::History<N, C, T, R>::kSize;
   walls::Wall& wall = w.walls[wall_index];
@@ -48,6 +48,7 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
 
   auto& p = w.particles;
   double* hist = w.wall_history[wall_index].data();
+  const double* inverse_mass = w.contact_inverse_mass();
   const walls::Mesh* mesh = std::get_if<walls::Mesh>(&wall.shape);
   // Only the particles that may touch the wall (World::wall_reach), those of [lo, hi).
   const std::vector<int>& near = w.wall_reach[wall_index].near;
@@ -69,6 +70,8 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
       in.w_rel = p.omega[i] - wall.omega;
       in.dt = w.dt;
       const contact::PairOutput out = laws[p.material[i]].evaluate(in, h);
+      if (out.stiffness > 0.0)
+        rate2 = std::max(rate2, out.stiffness * (inverse_mass ? inverse_mass[i] : 1.0 / in.m_star));
       p.f[i] += out.force;
       p.torque[i] += out.torque_i;
       wf -= out.force;
@@ -149,11 +152,11 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
   }
 }
 
-void add_wall_forces(World& w, std::size_t k, int lo, int hi, Wrench& on_wall) {
+void add_wall_forces(World& w, std::size_t k, int lo, int hi, Wrench& on_wall, double& rate2) {
   const int m0 = w.particles.material[0];
   contact::visit(w.wall_law(w.walls[k].material, m0),
                  [&](const auto& n, const auto& c, const auto& t, const auto& r) {
-                   wall_kernel(w, k, lo, hi, on_wall, n, c, t, r);
+                   wall_kernel(w, k, lo, hi, on_wall, rate2, n, c, t, r);
                  });
 }
 
@@ -190,6 +193,9 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
   const int threads = w.active_threads();
   // Each wall's force and torque, per thread, summed in thread order after the region.
   std::vector<std::vector<Wrench>> on_walls(w.walls.size(), std::vector<Wrench>(threads));
+  // Each thread's largest k / m* of a contact (World::contact_rate2).
+  std::vector<double> rates(threads, 0.0);
+  const double* inverse_mass = w.contact_inverse_mass();
 
   if (static_cast<int>(w.deferred.size()) != threads) w.deferred.assign(threads, {});
 
@@ -203,6 +209,7 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
     const auto [lo, hi] = w.owned_range(tid);
     auto& deferred = w.deferred[tid];
     deferred.clear();
+    double rate2 = 0.0;
     for (int i = lo; i < hi; ++i) {
       // A clump's weight acts at its centre of mass (rigid_body.hpp), not through its members.
       p.f[i] = p.motion[i] == particles::Motion::kClumpMember ? Vec3{} : w.gravity * p.mass[i];
@@ -227,6 +234,9 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
         const contact::PairInput in = particle_pair_input(
             d, std::sqrt(dist2), ri, rj, mi, p.mass[j], vi, p.v[j], wi, p.omega[j], dt);
         const contact::PairOutput out = law_row[p.material[j]].evaluate(in, h);
+        if (out.stiffness > 0.0)
+          rate2 = std::max(rate2, out.stiffness * (inverse_mass ? inverse_mass[i] + inverse_mass[j]
+                                                                : 1.0 / in.m_star));
         fi += out.force;
         ti += out.torque_i;
         if (j < hi) {
@@ -247,10 +257,12 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
           p.torque[c.particle] += c.torque;
         }
     for (std::size_t k = 0; k < w.walls.size(); ++k)
-      add_wall_forces(w, k, lo, hi, on_walls[k][tid]);
+      add_wall_forces(w, k, lo, hi, on_walls[k][tid], rate2);
+    rates[tid] = rate2;
     if (after) after(lo, hi);
   }
   for (std::size_t k = 0; k < w.walls.size(); ++k) sum_wall_wrench(w.walls[k], on_walls[k]);
+  w.contact_rate2 = *std::max_element(rates.begin(), rates.end());
 }
 
 }  // namespace
@@ -258,6 +270,7 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
 void compute_forces(World& world, const OwnedRangeTask& after) {
   if (world.particles.size() == 0) {
     for (auto& wall : world.walls) wall.force = wall.torque = {};
+    world.contact_rate2 = 0.0;
     return;
   }
   world.refresh_wall_reach();

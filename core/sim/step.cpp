@@ -38,6 +38,8 @@ void step(World& w) {
     // A new or changed world: build its state and its forces (prepare() computes them), so the
     // first kick below uses the forces of the initial configuration (as LIGGGHTS' setup does).
     w.prepare();
+    // The new state's contacts may need a shorter step than the one set.
+    if (w.adaptive_safety > 0.0) w.dt = next_time_step(w, false);
   }
   if (!w.owners_fit()) w.balance_owners();
   const double half = 0.5 * w.dt;
@@ -67,8 +69,7 @@ void step(World& w) {
 
   w.time += w.dt;
   ++w.step_count;
-  if (w.adaptive_safety > 0.0 && w.step_count % World::kRetuneSteps == 0)
-    w.dt = adapted_time_step(w, w.adaptive_safety);
+  if (w.adaptive_safety > 0.0) w.dt = next_time_step(w, w.step_count % World::kRetuneSteps == 0);
 }
 
 void run(World& w, std::int64_t steps) {

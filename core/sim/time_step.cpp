@@ -9,7 +9,6 @@
 #include "core/integrate/time_step.hpp"
 
 namespace demcal::sim {
-namespace {
 
 /// The mass a contact on sphere i accelerates, in the direction where it is smallest.
 ///
@@ -49,10 +48,12 @@ double contact_mass(const particles::ParticleStore& p, std::size_t i) {
   return 1.0 / (1.0 / body_mass + a2 * largest);
 }
 
+namespace {
+
 /// Both bounds of a world, found in one pass over its laws and particles.
 struct Bounds {
   TimeStepLimit law_max{std::numeric_limits<double>::infinity(), "no contacts"};
-  TimeStepLimit reached{std::numeric_limits<double>::infinity(), "no contacts"};
+  TimeStepLimit fresh{std::numeric_limits<double>::infinity(), "no contacts"};
 };
 
 void lower(TimeStepLimit& limit, double t, bool hertz, const std::string& which) {
@@ -63,76 +64,52 @@ void lower(TimeStepLimit& limit, double t, bool hertz, const std::string& which)
 }
 
 /// Tightens both bounds by a law's for every particle: at the law's largest stiffness, and at the
-/// stiffness of a contact whose overlap has reached `overlap` (< 0: the largest stiffness too).
+/// stiffness a contact has when it forms.
 void tighten(Bounds& bounds, const contact::ContactLaw& law, const std::string& which,
-             const World& world, double overlap) {
+             const World& world) {
   const auto& p = world.particles;
   const bool hertz = std::holds_alternative<contact::normal::Hertz>(law.normal);
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double r = p.radius[i];
     const double m = contact_mass(p, i);
-    double t_max, t_reached;
+    double t_max, t_fresh;
     if (hertz) {
       // The Rayleigh time pi r sqrt(rho / G) / (0.163 nu + 0.8766) is a bound in sqrt(m / r)
       // (rho = m / (4/3 pi r^3)); with m the mass the contact moves, it keeps for a member sphere
-      // (whose radius sets the Hertz stiffness) the margin it has for a lone sphere.
+      // (whose radius sets the Hertz stiffness) the margin it has for a lone sphere. It does not
+      // depend on the overlap, so it bounds an impact at any speed.
       const auto& model = std::get<contact::normal::Hertz>(law.normal);
       const double density = m / (4.0 / 3.0 * M_PI * r * r * r);
-      t_max = t_reached =
+      t_max = t_fresh =
           integrate::rayleigh_time(r, density, model.youngs_modulus, model.poisson_ratio);
     } else {
       // r_eff = 2 r covers equal spheres and sphere-wall contacts alike (and gives the larger
       // stiffness of the two: k1 grows with r_eff, k2*(delta) - k1 does not depend on it).
       t_max = integrate::spring_time(m, law.max_stiffness(2.0 * r));
-      t_reached = overlap < 0.0
-                      ? t_max
-                      : integrate::spring_time(m, law.reached_stiffness(2.0 * r, overlap));
+      t_fresh = integrate::spring_time(m, law.reached_stiffness(2.0 * r, 0.0));
     }
     lower(bounds.law_max, t_max, hertz, which);
-    lower(bounds.reached, t_reached, hertz, which);
+    lower(bounds.fresh, t_fresh, hertz, which);
   }
-}
-
-/// The deepest overlap the contacts of a history array have reached: the largest history[0] of
-/// its slots of `slot_stride` doubles (the Luding model keeps delta_max there).
-double deepest_overlap(const std::vector<double>& history, int slot_stride) {
-  double deepest = 0.0;
-  if (slot_stride <= 0) return deepest;
-  for (std::size_t k = 0; k < history.size(); k += static_cast<std::size_t>(slot_stride))
-    deepest = std::max(deepest, history[k]);
-  return deepest;
-}
-
-/// The overlap a law's reached bound is taken at: -1 (its largest stiffness) for a law whose
-/// stiffness does not follow the overlap; else kOverlapHeadroom times the deepest overlap reached
-/// (0 without history yet), so a contact may press that much deeper before the next re-tuning.
-constexpr double kOverlapHeadroom = 2.0;
-double bound_overlap(const contact::ContactLaw& law, const std::vector<double>* history,
-                     int slot_stride) {
-  if (!law.keeps_reached_overlap()) return -1.0;
-  return history ? kOverlapHeadroom * deepest_overlap(*history, slot_stride) : 0.0;
 }
 
 Bounds bounds_over_laws(const World& world) {
   Bounds bounds;
   for (int a = 0; a < world.materials(); ++a)
-    for (int b = a; b < world.materials(); ++b) {
-      const auto& law = world.pair_law(a, b);
-      tighten(bounds, law, "particle-particle law " + std::to_string(a) + "-" + std::to_string(b),
-              world, bound_overlap(law, &world.pair_history, world.pair_stride()));
-    }
-  for (std::size_t w = 0; w < world.walls.size(); ++w) {
-    const auto& wall = world.walls[w];
-    const bool has_history = w < world.wall_history.size();
-    for (int a = 0; a < world.materials(); ++a) {
-      const auto& law = world.wall_law(wall.material, a);
-      tighten(
-          bounds, law, "wall '" + wall.name + "' law", world,
-          bound_overlap(law, has_history ? &world.wall_history[w] : nullptr,
-                        has_history ? world.wall_stride(w) / walls::contact_slots(wall.shape) : 0));
-    }
-  }
+    for (int b = a; b < world.materials(); ++b)
+      tighten(bounds, world.pair_law(a, b),
+              "particle-particle law " + std::to_string(a) + "-" + std::to_string(b), world);
+  for (const auto& wall : world.walls)
+    for (int a = 0; a < world.materials(); ++a)
+      tighten(bounds, world.wall_law(wall.material, a), "wall '" + wall.name + "' law", world);
   return bounds;
+}
+
+/// kStableFraction x sqrt(m*/k) of the stiffest contact of the last force evaluation
+/// (infinite without contacts).
+double in_use_time_step(const World& world) {
+  return world.contact_rate2 > 0.0 ? kStableFraction / std::sqrt(world.contact_rate2)
+                                   : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace
@@ -141,8 +118,8 @@ TimeStepLimit critical_time_step(const World& world) {
   return bounds_over_laws(world).law_max;
 }
 
-TimeStepLimit reached_time_step(const World& world) {
-  return bounds_over_laws(world).reached;
+TimeStepLimit fresh_contact_time_step(const World& world) {
+  return bounds_over_laws(world).fresh;
 }
 
 double recommended_time_step(const World& world, double safety) {
@@ -150,13 +127,20 @@ double recommended_time_step(const World& world, double safety) {
 }
 
 double adapted_time_step(const World& world, double safety) {
-  const Bounds bounds = bounds_over_laws(world);
-  return std::min(safety * bounds.reached.critical, kStableFraction * bounds.law_max.critical);
+  return std::min(safety * fresh_contact_time_step(world).critical, in_use_time_step(world));
+}
+
+double next_time_step(const World& world, bool retune) {
+  const double in_use = in_use_time_step(world);
+  if (!retune) return std::min(world.dt, in_use);
+  return std::min({world.dt * World::kStepGrowth, in_use,
+                   world.adaptive_safety * fresh_contact_time_step(world).critical});
 }
 
 void check_time_step(const World& world) {
   if (!(world.dt > 0.0))
     throw SimulationFailure(SimulationFailure::Reason::kUnstableTimeStep, "time step must be > 0");
+  if (world.adaptive_safety > 0.0) return;  // the step follows the contacts (next_time_step)
   const TimeStepLimit limit = critical_time_step(world);
   if (world.dt > limit.critical) {
     char msg[256];

@@ -15,28 +15,42 @@ struct TimeStepLimit {
 /// for Hertz laws, sqrt(m_min / k_max) for linear and Luding laws.
 TimeStepLimit critical_time_step(const World& world);
 
-/// The same bound with the stiffness the contacts have reached: a Luding contact's un-/reloading
-/// stiffness k2* grows with its largest overlap from k1 to k2 (seed 000 eq. 5), and a bed under
-/// its own weight stays near k1. Each law is bounded at twice the deepest overlap its contacts
-/// reached (a contact may press that much deeper before the next re-tuning). Laws whose stiffness
-/// does not follow the overlap give critical_time_step()'s bound. As Yade's
-/// GlobalStiffnessTimeStepper, which bounds the step by the stiffness of the current contacts.
-TimeStepLimit reached_time_step(const World& world);
+/// The bound at the stiffness a contact has when it forms: the loading stiffness k1 of a Luding
+/// law (or its adhesive kc where steeper), kn of a linear law, the Rayleigh time of a Hertz law
+/// (which bounds an impact at any speed). A contact may form at any step, so an adapted step
+/// never exceeds safety times this bound.
+TimeStepLimit fresh_contact_time_step(const World& world);
 
 /// dt = safety * critical; seed 001 used 0.6 sqrt(m/k), 0.1-0.3 of the Rayleigh time is common.
 double recommended_time_step(const World& world, double safety);
 
-/// A step so that even a contact at the law's largest stiffness stays stable:
-/// omega dt = kStableFraction, below the velocity-Verlet limit 2 (sqrt(1 + z^2) - z) of a
-/// spring-dashpot at any damping ratio z <= 1 (0.83 at z = 1).
+/// The mass a contact on particle i moves: its own for a lone sphere; for a clump member the
+/// body's effective mass at the member in its worst normal direction.
+double contact_mass(const particles::ParticleStore& p, std::size_t i);
+
+/// A step so that a contact of stiffness k stays stable: omega dt = kStableFraction, below the
+/// velocity-Verlet limit 2 (sqrt(1 + z^2) - z) of a spring-dashpot at any damping ratio z <= 1
+/// (0.83 at z = 1).
 constexpr double kStableFraction = 0.7;
 
-/// dt = safety * reached_time_step(), at most kStableFraction * critical_time_step(): accurate for
-/// the stiffness the contacts have, stable for the stiffness they could reach before the next
-/// re-tuning.
+/// A step for the stiffness in use, as Yade's GlobalStiffnessTimeStepper bounds the step by the
+/// stiffness of the current contacts: accurate for a contact as it forms, safety x
+/// fresh_contact_time_step(), and stable for the stiffest contact of the last force evaluation,
+/// kStableFraction x sqrt(m*/k) (World::contact_rate2). A Luding contact's un-/reloading
+/// stiffness k2* grows with its largest overlap from k1 to k2 (seed 000 eq. 5), so a bed under a
+/// light load needs far less than the law's largest stiffness, and a stiff wall far away does
+/// not count until a particle touches it.
 double adapted_time_step(const World& world, double safety);
 
-/// Throws SimulationFailure(kUnstableTimeStep) naming both numbers when dt exceeds the limit.
+/// The step after a force evaluation of an adaptive world (World::adaptive_safety > 0), with
+/// the safeguards of Yade's GlobalStiffnessTimeStepper: it shrinks at once to kStableFraction x
+/// sqrt(m*/k) of the stiffest contact when a contact has stiffened; on a re-tuning step
+/// (`retune`, every World::kRetuneSteps) it may grow, by World::kStepGrowth at most, up to that
+/// bound and to adaptive_safety x fresh_contact_time_step().
+double next_time_step(const World& world, bool retune);
+
+/// Throws SimulationFailure(kUnstableTimeStep) naming both numbers when a fixed dt exceeds the
+/// limit (an adaptive world's step follows its contacts instead), or when dt is not > 0.
 void check_time_step(const World& world);
 
 }  // namespace demcal::sim

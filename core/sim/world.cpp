@@ -63,6 +63,20 @@ void World::change_pair_law(int a, int b, const contact::ContactLaw& law) {
   rebuild_list();
 }
 
+void World::change_wall_law(int wall_material, int particle_material,
+                            const contact::ContactLaw& law) {
+  if (!prepared_ || wall_material >= static_cast<int>(wall_laws_.size()) ||
+      particle_material >= n_materials_ || !wall_set_[wall_material][particle_material] ||
+      composition(law) != composition(wall_law(wall_material, particle_material))) {
+    set_wall_law(wall_material, particle_material, law);
+    return;
+  }
+  wall_laws_[wall_material][particle_material] = law;
+  check_time_step(*this);
+  // The new law's reach beyond contact may differ: list the walls' particles again.
+  for (auto& reach : wall_reach) reach.valid = false;
+}
+
 void World::rebuild_list() {
   for (auto& x : particles.x) domain.wrap(x);
   list.build(particles.x, particles.radius, domain, interaction_range() + skin_, active_threads(),
@@ -198,6 +212,10 @@ void World::prepare() {
              pair_history, pair_stride_, clump_bodies());
   balance_owners();
   clump_frames.reset(particles);
+  clump_inverse_mass_.clear();
+  if (particles.clumps.size())
+    for (std::size_t i = 0; i < particles.size(); ++i)
+      clump_inverse_mass_.push_back(1.0 / contact_mass(particles, i));
   wall_history.assign(walls.size(), {});
   for (std::size_t w = 0; w < walls.size(); ++w)
     wall_history[w].assign(particles.size() * wall_strides_[w], 0.0);

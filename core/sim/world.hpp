@@ -25,10 +25,24 @@ class World {
   Domain domain;
   Vec3 gravity{0.0, 0.0, -9.81};
   double dt = 0.0;  ///< time step (s)
-  /// > 0: step() re-tunes dt to sim::adapted_time_step(*this, adaptive_safety) every
-  /// kRetuneSteps steps, following the stiffness the contacts have reached; 0: dt stays as set.
+  /// > 0: the step follows the stiffness of the contacts in use (sim::next_time_step): after
+  /// every force evaluation dt shrinks at once to sim::kStableFraction x sqrt(m*/k) of the
+  /// stiffest contact, every kRetuneSteps steps it may grow by kStepGrowth, never beyond
+  /// adaptive_safety x the bound of a fresh contact (sim::fresh_contact_time_step); 0: dt stays
+  /// as set.
   double adaptive_safety = 0.0;
   static constexpr int kRetuneSteps = 100;
+  static constexpr double kStepGrowth = 1.1;
+  /// The largest k / m* over the contacts of the last force evaluation (1/s^2; 0 without any):
+  /// k the normal slope the contact can follow (contact::NormalResult::k_step), m* the mass it
+  /// moves (the reduced mass of a pair, the particle's at a wall; for clump members, with the
+  /// bodies' effective masses, sim::contact_mass).
+  double contact_rate2 = 0.0;
+  /// 1 / sim::contact_mass of each particle when there are clumps (set by prepare()), else null:
+  /// the force kernel then takes 1 / m* of the pair.
+  const double* contact_inverse_mass() const {
+    return clump_inverse_mass_.empty() ? nullptr : clump_inverse_mass_.data();
+  }
   double skin = 0.0;  ///< Verlet skin (m); 0 = 10 % of the smallest particle radius
   int threads = 1;    ///< OpenMP threads at most; see active_threads()
   /// The fewest particles a thread is given: a smaller system runs on fewer threads than asked.
@@ -79,6 +93,9 @@ class World {
   /// from the next force evaluation (the next first half kick uses the forces of the last step,
   /// as after any step). Another composition needs fresh history: as set_pair_law.
   void change_pair_law(int material_i, int material_j, const contact::ContactLaw& law);
+  /// Replaces a particle-wall law during a run, as change_pair_law: a law of the same
+  /// composition keeps the wall contacts' history and acts from the next force evaluation.
+  void change_wall_law(int wall_material, int particle_material, const contact::ContactLaw& law);
   const contact::ContactLaw& pair_law(int material_i, int material_j) const;
   const contact::ContactLaw& wall_law(int wall_material, int particle_material) const;
   int materials() const { return n_materials_; }
@@ -159,6 +176,7 @@ class World {
   int n_materials_ = 0;
   int pair_stride_ = 0;
   std::vector<int> wall_strides_;
+  std::vector<double> clump_inverse_mass_;
   std::vector<int> owner_bounds_{0, 0};  ///< thread t owns [owner_bounds_[t], owner_bounds_[t + 1])
   double skin_ = 0.0;
   bool prepared_ = false;

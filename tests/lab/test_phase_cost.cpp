@@ -73,14 +73,17 @@ TEST(PhaseCost, EveryPhaseOfAConfinedCompressionIsRecorded) {
   EXPECT_EQ(names, (std::vector<std::string>{"fill", "settle", "load 1", "unload 1", "load 2",
                                              "final unload"}));
   EXPECT_EQ(c.steps, steps);
-  // The step follows the stiffness the contacts reached: between the safety (0.2, the default)
-  // and the stability cap (0.7) times the bound at the laws' largest stiffness, at every step.
+  // The step follows the stiffness of the contacts in use: never below the safety (0.2, the
+  // default) times the bound at the laws' largest stiffness k2 = 5 k1, never above it times
+  // the bound of a fresh contact (k1: sqrt(5) times longer).
+  EXPECT_NE(c.time_step_limit.find("stiffest contact in use"), std::string::npos)
+      << c.time_step_limit;
   ASSERT_GT(c.critical_time_step, 0.0);
   const double crit_steps = static_cast<double>(steps) * c.critical_time_step;
   EXPECT_GE(c.simulated_time, (1.0 - 1e-9) * 0.2 * crit_steps);
-  EXPECT_LE(c.simulated_time, (1.0 + 1e-9) * sim::kStableFraction * crit_steps);
+  EXPECT_LE(c.simulated_time, (1.0 + 1e-9) * 0.2 * std::sqrt(5.0) * crit_steps);
   EXPECT_GE(c.time_step, (1.0 - 1e-9) * 0.2 * c.critical_time_step);
-  EXPECT_LE(c.time_step, (1.0 + 1e-9) * sim::kStableFraction * c.critical_time_step);
+  EXPECT_LE(c.time_step, (1.0 + 1e-9) * 0.2 * std::sqrt(5.0) * c.critical_time_step);
   EXPECT_GT(c.wall_seconds, 0.0);
   EXPECT_GT(c.particle_steps_per_second(), 0.0);
   EXPECT_TRUE(out.flags.empty());

@@ -1,8 +1,14 @@
 // tensile (seed 000 §2.7.3): about zero without cohesion; rises with the Hamaker constant and
-// with kc/k1.
+// with kc/k1; starts from the bed a confined compression of the same settings conditioned, taken
+// from the stage cache to the bit.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
 #include "core/lab/lab_test.hpp"
+#include "core/lab/stage_cache.hpp"
 #include "core/model/tensile_settings.hpp"
 #include "lab_test_util.hpp"
 
@@ -11,7 +17,12 @@ namespace {
 
 Settings small() {
   return {{"particles", 100},    {"wall_stiffness_factor", 1},   {"wall_hamaker_factor", 10},
-          {"wall_k2_factor", 1}, {"consolidation_stress", 5000}, {"pull_distance", 1}};
+          {"wall_k2_factor", 1}, {"consolidation_stress", 5000}, {"pull_distance", 1},
+          {"cycles", 1}};
+}
+/// The confined compression whose bed small() starts from.
+Settings conditioning() {
+  return {{"particles", 100}, {"wall_stiffness_factor", 1}, {"max_stress", 5000}, {"cycles", 1}};
 }
 double strength(const MaterialModel& m) {
   return run_lab_test("tensile", m, small(), {}).metrics.at("tensile_strength");
@@ -33,6 +44,64 @@ TEST(Tensile, RisesWithCohesionStiffness) {
   const double a = strength(testing::soft_luding(1e7, 5.0, 0.0, 1e-18));
   const double b = strength(testing::soft_luding(1e7, 5.0, 1.0, 1e-18));
   EXPECT_GT(b, 1.5 * a);
+}
+
+/// A fresh stage cache in a directory of its own.
+std::shared_ptr<const StageCache> fresh_cache(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("demcal_stage_cache_" + name);
+  std::filesystem::remove_all(dir);
+  return std::make_shared<const StageCache>(dir);
+}
+
+std::int64_t steps_of(const LabOutput& out) {
+  std::int64_t steps = 0;
+  for (const auto& p : out.cost.phases) steps += p.steps;
+  return steps;
+}
+
+TEST(Tensile, StartsFromTheBedAConfinedCompressionConditionedToTheBit) {
+  const auto m = testing::soft_luding(1e7, 5.0, 0.5, 1e-18);
+  const LabOutput alone = run_lab_test("tensile", m, small(), {});
+  RunOptions cached;
+  cached.stage_cache = fresh_cache("tensile");
+  const LabOutput compression = run_lab_test("confined_compression", m, conditioning(), cached);
+  ASSERT_TRUE(compression.flags.empty());
+  const LabOutput reused = run_lab_test("tensile", m, small(), cached);
+  // The same bits as the run that conditioned its own bed, for a fraction of its steps.
+  EXPECT_EQ(reused.metrics.at("tensile_strength"), alone.metrics.at("tensile_strength"));
+  EXPECT_EQ(reused.series.at("tensile").rows, alone.series.at("tensile").rows);
+  EXPECT_LT(steps_of(reused), steps_of(alone) / 2);
+  ASSERT_FALSE(reused.notes.empty());
+  EXPECT_NE(reused.notes.back().find("stage cache"), std::string::npos);
+  std::vector<std::string> phases;
+  for (const auto& p : reused.cost.phases) phases.push_back(p.name);
+  EXPECT_EQ(phases, (std::vector<std::string>{"unload", "pull"}));
+  // Another seed is another bed: conditioned afresh, the same as without the cache.
+  RunOptions other = cached;
+  other.seed = 2;
+  RunOptions other_alone;
+  other_alone.seed = 2;
+  EXPECT_EQ(run_lab_test("tensile", m, small(), other).metrics.at("tensile_strength"),
+            run_lab_test("tensile", m, small(), other_alone).metrics.at("tensile_strength"));
+}
+
+TEST(StageCache, KeepsARecordUnderItsWholeIdentity) {
+  const auto cache = fresh_cache("records");
+  EXPECT_FALSE(cache->find("a").has_value());
+  cache->keep("a", std::string("record\0a", 8));
+  cache->keep("b", "record b");
+  EXPECT_EQ(*cache->find("a"), std::string("record\0a", 8));
+  EXPECT_EQ(*cache->find("b"), "record b");
+  cache->keep("a", "again");
+  EXPECT_EQ(*cache->find("a"), "again");
+  // A damaged file counts as absent.
+  for (const auto& entry : std::filesystem::directory_iterator(cache->directory()))
+    std::ofstream(entry.path(), std::ios::trunc) << "xy";
+  EXPECT_FALSE(cache->find("a").has_value());
+  EXPECT_FALSE(cache->find("b").has_value());
+  // No half-written files are left behind.
+  for (const auto& entry : std::filesystem::directory_iterator(cache->directory()))
+    EXPECT_EQ(entry.path().extension(), ".stage");
 }
 
 TEST(Tensile, WallAdhesionFactorsOfEq34And35) {

@@ -56,6 +56,7 @@ struct Hertz {
     r.gamma_n = damping_factor * std::sqrt(root * in.m_star);
     r.fn = (4.0 / 3.0) * y_star * root * in.delta + r.gamma_n * in.vn;
     if (clip_attraction != 0.0 && r.fn < 0.0) r.fn = 0.0;
+    r.k_step = 2.0 * y_star * root;  // d/d(delta) of 4/3 Y* sqrt(R*) delta^(3/2)
     return r;
   }
 };

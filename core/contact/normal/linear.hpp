@@ -43,6 +43,7 @@ struct Linear {
     const bool damp = damp_approach_only == 0.0 || in.vn > 0.0;
     r.fn = kn * in.delta + (damp ? r.gamma_n * in.vn : 0.0);
     if (clip_attraction != 0.0 && r.fn < 0.0) r.fn = 0.0;
+    r.k_step = kn;
     return r;
   }
 };

@@ -125,6 +125,7 @@ struct Luding {
     r.gamma_n = damping(in.m_star, kl);
     r.fn = f_hys + r.gamma_n * in.vn;
     r.f_adhesive = kc * delta;
+    r.k_step = reached_stiffness(r_eff, delta_max);
     return r;
   }
 
