@@ -42,6 +42,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-backoff", o.max_backoff, "longest reconnection back-off (s)")
       ->capture_default_str();
+  app.add_option("--stage-cache", o.stage_cache_dir,
+                 "directory where jobs keep the stages other jobs start from (e.g. the bed a "
+                 "confined compression conditioned, for a tensile job); none by default");
   CLI11_PARSE(app, argc, argv);
   if (!token_file.empty()) try {
       o.channel.token = demcal::rpc::read_token_file(token_file);

@@ -16,6 +16,7 @@
 #include "core/common/error.hpp"
 #include "core/lab/lab_test.hpp"
 #include "core/lab/run_cancelled.hpp"
+#include "core/lab/stage_cache.hpp"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "rpc/material_convert.hpp"
 
@@ -140,10 +141,11 @@ lab::LabOutput run_lab(const v1::JobSpec& job, lab::RunOptions options) {
 
 Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progress,
                 const JobStop& stop, const CheckpointSender& send_checkpoint,
-                double checkpoint_seconds) {
+                double checkpoint_seconds, const std::shared_ptr<const lab::StageCache>& cache) {
   Outcome o;
   try {
     lab::RunOptions ro;
+    ro.stage_cache = cache;
     ro.threads = job_threads(job, threads);
     ro.seed = rpc::job_seed(job);
     ro.progress = [&progress, &stop](double f) {
@@ -250,7 +252,10 @@ class Worker {
         flags_(flags),
         id_(worker_id(opt)),
         stub_(v1::WorkerService::NewStub(rpc::make_channel(opt.channel))),
-        jitter_(std::hash<std::string>{}(id_)) {}
+        jitter_(std::hash<std::string>{}(id_)),
+        stage_cache_(opt.stage_cache_dir.empty()
+                         ? nullptr
+                         : std::make_shared<const lab::StageCache>(opt.stage_cache_dir)) {}
 
   WorkerStats run() {
     spdlog::info("worker {} -> {} ({} threads)", id_, opt_.channel.address, opt_.threads);
@@ -326,7 +331,7 @@ class Worker {
               [this, &job](const std::string& stage, std::string state) {
                 send_checkpoint(job, stage, std::move(state));
               },
-              opt_.checkpoint_seconds);
+              opt_.checkpoint_seconds, stage_cache_);
         });
     auto future = task->get_future();
     std::thread sim([task] { (*task)(); });
@@ -461,6 +466,7 @@ class Worker {
   const std::string id_;
   std::unique_ptr<v1::WorkerService::Stub> stub_;
   std::mt19937_64 jitter_;
+  std::shared_ptr<const lab::StageCache> stage_cache_;
   double backoff_ = kFirstBackoff;
   Clock::time_point idle_since_ = Clock::now();
   WorkerStats stats_;

@@ -25,6 +25,10 @@ struct WorkerOptions {
   /// A checkpoint a job offers is sent once this long has passed since the job's start or its
   /// last one sent (0: every one offered); a re-leased job goes on from the latest.
   double checkpoint_seconds = 300;
+  /// Where jobs keep the stages other jobs start from (core/lab/stage_cache.hpp: the bed a
+  /// confined compression conditioned, for the tensile job of the same material and seed);
+  /// empty: every job computes its own.
+  std::string stage_cache_dir;
 };
 
 /// Stop requests: `stop` = finish the current job and lease no more; `abort` = give the

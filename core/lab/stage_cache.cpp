@@ -73,8 +73,10 @@ void StageCache::keep(const std::string& identity, const std::string& record) co
   const auto target = file_for(identity);
   // A name of this process and call: two runs keeping one record at once never share a file.
   static std::atomic<unsigned> calls{0};
+  char suffix[64];
+  std::snprintf(suffix, sizeof suffix, ".%ld.%u.tmp", static_cast<long>(::getpid()), calls++);
   auto temporary = target;
-  temporary += "." + std::to_string(::getpid()) + "." + std::to_string(calls++) + ".tmp";
+  temporary += suffix;
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
