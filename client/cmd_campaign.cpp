@@ -78,6 +78,8 @@ void add_campaign_commands(CLI::App& app) {
       if (j.has_cost() && j.cost().wall_seconds() > 0.0)
         std::cout << "  [" << j.cost().steps() << " steps, " << j.cost().wall_seconds() << " s]";
       if (!j.error().empty()) std::cout << "  (" << j.error() << ")";
+      if (j.reused_from() != 0) std::cout << "  reused from job " << j.reused_from();
+      if (!j.reused_journal().empty()) std::cout << "  reused from " << j.reused_journal();
       std::cout << "\n";
       for (const auto& [k, why] : j.flags()) std::cout << "    ! " << k << ": " << why << "\n";
     }

@@ -1,6 +1,7 @@
 // `demcal effects ID [--format table|csv|json]`, `demcal calibrate ID [--verify [--wait]]`,
-// `demcal export ID [--format csv|json|liggghts] [-o FILE]`: analysis on the coordinator, on
-// demand. The liggghts format writes the calibrated material as a LIGGGHTS input fragment.
+// `demcal export ID|SPEC [--format csv|json|journal|liggghts] [-o FILE]`: analysis on the
+// coordinator, on demand. The journal format writes the finished jobs as a campaign journal
+// (docs/journal.md), the liggghts format the calibrated material as a LIGGGHTS input fragment.
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -8,6 +9,8 @@
 #include <thread>
 
 #include "client/commands.hpp"
+#include "client/embedded.hpp"
+#include "client/jsonl_file.hpp"
 #include "client/liggghts_fragment.hpp"
 #include "client/service_client.hpp"
 #include "rpc/material_convert.hpp"
@@ -39,6 +42,39 @@ std::string liggghts_export(v1::CampaignService::Stub& stub, const rpc::ChannelO
   return f.text;
 }
 
+struct ExportOptions {
+  rpc::ChannelOptions channel;
+  std::string campaign;  ///< a campaign id, or a spec on the embedded default
+  std::string format = "json";
+  std::string out;
+  bool series = false;  ///< json: each finished job's curves too
+  std::string workdir;  ///< of a spec: its work directory
+  LocalWorkers local;
+  bool verbose = false;
+};
+
+/// Writes the export of campaign `id` to the output file or standard output. Nothing is written
+/// unless the whole document arrived; a journal to a file is written as JSON lines (gzip when
+/// its name ends in .gz), as a kept journal is.
+void write_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                  std::int64_t id, const ExportOptions& o) {
+  std::string content;
+  if (o.format == "liggghts")
+    content = liggghts_export(stub, channel, id);
+  else
+    check(read_export(stub, channel, id, o.format, content, o.series), "export");
+  if (o.out.empty()) {
+    std::cout << content;
+    return;
+  }
+  if (o.format == "journal") {
+    JsonLinesFile(o.out).write(split_lines(content));
+  } else {
+    std::ofstream(o.out) << content;
+  }
+  std::cerr << "wrote " << o.out << "\n";
+}
+
 }  // namespace
 
 void add_analysis_commands(CLI::App& app) {
@@ -50,8 +86,6 @@ void add_analysis_commands(CLI::App& app) {
     std::string calibrate_model;  ///< empty: the spec's calibration.model
     double alpha = 0.05;
     bool verify = false, wait = false;
-    bool series = false;  ///< export: each finished job's curves too (json)
-    std::string out;
   };
   auto o = std::make_shared<Options>();
 
@@ -103,34 +137,28 @@ void add_analysis_commands(CLI::App& app) {
     print_calibration(std::cout, reply, o->format);
   });
 
+  auto e = std::make_shared<ExportOptions>();
   auto* exp = app.add_subcommand(
       "export",
-      "The campaign's design and results (csv or json), or its calibrated material as "
-      "a LIGGGHTS input fragment (liggghts)");
-  add_connection_options(*exp, o->channel);
-  exp->add_option("id", o->id, "campaign id")->required();
-  exp->add_option("--format", o->format, "csv, json or liggghts")
-      ->check(CLI::IsMember({"csv", "json", "liggghts"}));
-  exp->add_option("-o,--output", o->out, "file (default: standard output)");
-  exp->add_flag("--series", o->series,
+      "The campaign's design and results (csv or json), its finished jobs as a campaign journal "
+      "(journal), or its calibrated material as a LIGGGHTS input fragment (liggghts)");
+  add_connection_options(*exp, e->channel);
+  exp->add_option("campaign", e->campaign, "campaign id, or a spec YAML (embedded default)")
+      ->required();
+  exp->add_option("--format", e->format, "csv, json, journal or liggghts")
+      ->check(CLI::IsMember({"csv", "json", "journal", "liggghts"}));
+  exp->add_option("-o,--output", e->out,
+                  "file (default: standard output); a journal to FILE.gz is written as gzip");
+  exp->add_flag("--series", e->series,
                 "json: each finished job's curves (stress-strain, yield points, drum surface, "
                 "mass-time; docs/lab-tests.md) under jobs[].series");
-  exp->callback([o] {
-    std::string content;
-    if (o->format == "liggghts") {
-      content = liggghts_export(*campaign_stub(o->channel), o->channel, o->id);
-    } else {
-      // Nothing is written unless the whole document arrived.
-      check(read_export(*campaign_stub(o->channel), o->channel, o->id,
-                        o->format == "table" ? "json" : o->format, content, o->series),
-            "export");
-    }
-    if (o->out.empty()) {
-      std::cout << content;
-    } else {
-      std::ofstream(o->out) << content;
-      std::cerr << "wrote " << o->out << "\n";
-    }
+  exp->add_option("--workdir", e->workdir, "embedded: directory of the SQLite file");
+  add_local_worker_options(*exp, e->local);
+  exp->add_flag("-v,--verbose", e->verbose, "embedded: coordinator and worker logs");
+  exp->callback([e] {
+    with_campaign(e->campaign, e->workdir, e->local, e->verbose, e->channel,
+                  [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                      std::int64_t id) { write_export(stub, channel, id, *e); });
   });
 }
 

@@ -1,11 +1,13 @@
-// `demcal run SPEC [--workdir DIR] [--workers N] [--threads N] [--no-verify]`: the embedded default
-// (client/embedded.hpp). The campaign runs to the end over real gRPC; the effect tables and the
-// sequential calibration (verified by simulation round by round, docs/doe.md) are printed.
-// Running it again with the same work directory resumes the campaign of the same name instead
-// of starting over.
+// `demcal run SPEC [--workdir DIR] [--workers N] [--threads N] [--no-verify] [--journal FILE]`: the
+// embedded default (client/embedded.hpp). The campaign runs to the end over real gRPC; the effect
+// tables and the sequential calibration (verified by simulation round by round, docs/doe.md) are
+// printed. Running it again with the same work directory resumes the campaign of the same name
+// instead of starting over; with a journal (docs/journal.md) it goes on in any work directory
+// from the runs the journal holds.
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "client/commands.hpp"
 #include "client/embedded.hpp"
@@ -20,7 +22,8 @@ struct RunOptions {
   bool verify = true;
   bool verbose = false;
   std::string format = "table";
-  std::string http;  ///< HOST:PORT of the live report page; empty: none
+  std::string http;     ///< HOST:PORT of the live report page; empty: none
+  std::string journal;  ///< the campaign journal taken from and kept; empty: none
 };
 
 /// With `--format json` the one JSON document is all that goes to standard output: the
@@ -29,12 +32,17 @@ void run_embedded(const RunOptions& opt) {
   const bool json = opt.format == "json";
   std::ostream& text = json ? std::cerr : std::cout;
   const SpecFile file = read_campaign_spec(opt.spec);
+  // Read before anything starts: a journal with a bad line refuses the run.
+  std::optional<CampaignJournal> journal;
+  if (!opt.journal.empty()) journal.emplace(opt.journal);
   const auto workdir = work_directory(opt.spec, opt.workdir);
   EmbeddedService service(workdir, opt.local, opt.verbose);
   auto* stub = &service.stub();
   const auto& channel = service.channel();
   text << "work directory: " << workdir.string() << " (SQLite: " << service.db() << ")\n";
+  if (journal) import_journal(*stub, channel, *journal, text);
   const std::int64_t id = service.submit_or_resume(file, text);
+  if (journal) service.keep_journal(*journal, id);
   if (!opt.http.empty())
     std::cerr << "live report page: " << service.serve_http(opt.http, id) << std::endl;
   text << std::flush;
@@ -84,6 +92,9 @@ void add_run_command(CLI::App& app) {
   add_local_worker_options(*cmd, o->local);
   cmd->add_flag("!--no-verify", o->verify, "do not simulate the proposed set");
   cmd->add_flag("-v,--verbose", o->verbose, "coordinator and worker logs");
+  cmd->add_option("--journal", o->journal,
+                  "campaign journal (JSON lines, .gz read and written as gzip): its runs are taken "
+                  "instead of simulated, each job finished is appended (docs/journal.md)");
   cmd->add_option("--http", o->http,
                   "HOST:PORT: serve the live report page while the campaign runs (docs/report.md)");
   cmd->add_option("--format", o->format,

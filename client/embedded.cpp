@@ -144,6 +144,11 @@ void EmbeddedService::stop_on_signal(int sig) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (running_ > 0 && std::chrono::steady_clock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  if (keeper_) keeper_->sync();
+}
+
+void EmbeddedService::keep_journal(CampaignJournal& journal, std::int64_t id) {
+  keeper_ = std::make_unique<JournalKeeper>(journal, *stub_, channel_, id);
 }
 
 EmbeddedService::~EmbeddedService() {
@@ -151,6 +156,7 @@ EmbeddedService::~EmbeddedService() {
   if (http_) http_->stop();
   flags_.stop = true;
   for (auto& w : workers_) w.join();
+  keeper_.reset();  // its last update, with every job the workers finished
   coordinator_->shutdown();
 }
 

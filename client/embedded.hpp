@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "client/campaign_journal.hpp"
 #include "client/service_client.hpp"
 #include "client/spec_yaml.hpp"
 #include "server/coordinator.hpp"
@@ -50,9 +51,14 @@ class EmbeddedService {
   /// its fragment (never sent to the server by a browser).
   std::string serve_http(const std::string& address, std::int64_t id);
 
+  /// Keeps `journal` up to date with campaign `id`'s finished jobs while this service lives
+  /// (JournalKeeper), with a last update once its workers have stopped, also on a stop signal.
+  void keep_journal(CampaignJournal& journal, std::int64_t id);
+
   /// SIGINT or SIGTERM `sig` (Ctrl-C, the end of a batch allocation): the workers give their
-  /// leases back at once, uncounted, and return; the caller then ends the process. The next
-  /// run of the same command goes on from the jobs' latest checkpoints.
+  /// leases back at once, uncounted, and return; the journal kept, if any, is brought up to
+  /// date; the caller then ends the process. The next run of the same command goes on from the
+  /// jobs' latest checkpoints.
   void stop_on_signal(int sig);
 
  private:
@@ -64,6 +70,7 @@ class EmbeddedService {
   std::vector<std::thread> workers_;
   std::atomic<int> running_{0};  ///< workers that have not returned
   std::unique_ptr<v1::CampaignService::Stub> stub_;
+  std::unique_ptr<JournalKeeper> keeper_;
 };
 
 /// demcal-work/<spec stem> unless a directory is given.

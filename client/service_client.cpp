@@ -79,11 +79,13 @@ std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const rpc::ChannelOptio
 
 grpc::Status read_export(v1::CampaignService::StubInterface& stub,
                          const rpc::ChannelOptions& options, std::int64_t id,
-                         const std::string& format, std::string& content, bool series) {
+                         const std::string& format, std::string& content, bool series,
+                         const std::vector<std::int64_t>& jobs) {
   v1::ExportRequest req;
   req.set_id(id);
   req.set_format(format);
   req.set_series(series);
+  for (const auto job : jobs) req.add_jobs(job);
   const auto context = rpc::make_context(options, 600);
   auto reader = stub.Export(context.get(), req);
   content.clear();
@@ -167,6 +169,7 @@ std::string progress_line(const v1::Progress& p, int width) {
   s << "[" << std::string(std::size_t(filled), '#') << std::string(std::size_t(width - filled), '.')
     << "] " << p.done() + p.failed() << "/" << p.total() - p.cancelled() << " done";
   if (p.failed()) s << " (" << p.failed() << " failed)";
+  if (p.reused()) s << " (" << p.reused() << " reused)";
   s << ", " << p.leased() << " running, elapsed " << duration(p.elapsed_seconds()) << ", ETA "
     << duration(p.eta_seconds());
   return s.str();

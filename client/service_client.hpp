@@ -6,6 +6,7 @@
 #include <memory>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "rpc/channel.hpp"
@@ -21,12 +22,14 @@ std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const rpc::ChannelOptio
 /// std::runtime_error "<what>: <CODE>: <message>" otherwise.
 void check(const grpc::Status& status, const std::string& what);
 
-/// The campaign's Export document in `format` (json or csv; with `series` the jobs' curves too),
-/// read whole from its stream (it may exceed one gRPC message). Returns the stream's status;
-/// `content` is complete only when it is OK.
+/// The campaign's Export document in `format` (json, csv or journal; with `series` the jobs'
+/// curves too; a journal of the jobs in `jobs` only when it is not empty), read whole from its
+/// stream (it may exceed one gRPC message). Returns the stream's status; `content` is complete
+/// only when it is OK.
 grpc::Status read_export(v1::CampaignService::StubInterface& stub,
                          const rpc::ChannelOptions& options, std::int64_t id,
-                         const std::string& format, std::string& content, bool series = false);
+                         const std::string& format, std::string& content, bool series = false,
+                         const std::vector<std::int64_t>& jobs = {});
 
 void print_design_summary(std::ostream& out, const v1::DesignSummary& d);
 std::string progress_line(const v1::Progress& p, int width = 30);

@@ -7,10 +7,9 @@
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <string>
 #include <utility>
-#include <vector>
 
+#include "client/jsonl_file.hpp"
 #include "core/lab/study.hpp"
 
 namespace demcal::cli {
@@ -18,9 +17,9 @@ namespace demcal::cli {
 class StudyJournalFile {
  public:
   /// Reads the runs `path` holds for the study `identity` (none when the file is new). A last
-  /// line cut short (a run killed while writing) is dropped from the file; any other line that
-  /// is not a run,
-  /// or a first line naming another study, is an InputError naming the file and line.
+  /// line cut short (a run killed while writing) is dropped from the file (JsonLinesFile); any
+  /// other line that is not a run, or a first line naming another study, is an InputError naming
+  /// the file and line.
   StudyJournalFile(std::filesystem::path path, nlohmann::json identity);
 
   /// The journal for lab::run_study: finds the runs read, appends each new one to the file.
@@ -28,11 +27,10 @@ class StudyJournalFile {
   std::size_t runs_read() const { return done_.size(); }
 
  private:
-  void read();
-  void rewrite(const std::vector<std::string>& lines) const;
+  void take(const std::string& text, std::size_t line);
   void append(double value, const lab::StudyReplicate& replicate);
 
-  std::filesystem::path path_;
+  JsonLinesFile file_;
   nlohmann::json identity_;
   std::map<std::pair<double, std::uint64_t>, lab::StudyReplicate> done_;
 };

@@ -297,6 +297,7 @@
         el('span', { id: 'campaign-state', 'data-state': c.state }, String(c.state).toLowerCase()),
         ' · ', finished + ' of ' + total + ' jobs finished',
         Number(p.failed) ? ' (' + p.failed + ' failed)' : '',
+        Number(p.reused) ? ' (' + p.reused + ' reused: taken from earlier runs of the same run key)' : '',
         ' · ', Number(p.leased || 0) + ' running',
         ' · created ' + (c.created_at || '')),
       el('progress', { max: total, value: finished }),

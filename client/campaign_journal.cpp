@@ -1,0 +1,145 @@
+#include "client/campaign_journal.hpp"
+
+#include <chrono>
+#include <iostream>
+#include <map>
+#include <variant>
+
+#include "client/service_client.hpp"
+#include "core/common/error.hpp"
+#include "rpc/journal_line.hpp"
+
+namespace demcal::cli {
+namespace {
+
+/// "3 (version 1), 2 (version 4)": the runs of each protocol version but the coordinator's.
+std::string other_protocols(const std::vector<v1::JournalRun>& runs, int protocol) {
+  std::map<int, int> count;
+  for (const auto& run : runs)
+    if (run.protocol() != protocol) ++count[run.protocol()];
+  std::string text;
+  for (const auto& [version, n] : count)
+    text +=
+        (text.empty() ? "" : ", ") + std::to_string(n) + " of version " + std::to_string(version);
+  return text;
+}
+
+}  // namespace
+
+CampaignJournal::CampaignJournal(std::filesystem::path path) : file_(std::move(path)) {
+  file_.read([this](const std::string& text, std::size_t line) { take(text, line); },
+             "a line of a campaign journal");
+}
+
+void CampaignJournal::take(const std::string& text, std::size_t line) {
+  auto parsed = rpc::parse_journal_line(text);
+  if (std::holds_alternative<v1::JournalHeader>(parsed)) {
+    header_ = text;
+    return;
+  }
+  if (line == 1)
+    throw InputError(file_.where(line),
+                     "not a campaign journal: its first line is not a journal's header");
+  auto& run = std::get<v1::JournalRun>(parsed);
+  // The first run of a key is the one taken, as the coordinator keeps the first it is offered.
+  if (!keys_.insert(run.run_key()).second) return;
+  run.set_source(file_.where(line));
+  runs_.push_back(std::move(run));
+}
+
+void CampaignJournal::append_export(const std::string& content) {
+  std::vector<std::string> lines;
+  std::string header;  ///< the export's header, written before its first new run
+  for (const auto& text : split_lines(content)) {
+    const auto parsed = rpc::parse_journal_line(text);
+    if (std::holds_alternative<v1::JournalHeader>(parsed)) {
+      header = text;
+      continue;
+    }
+    if (!keys_.insert(std::get<v1::JournalRun>(parsed).run_key()).second) continue;
+    if (!header.empty() && header != header_) {
+      lines.push_back(header);
+      header_ = header;
+    }
+    lines.push_back(text);
+  }
+  if (!lines.empty()) file_.append(lines);
+}
+
+void import_journal(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                    const CampaignJournal& journal, std::ostream& out) {
+  constexpr std::size_t kBatchBytes = std::size_t(1) << 20;
+  v1::ImportRunsReply total;
+  for (std::size_t first = 0; first < journal.runs().size();) {
+    v1::ImportRunsRequest batch;
+    std::size_t bytes = 0;
+    for (; first < journal.runs().size() && bytes < kBatchBytes; ++first) {
+      bytes += journal.runs()[first].ByteSizeLong();
+      *batch.add_runs() = journal.runs()[first];
+    }
+    v1::ImportRunsReply reply;
+    check(stub.ImportRuns(rpc::make_context(channel, 120).get(), batch, &reply), "import");
+    total.set_kept(total.kept() + reply.kept());
+    total.set_known(total.known() + reply.known());
+    total.set_other_protocol(total.other_protocol() + reply.other_protocol());
+    total.set_protocol(reply.protocol());
+  }
+  out << "journal " << journal.path().string() << ": " << journal.runs().size() << " run(s) read, "
+      << total.kept() << " new to the coordinator, " << total.known() << " held already\n";
+  if (total.other_protocol() > 0)
+    out << "journal " << journal.path().string() << ": " << total.other_protocol()
+        << " run(s) not taken: simulated under another lab protocol ("
+        << other_protocols(journal.runs(), total.protocol()) << "; this coordinator runs version "
+        << total.protocol() << "), whose results may differ\n";
+}
+
+JournalKeeper::JournalKeeper(CampaignJournal& journal, v1::CampaignService::Stub& stub,
+                             const rpc::ChannelOptions& channel, std::int64_t id)
+    : journal_(journal), stub_(stub), channel_(channel), id_(id), thread_([this] {
+        std::unique_lock lock(mutex_);
+        while (!cv_.wait_for(lock, std::chrono::milliseconds(500), [this] { return stopped_; })) {
+          lock.unlock();
+          sync();
+          lock.lock();
+        }
+      }) {}
+
+JournalKeeper::~JournalKeeper() {
+  {
+    std::lock_guard lock(mutex_);
+    stopped_ = true;
+  }
+  cv_.notify_all();
+  thread_.join();
+  sync();
+}
+
+void JournalKeeper::sync() {
+  std::lock_guard lock(sync_mutex_);
+  try {
+    append_finished();
+    last_error_.clear();
+  } catch (const std::exception& e) {
+    // Said once per cause, not at every try: the next update tries again.
+    if (e.what() != last_error_)
+      std::cerr << "journal " << journal_.path().string() << ": not updated: " << e.what() << "\n";
+    last_error_ = e.what();
+  }
+}
+
+void JournalKeeper::append_finished() {
+  v1::GetRequest req;
+  req.set_id(id_);
+  v1::ResultsReply results;
+  check(stub_.GetResults(rpc::make_context(channel_, 60).get(), req, &results), "results");
+  std::vector<std::int64_t> fresh;
+  for (const auto& job : results.jobs())
+    if (job.state() == "done" && !job.run_key().empty() && !journal_.holds(job.run_key()))
+      fresh.push_back(job.job_id());
+  if (fresh.empty()) return;
+  std::string content;
+  check(read_export(stub_, channel_, id_, "journal", content, false, fresh), "export");
+  journal_.append_export(content);
+}
+
+}  // namespace demcal::cli

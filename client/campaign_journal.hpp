@@ -1,0 +1,85 @@
+#pragma once
+// A campaign's journal file as `demcal run --journal FILE` and `demcal submit --journal FILE` keep
+// it (docs/journal.md; its lines: rpc/journal_line.hpp): the runs it holds are offered to the
+// coordinator before the campaign starts, so that every job whose run key it holds takes that
+// run's result instead of being simulated, and every job the campaign finishes is appended as it
+// finishes.
+#include <condition_variable>
+#include <cstdint>
+#include <filesystem>
+#include <mutex>
+#include <ostream>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "client/jsonl_file.hpp"
+#include "demcal/v1/campaign.grpc.pb.h"
+#include "rpc/channel.hpp"
+
+namespace demcal::cli {
+
+class CampaignJournal {
+ public:
+  /// Reads the file (a new one holds nothing). A last line cut short is dropped from it; any
+  /// other line that is not a journal line, or a first line that is not a journal's header, is
+  /// an InputError naming the file and line.
+  explicit CampaignJournal(std::filesystem::path path);
+
+  const std::filesystem::path& path() const { return file_.path(); }
+  /// The runs read, each with its source (FILE:LINE).
+  const std::vector<v1::JournalRun>& runs() const { return runs_; }
+  bool holds(const std::string& run_key) const { return keys_.count(run_key) > 0; }
+
+  /// Appends a journal export of the coordinator (Export, format journal): its header line when
+  /// it differs from the latest header of the file (another campaign or build writes on), then
+  /// its runs whose keys the file does not hold.
+  void append_export(const std::string& content);
+
+ private:
+  void take(const std::string& text, std::size_t line);
+
+  JsonLinesFile file_;
+  std::vector<v1::JournalRun> runs_;
+  std::set<std::string> keys_;
+  std::string header_;  ///< the latest header line of the file
+};
+
+/// Offers the journal's runs to the coordinator (ImportRuns, in batches of about 1 MiB) and says
+/// on `out` what became of them: how many were new or held already, and how many were not taken
+/// because they were simulated under another lab protocol version.
+void import_journal(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                    const CampaignJournal& journal, std::ostream& out);
+
+/// Keeps the journal of campaign `id` up to date while it lives: every half second, and once more
+/// when it ends, the campaign's finished jobs whose run keys the journal does not hold are
+/// appended (exported by the coordinator in the journal format). A failed update is reported on
+/// standard error and tried again at the next.
+class JournalKeeper {
+ public:
+  JournalKeeper(CampaignJournal& journal, v1::CampaignService::Stub& stub,
+                const rpc::ChannelOptions& channel, std::int64_t id);
+  ~JournalKeeper();
+  JournalKeeper(const JournalKeeper&) = delete;
+  JournalKeeper& operator=(const JournalKeeper&) = delete;
+
+  /// Appends the finished jobs the journal does not hold yet; errors are reported, not thrown.
+  void sync();
+
+ private:
+  void append_finished();
+
+  CampaignJournal& journal_;
+  v1::CampaignService::Stub& stub_;
+  const rpc::ChannelOptions& channel_;
+  std::int64_t id_;
+  std::mutex sync_mutex_;   ///< one update at a time (the keeper's thread, a stop signal's)
+  std::string last_error_;  ///< of the latest update; empty when it succeeded
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool stopped_ = false;
+  std::thread thread_;  ///< last: started once the members it uses exist
+};
+
+}  // namespace demcal::cli
