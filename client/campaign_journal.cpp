@@ -42,7 +42,7 @@ void CampaignJournal::take(const std::string& text, std::size_t line) {
                      "not a campaign journal: its first line is not a journal's header");
   auto& run = std::get<v1::JournalRun>(parsed);
   // The first run of a key is the one taken, as the coordinator keeps the first it is offered.
-  if (!keys_.insert(run.run_key()).second) return;
+  if (!held_.insert({run.run_key(), run.protocol()}).second) return;
   run.set_source(file_.where(line));
   runs_.push_back(std::move(run));
 }
@@ -56,7 +56,8 @@ void CampaignJournal::append_export(const std::string& content) {
       header = text;
       continue;
     }
-    if (!keys_.insert(std::get<v1::JournalRun>(parsed).run_key()).second) continue;
+    const auto& run = std::get<v1::JournalRun>(parsed);
+    if (!held_.insert({run.run_key(), run.protocol()}).second) continue;
     if (!header.empty() && header != header_) {
       lines.push_back(header);
       header_ = header;
@@ -134,7 +135,8 @@ void JournalKeeper::append_finished() {
   check(stub_.GetResults(rpc::make_context(channel_, 60).get(), req, &results), "results");
   std::vector<std::int64_t> fresh;
   for (const auto& job : results.jobs())
-    if (job.state() == "done" && !job.run_key().empty() && !journal_.holds(job.run_key()))
+    if (job.state() == "done" && !job.run_key().empty() &&
+        !journal_.holds(job.run_key(), job.run_protocol()))
       fresh.push_back(job.job_id());
   if (fresh.empty()) return;
   std::string content;

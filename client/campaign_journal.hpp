@@ -12,6 +12,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "client/jsonl_file.hpp"
@@ -30,11 +31,14 @@ class CampaignJournal {
   const std::filesystem::path& path() const { return file_.path(); }
   /// The runs read, each with its source (FILE:LINE).
   const std::vector<v1::JournalRun>& runs() const { return runs_; }
-  bool holds(const std::string& run_key) const { return keys_.count(run_key) > 0; }
+  /// Whether the journal has a line of this run key written under this lab protocol version.
+  bool holds(const std::string& run_key, int protocol) const {
+    return held_.count({run_key, protocol}) > 0;
+  }
 
   /// Appends a journal export of the coordinator (Export, format journal): its header line when
   /// it differs from the latest header of the file (another campaign or build writes on), then
-  /// its runs whose keys the file does not hold.
+  /// its runs the file does not hold.
   void append_export(const std::string& content);
 
  private:
@@ -42,8 +46,8 @@ class CampaignJournal {
 
   JsonLinesFile file_;
   std::vector<v1::JournalRun> runs_;
-  std::set<std::string> keys_;
-  std::string header_;  ///< the latest header line of the file
+  std::set<std::pair<std::string, int>> held_;  ///< run key, protocol of every run line
+  std::string header_;                          ///< the latest header line of the file
 };
 
 /// Offers the journal's runs to the coordinator (ImportRuns, in batches of about 1 MiB) and says

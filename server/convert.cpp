@@ -491,6 +491,7 @@ v1::JobResult job_message(const JobRow& job) {
   for (const auto& [k, v] : flags.items()) (*r.mutable_flags())[k] = v.get<std::string>();
   from_json(job.cost_json, *r.mutable_cost());
   r.set_run_key(job.run_key.key);
+  r.set_run_protocol(job.run_key.protocol);
   r.set_reused_from(job.reused_from);
   r.set_reused_journal(job.reused_journal);
   return r;

@@ -14,12 +14,15 @@ namespace demcal::server {
 namespace {
 
 v1::JournalHeader journal_header(const CampaignRow& row) {
+  // The spec in canonical JSON (keys sorted; the stored text has protobuf's map order, which
+  // differs between processes), so that one spec has one text and one hash.
+  const std::string spec = nlohmann::json::parse(row.spec_json).dump();
   v1::JournalHeader h;
   h.set_journal(rpc::kJournalMarker);
   h.set_version(rpc::kJournalFormat);
   h.set_campaign(row.name);
-  h.set_spec(row.spec_json);
-  h.set_spec_sha256(sha256_hex(row.spec_json));
+  h.set_spec(spec);
+  h.set_spec_sha256(sha256_hex(spec));
   h.set_build_version(build_version());
   h.set_build_commit(build_commit());
   h.set_protocol(lab::kProtocolVersion);

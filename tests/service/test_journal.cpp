@@ -1,0 +1,387 @@
+// Campaign journals and runs reused by run key (docs/journal.md), with real processes: a second
+// campaign in one store takes the first's results instead of leasing its jobs; `demcal run
+// --journal` interrupted and resumed in a fresh work directory gives the uninterrupted run's
+// effects to the bit with no run simulated twice; a journal of another spec gives exactly the runs
+// whose keys match; runs of another lab protocol version are not taken; lines cut short are
+// dropped and malformed lines refused with their file and line.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "core/lab/protocol.hpp"
+#include "tests/service/service_fixture.hpp"
+
+namespace demcal::test {
+namespace {
+
+/// A 2^2 packing campaign of 200-particle beds (a fraction of a second each), without
+/// measurements (no calibration): the restitution's high level sets which runs it shares with
+/// another spec. The bounds are sums of powers of two, so that a level is the same double in
+/// every box that has it (a level is computed as centre -+ half the range).
+std::string packing_spec(const std::string& name, double restitution_high) {
+  return "name: " + name + R"(
+material:
+  particle_law:
+    normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 0.0005}}
+  density: 2500
+tests:
+  - test: packing
+    settings: {particles: 200}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.125, high: 0.5}
+  - {path: particle_law.normal.restitution, low: 0.25, high: )" +
+         std::to_string(restitution_high) + R"(}
+design: {type: full_factorial}
+)";
+}
+
+std::vector<std::string> file_lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+void write_lines(const std::string& path, const std::vector<std::string>& lines) {
+  std::ofstream out(path, std::ios::trunc);
+  for (const auto& line : lines) out << line << "\n";
+}
+
+/// The run keys of a journal's run lines, in order.
+std::vector<std::string> journal_keys(const std::string& path) {
+  std::vector<std::string> keys;
+  for (const auto& line : file_lines(path)) {
+    const auto j = nlohmann::json::parse(line);
+    if (j.contains("run_key")) keys.push_back(j.at("run_key"));
+  }
+  return keys;
+}
+
+/// Each job of a campaign's file: its run key, whether its result was simulated (not reused),
+/// and its attempts.
+struct StoredJob {
+  std::string run_key;
+  bool reused = false;
+  int attempt = 0;
+  std::string metrics;
+};
+
+class Journal : public Service {
+ protected:
+  /// `demcal run SPEC --workdir WORK [--journal J] --format json` on one worker of one thread;
+  /// its standard output (the JSON document) in NAME.json, its standard error in NAME.err.
+  std::vector<std::string> run_argv(const std::string& spec, const std::string& work,
+                                    const std::string& journal) {
+    std::vector<std::string> argv{DEMCAL_CLI_BIN, "run", spec,        "--workdir", path(work),
+                                  "--workers",    "1",   "--threads", "1",         "--format",
+                                  "json"};
+    if (!journal.empty()) argv.insert(argv.end(), {"--journal", journal});
+    return argv;
+  }
+
+  /// Runs it to its end; the exit status, with standard error in `err`.
+  int run(const std::string& spec, const std::string& work, const std::string& journal,
+          std::string& err) {
+    Process p(run_argv(spec, work, journal), path(work + ".json"), path(work + ".err"));
+    const int status = p.wait_exit(120);
+    std::ifstream in(path(work + ".err"));
+    err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    return status;
+  }
+
+  nlohmann::json output(const std::string& work) {
+    return nlohmann::json::parse(std::ifstream(path(work + ".json")));
+  }
+
+  /// The jobs of the campaign in WORK/campaign.db, in job order.
+  std::vector<StoredJob> stored_jobs(const std::string& work) {
+    std::vector<StoredJob> out;
+    each_row(path(work + "/campaign.db"),
+             "SELECT j.run_key, r.reused_from != 0 OR r.reused_journal != '', j.attempt, "
+             "COALESCE(r.metrics_json, '') FROM jobs j LEFT JOIN results r ON r.job_id = j.id "
+             "ORDER BY j.id",
+             [&](sqlite3_stmt* st) {
+               out.push_back({reinterpret_cast<const char*>(sqlite3_column_text(st, 0)),
+                              sqlite3_column_int(st, 1) != 0, sqlite3_column_int(st, 2),
+                              reinterpret_cast<const char*>(sqlite3_column_text(st, 3))});
+             });
+    return out;
+  }
+
+  /// How many jobs of the campaign in WORK were simulated, and how many took a result.
+  std::pair<int, int> simulated_and_reused(const std::string& work) {
+    int simulated = 0, reused = 0;
+    for (const auto& job : stored_jobs(work)) (job.reused ? reused : simulated) += 1;
+    return {simulated, reused};
+  }
+
+  /// Results stored in WORK/campaign.db so far (0 while the file or its tables do not exist).
+  int results_stored(const std::string& work) {
+    const std::string db = path(work + "/campaign.db");
+    int n = 0;
+    sqlite3* file = nullptr;
+    sqlite3_stmt* st = nullptr;
+    if (fs::exists(db) &&
+        sqlite3_open_v2(db.c_str(), &file, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK &&
+        sqlite3_prepare_v2(file, "SELECT COUNT(*) FROM results", -1, &st, nullptr) == SQLITE_OK &&
+        sqlite3_step(st) == SQLITE_ROW)
+      n = sqlite3_column_int(st, 0);
+    sqlite3_finalize(st);
+    sqlite3_close(file);
+    return n;
+  }
+};
+
+TEST_F(Journal, ASecondCampaignInTheStoreTakesTheFirstsResultsInsteadOfSimulatingThem) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t first = 0, second = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &first).ok());
+  std::map<std::string, double> by_key;  // the result of each run key, as completed
+  for (int i = 0; i < 4; ++i)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec&, v1::CompleteRequest& c) {
+      (*c.mutable_metrics())["solid_fraction"] = 0.55 + 0.01 * i;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+      c.set_wall_seconds(1.0 + i);
+    }));
+  const auto first_jobs = results(first);
+  for (const auto& j : first_jobs.jobs()) by_key[j.run_key()] = j.metrics().at("solid_fraction");
+  ASSERT_EQ(by_key.size(), 4u);  // four runs, four keys
+  // The same spec again: the worker's lease finds nothing to simulate, and the campaign is done
+  // with every result taken from the first campaign's job of its key.
+  ASSERT_TRUE(submit(tiny_spec(30), &second).ok());
+  v1::LeaseRequest lr;
+  lr.set_worker("w");
+  v1::LeaseReply lease;
+  ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
+  EXPECT_FALSE(lease.has_job());
+  EXPECT_TRUE(campaign_done(second));
+  std::map<std::int64_t, std::string> first_keys;
+  for (const auto& j : first_jobs.jobs()) first_keys[j.job_id()] = j.run_key();
+  const auto second_jobs = results(second);
+  for (const auto& j : second_jobs.jobs()) {
+    EXPECT_EQ(j.state(), "done");
+    EXPECT_EQ(j.attempt(), 0) << "never leased";
+    ASSERT_TRUE(first_keys.count(j.reused_from())) << j.reused_from();
+    EXPECT_EQ(first_keys[j.reused_from()], j.run_key());
+    EXPECT_EQ(j.metrics().at("solid_fraction"), by_key[j.run_key()]);
+  }
+  // Counted and shown as reused: Get's progress, `demcal status` and `demcal export`.
+  v1::GetRequest get;
+  get.set_id(second);
+  v1::Campaign c;
+  ASSERT_TRUE(campaigns_->Get(ctx().get(), get, &c).ok());
+  EXPECT_EQ(c.progress().reused(), 4);
+  EXPECT_EQ(c.progress().done(), 4);
+  const std::string id = std::to_string(second);
+  Process status({DEMCAL_CLI_BIN, "status", id, "--jobs", "--coordinator", channel_.address,
+                  "--token", kToken},
+                 path("status.log"));
+  ASSERT_EQ(status.wait_exit(30), 0) << status.log();
+  EXPECT_NE(status.log().find("4/4 done (4 reused)"), std::string::npos) << status.log();
+  EXPECT_NE(status.log().find("reused from job "), std::string::npos) << status.log();
+  const auto exported = cli_json(dir_, "export", {"export", id, "--format", "json"}, channel_);
+  EXPECT_EQ(exported.at("reused"), 4);
+  EXPECT_NE(exported.at("jobs").at(0).at("reused_from"), 0);
+  // A journal of the second campaign names the first's runs by the same keys.
+  Process journal({DEMCAL_CLI_BIN, "export", id, "--format", "journal", "-o", path("second.jsonl"),
+                   "--coordinator", channel_.address, "--token", kToken},
+                  path("journal.log"));
+  ASSERT_EQ(journal.wait_exit(30), 0) << journal.log();
+  const auto keys = journal_keys(path("second.jsonl"));
+  EXPECT_EQ(std::set<std::string>(keys.begin(), keys.end()).size(), 4u);
+  for (const auto& key : keys) EXPECT_TRUE(by_key.count(key)) << key;
+}
+
+TEST_F(Journal, ImportRunsRefusesAnInvalidRunNamingItsLineAndKeepsNothingOfTheCall) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  v1::ImportRunsRequest req;
+  auto* good = req.add_runs();
+  good->set_run_key(std::string(64, 'a'));
+  good->set_protocol(lab::kProtocolVersion);
+  (*good->mutable_metrics())["solid_fraction"] = 0.6;
+  good->set_source("j.jsonl:2");
+  auto* bad = req.add_runs();
+  *bad = *good;
+  bad->set_run_key(std::string(64, 'b'));
+  (*bad->mutable_metrics())["solid_fraction"] = std::numeric_limits<double>::infinity();
+  bad->set_source("j.jsonl:3");
+  v1::ImportRunsReply reply;
+  auto s = campaigns_->ImportRuns(ctx().get(), req, &reply);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(s.error_message(), "j.jsonl:3: metrics.solid_fraction: must be finite");
+  req.mutable_runs()->RemoveLast();
+  auto* other = req.add_runs();
+  *other = *good;
+  other->set_run_key(std::string(64, 'c'));
+  other->set_protocol(lab::kProtocolVersion + 1);
+  ASSERT_TRUE(campaigns_->ImportRuns(ctx().get(), req, &reply).ok());
+  EXPECT_EQ(reply.kept(), 1);  // the good run: the call refused before kept nothing
+  EXPECT_EQ(reply.known(), 0);
+  EXPECT_EQ(reply.other_protocol(), 1);
+  EXPECT_EQ(reply.protocol(), lab::kProtocolVersion);
+  ASSERT_TRUE(campaigns_->ImportRuns(ctx().get(), req, &reply).ok());
+  EXPECT_EQ(reply.kept(), 0);
+  EXPECT_EQ(reply.known(), 1);
+}
+
+TEST_F(Journal, AnInterruptedCampaignGoesOnElsewhereFromItsJournalToTheSameEffects) {
+  const std::string spec = path("moved.yaml");
+  std::ofstream(spec) << wall_friction_spec("moved", "");
+  const std::string journal = path("moved.jsonl");
+  {
+    // Stopped (Ctrl-C) once two of its four runs are finished, a few seconds each.
+    Process first(run_argv(spec, "first", journal), path("first.json"), path("first.err"));
+    ASSERT_TRUE(wait_until([&] { return results_stored("first") >= 2; }, 90));
+    first.signal(SIGINT);
+    EXPECT_EQ(first.wait_exit(40), 128 + SIGINT);
+  }
+  // The journal holds its header and every run the interrupted campaign finished.
+  const int finished = results_stored("first");
+  ASSERT_LT(finished, 4);
+  EXPECT_EQ(file_lines(journal).size(), 1u + unsigned(finished));
+  // Moved with the spec to a fresh work directory, the same command goes on from it: the
+  // journal's runs are taken, the others simulated, each run simulated once over the two.
+  std::string err;
+  ASSERT_EQ(run(spec, "second", journal, err), 0) << err;
+  EXPECT_NE(err.find(std::to_string(finished) + " run(s) read, " + std::to_string(finished) +
+                     " new to the coordinator"),
+            std::string::npos)
+      << err;
+  const auto [simulated, reused] = simulated_and_reused("second");
+  EXPECT_EQ(reused, finished);
+  EXPECT_EQ(simulated, 4 - finished);
+  for (const auto& job : stored_jobs("second")) EXPECT_EQ(job.attempt, job.reused ? 0 : 1);
+  const auto keys = journal_keys(journal);
+  EXPECT_EQ(keys.size(), 4u);
+  EXPECT_EQ(std::set<std::string>(keys.begin(), keys.end()).size(), 4u);
+  // An uninterrupted run gives the same effect tables, to the bit.
+  ASSERT_EQ(run(spec, "whole", "", err), 0) << err;
+  EXPECT_EQ(output("second").at("effects"), output("whole").at("effects"));
+}
+
+TEST_F(Journal, AJournalOfAnotherSpecGivesExactlyTheRunsWhoseKeysMatch) {
+  std::ofstream(path("a.yaml")) << packing_spec("a", 0.75);
+  std::ofstream(path("b.yaml")) << packing_spec("b", 0.5);
+  const std::string journal = path("a.jsonl");
+  std::string err;
+  ASSERT_EQ(run(path("a.yaml"), "a", journal, err), 0) << err;
+  const auto a_keys = journal_keys(journal);
+  ASSERT_EQ(a_keys.size(), 4u);
+  ASSERT_EQ(run(path("b.yaml"), "b", journal, err), 0) << err;
+  // b shares a's runs at the restitution's low level (its design rows 1 and 2, same seeds): those
+  // and only those are taken, with a's results.
+  std::map<std::string, std::string> a_metrics;
+  for (const auto& job : stored_jobs("a")) a_metrics[job.run_key] = job.metrics;
+  int taken = 0;
+  for (const auto& job : stored_jobs("b")) {
+    EXPECT_EQ(job.reused, a_metrics.count(job.run_key) > 0) << job.run_key;
+    if (job.reused) EXPECT_EQ(job.metrics, a_metrics[job.run_key]);
+    taken += job.reused;
+  }
+  EXPECT_EQ(taken, 2);
+  // b's two runs of its own follow a's under a header naming b.
+  const auto lines = file_lines(journal);
+  ASSERT_EQ(lines.size(), 1u + 4u + 1u + 2u);
+  EXPECT_EQ(nlohmann::json::parse(lines[5]).at("campaign"), "b");
+  EXPECT_EQ(nlohmann::json::parse(lines[0]).at("campaign"), "a");
+}
+
+TEST_F(Journal, RunsOfAnotherLabProtocolVersionAreNotTaken) {
+  std::ofstream(path("a.yaml")) << packing_spec("a", 0.75);
+  const std::string journal = path("a.jsonl");
+  std::string err;
+  ASSERT_EQ(run(path("a.yaml"), "a", journal, err), 0) << err;
+  auto lines = file_lines(journal);
+  ASSERT_EQ(lines.size(), 5u);
+  auto changed = nlohmann::json::parse(lines[2]);
+  changed["protocol"] = lab::kProtocolVersion + 1;
+  lines[2] = changed.dump();
+  write_lines(journal, lines);
+  ASSERT_EQ(run(path("a.yaml"), "again", journal, err), 0) << err;
+  EXPECT_NE(
+      err.find("1 run(s) not taken: simulated under another lab protocol (1 of version " +
+               std::to_string(lab::kProtocolVersion + 1) + "; this coordinator runs version " +
+               std::to_string(lab::kProtocolVersion) + ")"),
+      std::string::npos)
+      << err;
+  for (const auto& job : stored_jobs("again"))
+    EXPECT_EQ(job.reused, job.run_key != changed.at("run_key")) << job.run_key;
+  // The run simulated again is kept under this version: a third directory takes all four.
+  EXPECT_EQ(file_lines(journal).size(), 6u);
+  ASSERT_EQ(run(path("a.yaml"), "third", journal, err), 0) << err;
+  EXPECT_EQ(simulated_and_reused("third"), std::make_pair(0, 4));
+}
+
+TEST_F(Journal, ALineCutShortIsDroppedAndAMalformedLineIsRefusedWithItsFileAndLine) {
+  std::ofstream(path("a.yaml")) << packing_spec("a", 0.75);
+  const std::string journal = path("a.jsonl");
+  std::string err;
+  ASSERT_EQ(run(path("a.yaml"), "a", journal, err), 0) << err;
+  const auto whole = file_lines(journal);
+  ASSERT_EQ(whole.size(), 5u);
+  // The writer killed during its last line: the line is dropped, its run simulated again and
+  // appended whole.
+  {
+    std::ofstream cut(journal, std::ios::trunc);
+    for (int i = 0; i < 4; ++i) cut << whole[std::size_t(i)] << "\n";
+    cut << whole[4].substr(0, 40);
+  }
+  ASSERT_EQ(run(path("a.yaml"), "cut", journal, err), 0) << err;
+  EXPECT_NE(err.find(journal + ":5: a line cut short while it was written, dropped"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(simulated_and_reused("cut"), std::make_pair(1, 3));
+  EXPECT_EQ(file_lines(journal).size(), 5u);
+  // A line in the middle that is no run, or a run with a number that is not finite: refused
+  // before anything starts, naming the file and line, the file left as it is.
+  const auto kept = file_lines(journal);
+  auto nan = nlohmann::json::parse(kept[1]);
+  nan["metrics"]["solid_fraction"] = "NaN";  // how protobuf's JSON writes a NaN
+  const std::pair<std::string, std::string> malformed[] = {
+      {R"({"run_key": "abc"})",
+       ":2: not a line of a campaign journal: run_key: 64 lower-case "
+       "hex digits expected"},
+      {nan.dump(), ":2: not a line of a campaign journal: metrics.solid_fraction: must be finite"},
+      {"{\"run_key\": ", ":2: not a line of a campaign journal: "}};
+  for (const auto& [line, message] : malformed) {
+    auto lines = kept;
+    lines[1] = line;
+    write_lines(journal, lines);
+    ASSERT_NE(run(path("a.yaml"), "refused", journal, err), 0);
+    EXPECT_NE(err.find(journal + message), std::string::npos) << err;
+    EXPECT_EQ(file_lines(journal), lines);
+    EXPECT_FALSE(fs::exists(path("refused")));  // nothing started
+  }
+  // A gzip journal cut short: the damaged end is dropped, every whole line is read, and the
+  // journal is written whole again.
+  const std::string gz = path("a.jsonl.gz");
+  write_lines(journal, kept);
+  Process exported({DEMCAL_CLI_BIN, "export", path("a.yaml"), "--workdir", path("a"), "--format",
+                    "journal", "-o", gz},
+                   path("export.log"));
+  ASSERT_EQ(exported.wait_exit(60), 0) << exported.log();
+  fs::resize_file(gz, fs::file_size(gz) - 12);
+  ASSERT_EQ(run(path("a.yaml"), "gzip", gz, err), 0) << err;
+  EXPECT_NE(err.find(gz + ": its gzip end was cut short while it was written"), std::string::npos)
+      << err;
+  const auto [simulated, reused] = simulated_and_reused("gzip");
+  EXPECT_EQ(simulated + reused, 4);
+  EXPECT_GE(reused, 3);
+  Process unzip({"/bin/gzip", "-dc", gz}, path("unzipped.jsonl"));
+  ASSERT_EQ(unzip.wait_exit(30), 0);
+  EXPECT_EQ(journal_keys(path("unzipped.jsonl")).size(), 4u);
+}
+
+}  // namespace
+}  // namespace demcal::test
