@@ -147,7 +147,7 @@ TEST(Cli, LabStudyGoesOnWhereItStopped) {
   const Result resumed = demcal(study);
   ASSERT_EQ(resumed.exit_code, 0) << resumed.out;
   EXPECT_NE(resumed.out.find("2 finished run(s) read"), std::string::npos) << resumed.out;
-  EXPECT_NE(resumed.out.find("replicates.jsonl:4: a run cut short"), std::string::npos);
+  EXPECT_NE(resumed.out.find("replicates.jsonl:4: a line cut short"), std::string::npos);
   EXPECT_EQ(file_lines(journal).size(), 5u);
   const auto after = nlohmann::json::parse(std::ifstream(dir / "out" / "study.json"));
   // The 60-particle runs are the kept ones, wall times included; the 120-particle runs ran
