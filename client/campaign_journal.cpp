@@ -12,7 +12,7 @@
 namespace demcal::cli {
 namespace {
 
-/// "3 (version 1), 2 (version 4)": the runs of each protocol version but the coordinator's.
+/// "3 of version 1, 2 of version 4": the runs of each protocol version but the coordinator's.
 std::string other_protocols(const std::vector<v1::JournalRun>& runs, int protocol) {
   std::map<int, int> count;
   for (const auto& run : runs)
@@ -96,35 +96,50 @@ void import_journal(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& 
 
 JournalKeeper::JournalKeeper(CampaignJournal& journal, v1::CampaignService::Stub& stub,
                              const rpc::ChannelOptions& channel, std::int64_t id)
-    : journal_(journal), stub_(stub), channel_(channel), id_(id), thread_([this] {
-        std::unique_lock lock(mutex_);
-        while (!cv_.wait_for(lock, std::chrono::milliseconds(500), [this] { return stopped_; })) {
-          lock.unlock();
-          sync();
-          lock.lock();
-        }
-      }) {}
+    : journal_(journal), stub_(stub), channel_(channel), id_(id), thread_([this] { follow(); }) {}
 
 JournalKeeper::~JournalKeeper() {
   {
     std::lock_guard lock(mutex_);
     stopped_ = true;
+    if (watching_) watching_->TryCancel();
   }
   cv_.notify_all();
   thread_.join();
   sync();
 }
 
-void JournalKeeper::sync() {
+void JournalKeeper::follow() {
+  std::int64_t synced = -1;  ///< the count of finished jobs the journal is up to date with
+  std::unique_lock lock(mutex_);
+  while (!stopped_) {
+    const auto context = rpc::make_context(channel_, 7 * 24 * 3600.0);
+    watching_ = context.get();
+    lock.unlock();
+    v1::WatchRequest req;
+    req.set_id(id_);
+    const auto reader = stub_.Watch(context.get(), req);
+    for (v1::Progress p; reader->Read(&p);)
+      if (p.done() != synced && sync()) synced = p.done();
+    reader->Finish();  // the campaign no longer runs, the coordinator is away, or stopped
+    lock.lock();
+    watching_ = nullptr;
+    cv_.wait_for(lock, std::chrono::milliseconds(500), [this] { return stopped_; });
+  }
+}
+
+bool JournalKeeper::sync() {
   std::lock_guard lock(sync_mutex_);
   try {
     append_finished();
     last_error_.clear();
+    return true;
   } catch (const std::exception& e) {
     // Said once per cause, not at every try: the next update tries again.
     if (e.what() != last_error_)
       std::cerr << "journal " << journal_.path().string() << ": not updated: " << e.what() << "\n";
     last_error_ = e.what();
+    return false;
   }
 }
 

@@ -56,10 +56,11 @@ class CampaignJournal {
 void import_journal(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                     const CampaignJournal& journal, std::ostream& out);
 
-/// Keeps the journal of campaign `id` up to date while it lives: every half second, and once more
-/// when it ends, the campaign's finished jobs whose run keys the journal does not hold are
-/// appended (exported by the coordinator in the journal format). A failed update is reported on
-/// standard error and tried again at the next.
+/// Keeps the journal of campaign `id` up to date while it lives: following the campaign's
+/// progress (Watch, again every half second once the campaign no longer runs, since a calibration
+/// or diagnosis may reopen it), whenever its count of finished jobs changes, and once more when it
+/// ends, the finished jobs the journal does not hold are appended (exported by the coordinator in
+/// the journal format). A failed update is reported on standard error and tried again at the next.
 class JournalKeeper {
  public:
   JournalKeeper(CampaignJournal& journal, v1::CampaignService::Stub& stub,
@@ -68,10 +69,12 @@ class JournalKeeper {
   JournalKeeper(const JournalKeeper&) = delete;
   JournalKeeper& operator=(const JournalKeeper&) = delete;
 
-  /// Appends the finished jobs the journal does not hold yet; errors are reported, not thrown.
-  void sync();
+  /// Appends the finished jobs the journal does not hold yet; false (the error reported, not
+  /// thrown) when it could not.
+  bool sync();
 
  private:
+  void follow();
   void append_finished();
 
   CampaignJournal& journal_;
@@ -83,7 +86,8 @@ class JournalKeeper {
   std::mutex mutex_;
   std::condition_variable cv_;
   bool stopped_ = false;
-  std::thread thread_;  ///< last: started once the members it uses exist
+  grpc::ClientContext* watching_ = nullptr;  ///< the Watch call under way, cancelled at the end
+  std::thread thread_;                       ///< last: started once the members it uses exist
 };
 
 }  // namespace demcal::cli

@@ -30,13 +30,10 @@ inline const std::string kToken = "test-token-123";
 /// before it would end).
 inline constexpr int kLongJobParticles = 20000;
 
-/// A packing campaign of 2^2 runs (+ centre points) at `particles` particles; by default its
-/// calibration verifies one round only.
-inline std::string tiny_spec(
-    int particles, int centre = 0, const std::string& extra_factor = "",
-    const std::string& calibration = "calibration: {rounds: 1, stages: 1}\n") {
+/// The material and test of the packing campaigns: frictional Hertz spheres of 0.5 mm,
+/// `particles` to a bed.
+inline std::string packing_material(int particles) {
   return R"(
-name: tiny
 material:
   particle_law:
     normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
@@ -46,8 +43,15 @@ material:
 tests:
   - test: packing
     settings: {particles: )" +
-         std::to_string(particles) + R"(}
-factors:
+         std::to_string(particles) + "}\n";
+}
+
+/// A packing campaign of 2^2 runs (+ centre points) at `particles` particles; by default its
+/// calibration verifies one round only.
+inline std::string tiny_spec(
+    int particles, int centre = 0, const std::string& extra_factor = "",
+    const std::string& calibration = "calibration: {rounds: 1, stages: 1}\n") {
+  return "name: tiny" + packing_material(particles) + R"(factors:
   - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
   - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
 )" + extra_factor +

@@ -28,17 +28,7 @@ namespace {
 /// another spec. The bounds are sums of powers of two, so that a level is the same double in
 /// every box that has it (a level is computed as centre -+ half the range).
 std::string packing_spec(const std::string& name, double restitution_high) {
-  return "name: " + name + R"(
-material:
-  particle_law:
-    normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
-    tangential: {model: history, mu_s: 0.3}
-  sizes: {monodisperse: {radius: 0.0005}}
-  density: 2500
-tests:
-  - test: packing
-    settings: {particles: 200}
-factors:
+  return "name: " + name + packing_material(200) + R"(factors:
   - {path: particle_law.tangential.mu_s, low: 0.125, high: 0.5}
   - {path: particle_law.normal.restitution, low: 0.25, high: )" +
          std::to_string(restitution_high) + R"(}
@@ -98,6 +88,15 @@ class Journal : public Service {
     std::ifstream in(path(work + ".err"));
     err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     return status;
+  }
+
+  /// Spec a (packing_spec) run in the work directory "a" with the journal a.jsonl, which then
+  /// holds its header and its four runs.
+  void run_a() {
+    std::ofstream(path("a.yaml")) << packing_spec("a", 0.75);
+    std::string err;
+    ASSERT_EQ(run(path("a.yaml"), "a", path("a.jsonl"), err), 0) << err;
+    ASSERT_EQ(file_lines(path("a.jsonl")).size(), 5u);
   }
 
   nlohmann::json output(const std::string& work) {
@@ -271,13 +270,10 @@ TEST_F(Journal, AnInterruptedCampaignGoesOnElsewhereFromItsJournalToTheSameEffec
 }
 
 TEST_F(Journal, AJournalOfAnotherSpecGivesExactlyTheRunsWhoseKeysMatch) {
-  std::ofstream(path("a.yaml")) << packing_spec("a", 0.75);
-  std::ofstream(path("b.yaml")) << packing_spec("b", 0.5);
+  ASSERT_NO_FATAL_FAILURE(run_a());
   const std::string journal = path("a.jsonl");
+  std::ofstream(path("b.yaml")) << packing_spec("b", 0.5);
   std::string err;
-  ASSERT_EQ(run(path("a.yaml"), "a", journal, err), 0) << err;
-  const auto a_keys = journal_keys(journal);
-  ASSERT_EQ(a_keys.size(), 4u);
   ASSERT_EQ(run(path("b.yaml"), "b", journal, err), 0) << err;
   // b shares a's runs at the restitution's low level (its design rows 1 and 2, same seeds): those
   // and only those are taken, with a's results.
@@ -298,12 +294,10 @@ TEST_F(Journal, AJournalOfAnotherSpecGivesExactlyTheRunsWhoseKeysMatch) {
 }
 
 TEST_F(Journal, RunsOfAnotherLabProtocolVersionAreNotTaken) {
-  std::ofstream(path("a.yaml")) << packing_spec("a", 0.75);
+  ASSERT_NO_FATAL_FAILURE(run_a());
   const std::string journal = path("a.jsonl");
-  std::string err;
-  ASSERT_EQ(run(path("a.yaml"), "a", journal, err), 0) << err;
   auto lines = file_lines(journal);
-  ASSERT_EQ(lines.size(), 5u);
+  std::string err;
   auto changed = nlohmann::json::parse(lines[2]);
   changed["protocol"] = lab::kProtocolVersion + 1;
   lines[2] = changed.dump();
@@ -324,12 +318,10 @@ TEST_F(Journal, RunsOfAnotherLabProtocolVersionAreNotTaken) {
 }
 
 TEST_F(Journal, ALineCutShortIsDroppedAndAMalformedLineIsRefusedWithItsFileAndLine) {
-  std::ofstream(path("a.yaml")) << packing_spec("a", 0.75);
+  ASSERT_NO_FATAL_FAILURE(run_a());
   const std::string journal = path("a.jsonl");
-  std::string err;
-  ASSERT_EQ(run(path("a.yaml"), "a", journal, err), 0) << err;
   const auto whole = file_lines(journal);
-  ASSERT_EQ(whole.size(), 5u);
+  std::string err;
   // The writer killed during its last line: the line is dropped, its run simulated again and
   // appended whole.
   {
