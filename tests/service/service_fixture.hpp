@@ -182,13 +182,19 @@ class Service : public ::testing::Test {
     return r;
   }
 
+  /// The coordinator's answer to a Lease of `worker` (no job in it when none is to be run).
+  void lease_as(const std::string& worker, v1::LeaseReply& lease) {
+    v1::LeaseRequest lr;
+    lr.set_worker(worker);
+    const auto status = workers_stub_->Lease(ctx().get(), lr, &lease);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+  }
+
   /// Leases the next job as `worker` into `job` and starts its result `c` (job, attempt,
   /// worker): a result through the real worker protocol, no physics.
   void lease_request(const std::string& worker, v1::JobSpec& job, v1::CompleteRequest& c) {
-    v1::LeaseRequest lr;
-    lr.set_worker(worker);
     v1::LeaseReply lease;
-    ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
+    ASSERT_NO_FATAL_FAILURE(lease_as(worker, lease));
     ASSERT_TRUE(lease.has_job());
     job = lease.job();
     c.set_job_id(job.job_id());

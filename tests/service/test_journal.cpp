@@ -159,10 +159,8 @@ TEST_F(Journal, ASecondCampaignInTheStoreTakesTheFirstsResultsInsteadOfSimulatin
   // The same spec again: the worker's lease finds nothing to simulate, and the campaign is done
   // with every result taken from the first campaign's job of its key.
   ASSERT_TRUE(submit(tiny_spec(30), &second).ok());
-  v1::LeaseRequest lr;
-  lr.set_worker("w");
   v1::LeaseReply lease;
-  ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &lease).ok());
+  ASSERT_NO_FATAL_FAILURE(lease_as("w", lease));
   EXPECT_FALSE(lease.has_job());
   EXPECT_TRUE(campaign_done(second));
   std::map<std::int64_t, std::string> first_keys;

@@ -368,10 +368,8 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
                                               "value: 20, uncertainty: 1}\n");
   std::int64_t id = 0;
   ASSERT_TRUE(submit(spec, &id).ok());
-  v1::LeaseRequest lr;
-  lr.set_worker("first");
   v1::LeaseReply first;
-  ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &first).ok());
+  ASSERT_NO_FATAL_FAILURE(lease_as("first", first));
   ASSERT_TRUE(first.has_job());
   const v1::JobSpec& job = first.job();
   EXPECT_TRUE(job.checkpoint_stage().empty());
@@ -452,10 +450,8 @@ TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
   start_server(/*lease=*/1.0, /*heartbeat=*/0.2);
   std::int64_t id = 0;
   ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
-  v1::LeaseRequest lr;
-  lr.set_worker("slow");
   v1::LeaseReply first;
-  ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &first).ok());
+  ASSERT_NO_FATAL_FAILURE(lease_as("slow", first));
   ASSERT_TRUE(first.has_job());
   const auto job = first.job().job_id();
   std::this_thread::sleep_for(std::chrono::milliseconds(1600));  // lease lapses, reaper runs
@@ -475,9 +471,8 @@ TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
   EXPECT_EQ(workers_stub_->Heartbeat(ctx().get(), hb, &hr).error_code(),
             grpc::StatusCode::FAILED_PRECONDITION);
   // The job is handed out again, with the next attempt number.
-  lr.set_worker("fast");
   v1::LeaseReply second;
-  ASSERT_TRUE(workers_stub_->Lease(ctx().get(), lr, &second).ok());
+  ASSERT_NO_FATAL_FAILURE(lease_as("fast", second));
   ASSERT_EQ(second.job().job_id(), job);
   EXPECT_EQ(second.job().attempt(), 2);
   EXPECT_EQ(workers_stub_->Complete(ctx().get(), late, &cr).error_code(),
