@@ -27,6 +27,10 @@ std::string other_protocols(const std::vector<v1::JournalRun>& runs, int protoco
 }  // namespace
 
 CampaignJournal::CampaignJournal(std::filesystem::path path) : file_(std::move(path)) {
+  // Refused now rather than at the first job finished, which could not be appended.
+  const auto directory = file_.path().parent_path();
+  if (!directory.empty() && !std::filesystem::is_directory(directory))
+    throw InputError(file_.path().string(), "its directory does not exist");
   file_.read([this](const std::string& text, std::size_t line) { take(text, line); },
              "a line of a campaign journal");
 }

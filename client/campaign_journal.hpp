@@ -25,7 +25,7 @@ class CampaignJournal {
  public:
   /// Reads the file (a new one holds nothing). A last line cut short is dropped from it; any
   /// other line that is not a journal line, or a first line that is not a journal's header, is
-  /// an InputError naming the file and line.
+  /// an InputError naming the file and line; so is a file whose directory does not exist.
   explicit CampaignJournal(std::filesystem::path path);
 
   const std::filesystem::path& path() const { return file_.path(); }

@@ -353,6 +353,11 @@ TEST_F(Journal, ALineCutShortIsDroppedAndAMalformedLineIsRefusedWithItsFileAndLi
     EXPECT_EQ(file_lines(journal), lines);
     EXPECT_FALSE(fs::exists(path("refused")));  // nothing started
   }
+  // A journal that could not be written is refused as well.
+  ASSERT_EQ(run(path("a.yaml"), "refused", path("missing/a.jsonl"), err), 2);
+  EXPECT_NE(err.find(path("missing/a.jsonl") + ": its directory does not exist"), std::string::npos)
+      << err;
+  EXPECT_FALSE(fs::exists(path("refused")));
   // A gzip journal cut short: the damaged end is dropped, every whole line is read, and the
   // journal is written whole again.
   const std::string gz = path("a.jsonl.gz");
