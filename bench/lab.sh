@@ -3,6 +3,9 @@
 #   bench/lab.sh [BUILD_DIR] [COUNTS] [THREADS]      e.g. bench/lab.sh build 1000 2
 # MATERIAL=lh220 (default; bench/materials/NAME.yaml: lh220, lh100, hertz) and
 # TESTS="packing confined_compression ..." (default: all seven) select what runs.
+# STAGE_CACHE=DIR passes --stage-cache DIR, so that a tensile test after a confined compression
+# of the same material and size starts from the bed it conditioned (docs/lab-tests.md, "Work
+# done once"): TESTS="confined_compression tensile" STAGE_CACHE=$(mktemp -d) bench/lab.sh ...
 # The specs are bench/lab_spec.sh's (five compression cycles included). Prints per test: wall
 # time, steps, particle-steps/s, phases short of their target, flagged metrics, and the metrics.
 # Not part of ctest.
@@ -24,7 +27,7 @@ for n in ${COUNTS//,/ }; do
     spec="$TMP/$test-$n.yaml"
     lab_spec "$test" "$n" "$THREADS" > "$spec"
     start=$(date +%s.%N)
-    if "$DEMCAL" lab run "$spec" > "$TMP/out.json" 2> "$TMP/err"; then status=""; else status=" FAILED: $(tail -1 "$TMP/err")"; fi
+    if "$DEMCAL" lab run "$spec" ${STAGE_CACHE:+--stage-cache "$STAGE_CACHE"} > "$TMP/out.json" 2> "$TMP/err"; then status=""; else status=" FAILED: $(tail -1 "$TMP/err")"; fi
     end=$(date +%s.%N)
     line=$(python3 - "$TMP/out.json" <<'PY' 2>/dev/null || true
 import json, sys

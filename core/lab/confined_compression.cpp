@@ -42,9 +42,7 @@ LabOutput ConfinedCompressionTest::run(const MaterialModel& material, const Sett
   write_snapshot(w, options, "final", out);
 
   const Cycles& done = c.done;
-  const double d_max =
-      2.0 * *std::max_element(w.particles.radius.begin(), w.particles.radius.end());
-  const metrics::SamplingCylinder region{c.bed.radius - d_max, d_max, done.final_z - d_max};
+  const metrics::SamplingCylinder region = bed_sample(w, c.bed.radius, done.final_z);
   out.metrics["compressibility"] = 100.0 * (c.bed.h0 - done.h1) / c.bed.h0;  // eq. 31, %
   out.metrics["k_load"] = done.k_load / cycles;
   out.metrics["k_unload"] = done.k_unload / cycles;

@@ -19,12 +19,13 @@ std::vector<std::string> confinement_stages(int cycles) {
 
 PistonBedRequest confinement_request(const MaterialModel& material,
                                      const ConfinedCompressionSettings& s) {
-  return piston_bed_request(
-      s, s.max_stress * material.factors().stress, [&material](sim::World& w, double factor) {
-        const auto stiff_wall = simulated_law(material, stiffen_normal(material.wall_law, factor));
-        w.change_wall_law(kWallPiston, 0, stiff_wall);
-        w.change_wall_law(kWallBottom, 0, stiff_wall);
-      });
+  const auto stiff_wall =
+      simulated_law(material, stiffen_normal(material.wall_law, s.wall_stiffness_factor));
+  return piston_bed_request(s, s.max_stress * material.factors().stress,
+                            [stiff_wall](sim::World& w) {
+                              w.set_wall_law(kWallPiston, 0, stiff_wall);
+                              w.set_wall_law(kWallBottom, 0, stiff_wall);
+                            });
 }
 
 std::string conditioned_bed_identity(const MaterialModel& material,
@@ -64,7 +65,7 @@ std::optional<PistonBed> cached_conditioned_bed(const MaterialModel& material,
   // The world as the protocol makes it (its laws, its threads), then the state kept.
   bed.world = make_material_world(material, options);
   const PistonBedRequest request = confinement_request(material, s);
-  request.set_laws(bed.world, request.wall_stiffness_factor);
+  request.set_laws(bed.world);
   ByteReader in(*record, "stage cache");
   std::string state;
   in.get(state);

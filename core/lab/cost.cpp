@@ -32,7 +32,7 @@ void RunCost::close(const sim::World& world) {
                   "at most %.3g x every %d steps), at most %.3g x the bound of a fresh contact, "
                   "%s (%.4g s); at the end %.4g s, %.3g x the bound at the laws' largest "
                   "stiffness (%.4g s)",
-                  sim::kStableFraction, sim::World::kStepGrowth, sim::World::kRetuneSteps,
+                  world.adaptive_safety, sim::World::kStepGrowth, sim::World::kRetuneSteps,
                   world.adaptive_safety, fresh.basis.c_str(), fresh.critical, world.dt,
                   world.dt / limit.critical, limit.critical);
   } else {

@@ -166,6 +166,9 @@ void add_bed_phases(LabOutput& out, const PistonBed& bed, const PistonBedRequest
   out.add_phase(bed.filled, {});
   if (bed.built.prepared.steps > 0) out.add_phase(bed.built.prepared, {});
   out.add_phase(bed.built.settled, request.depending);
+  out.series["settled_bed"] =
+      Series{{"h0_m", "solid_fraction", "coordination_number"},
+             {{bed.h0, bed.settled_solid_fraction, bed.settled_coordination}}};
 }
 
 void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string& name,
@@ -173,6 +176,12 @@ void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string&
   PhaseCost cost = phase.cost;
   cost.name = name;
   out.add_phase(cost, depending);
+}
+
+metrics::SamplingCylinder bed_sample(const sim::World& world, double die_radius, double top) {
+  const auto& r = world.particles.radius;
+  const double d_max = r.empty() ? 0.0 : 2.0 * *std::max_element(r.begin(), r.end());
+  return {die_radius - d_max, d_max, top - d_max};
 }
 
 void check_piston(const PistonBed& bed) {
@@ -192,9 +201,9 @@ PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest&
   b.world = make_die_world(material, spec, options);
   b.filled = fill_clock.stop(b.world, "fill", "all particles inserted", true);
   sim::World& w = b.world;
-  if (request.set_laws) request.set_laws(w, 1.0);
+  if (request.set_laws) request.set_laws(w);
   // The piston shares the bottom's law; added far above, it touches nothing while the bed
-  // settles.
+  // settles, and the step's ceiling covers its law from the start.
   b.radius = die_radius(w);
   b.area = M_PI * b.radius * b.radius;
   const double top = metrics_top(w);
@@ -203,10 +212,10 @@ PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest&
   w.dt = sim::adapted_time_step(w, request.safety);
   b.built = prepare_and_settle(w, material, spec, b.limits, top, options.seed);
   b.h0 = metrics_top(w);
-  // Stiff piston and bottom for the loads; the step follows the stiffer contacts at once.
-  if (request.set_laws && request.wall_stiffness_factor != 1.0) {
-    request.set_laws(w, request.wall_stiffness_factor);
-    w.dt = sim::adapted_time_step(w, request.safety);
+  if (const metrics::SamplingCylinder region = bed_sample(w, b.radius, b.h0);
+      region.radius > 0.0 && region.z_hi > region.z_lo) {
+    b.settled_solid_fraction = metrics::solid_fraction(w, region);
+    b.settled_coordination = metrics::coordination_number(w, region);
   }
   auto& disk = std::get<walls::Disk>(w.walls[b.piston].shape);
   disk.centre.z = b.h0;

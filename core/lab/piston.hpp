@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/lab/bed.hpp"
+#include "core/metrics/bulk.hpp"
 #include "core/model/piston_settings.hpp"
 
 namespace demcal::lab {
@@ -73,6 +74,9 @@ struct PistonBed {
   sim::HealthLimits limits;
   PhaseCost filled;  ///< the phases that built it
   PreparedBed built;
+  /// The settled bed, at h0 (sampled one largest diameter from die, floor and top): its solid
+  /// fraction and coordination number, reported with every piston test (series `settled_bed`).
+  double settled_solid_fraction = 0.0, settled_coordination = 0.0;
   /// The piston's servo at the test's largest stress (make_servo); fixed with the bed, as its
   /// hold time is in steps of the bed's time step, which adapts as the run goes.
   ServoSettings servo;
@@ -89,6 +93,8 @@ void record_fields(A& a, B& b) {
   a.field(b.filled);
   a.field(b.built.prepared);
   a.field(b.built.settled);
+  a.field(b.settled_solid_fraction);
+  a.field(b.settled_coordination);
   a.field(b.servo);
 }
 
@@ -101,14 +107,8 @@ struct PistonBedRequest {
   double stress_level = 0.0;
   /// The test's servo settings, for PistonBed::servo at stress_level (none when it is 0).
   PistonServoSettings servo{};
-  /// Replaces wall laws (e.g. stiff or adhesive piston and bottom) with the normal stiffness of
-  /// piston and bottom times the given factor (World::change_wall_law, so a settled bed keeps
-  /// its contacts' history).
-  std::function<void(sim::World&, double stiffness_factor)> set_laws;
-  /// The factor set_laws gets once the bed has settled, for the servo phases (seed 000 §2.7.2:
-  /// 30, so that particles do not escape past the piston); the bed settles at factor 1, on
-  /// walls as stiff as the material's own wall law.
-  double wall_stiffness_factor = 1.0;
+  /// Replaces wall laws (e.g. stiff or adhesive piston and bottom).
+  std::function<void(sim::World&)> set_laws;
   /// The metrics read from the settled state (its height): flagged if settling fell short.
   std::vector<std::string> depending;
 };
@@ -117,30 +117,32 @@ struct PistonBedRequest {
 /// the largest stress it applies (simulated) and its wall laws.
 template <class S>
 PistonBedRequest piston_bed_request(const S& settings, double stress_level,
-                                    std::function<void(sim::World&, double)> set_laws) {
+                                    std::function<void(sim::World&)> set_laws) {
   PistonBedRequest request;
   request.particles = static_cast<std::size_t>(settings.particles);
   request.safety = settings.time_step_safety;
   request.stress_level = stress_level;
   request.servo = settings;
   request.set_laws = std::move(set_laws);
-  request.wall_stiffness_factor = settings.wall_stiffness_factor;
   return request;
 }
 
-/// Records the bed's fill and settle phases in `out`, flagging the request's `depending`.
+/// Records the bed's fill and settle phases in `out`, flagging the request's `depending`, and
+/// the settled bed's solid fraction and coordination number (series `settled_bed`).
 void add_bed_phases(LabOutput& out, const PistonBed& bed, const PistonBedRequest& request);
 /// Records a servo phase under `name`, flagging `depending` if it did not reach its target.
 void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string& name,
                      const std::vector<std::string>& depending);
-/// Builds the die world, lets `set_laws` replace wall laws (stiffness factor 1), settles relative
-/// to the stress level with the adapted time step, stiffens piston and bottom by the request's
-/// wall_stiffness_factor, adds the piston at the bed top and sets its servo.
+/// Builds the die world, lets `set_laws` replace wall laws, settles relative to the stress level
+/// with the adapted time step, adds the piston at the bed top and sets its servo.
 PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
                           const RunOptions& options);
 
 /// The first checkpoint stage of every piston test: the settled bed with its piston.
 inline constexpr const char* kPistonBedStage = "piston bed";
+
+/// The sampling cylinder of a die bed up to `top`: one largest diameter from die, floor and top.
+metrics::SamplingCylinder bed_sample(const sim::World& world, double die_radius, double top);
 
 /// Throws naming `checkpoint` unless the bed's piston is a disk wall of its world.
 void check_piston(const PistonBed& bed);
@@ -155,8 +157,7 @@ std::size_t start_piston_test(S& stages, const MaterialModel& material,
                               PistonBed& bed, LabOutput& out) {
   if (stages.resuming()) {
     bed.world = make_material_world(material, options);
-    // Every stage runs on the stiffened piston and bottom.
-    if (request.set_laws) request.set_laws(bed.world, request.wall_stiffness_factor);
+    if (request.set_laws) request.set_laws(bed.world);
     const std::size_t next = stages.resume(bed.world);
     check_piston(bed);
     return next;

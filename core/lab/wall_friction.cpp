@@ -34,14 +34,16 @@ LabOutput WallFrictionTest::run(const MaterialModel& material, const Settings& v
                                 const RunOptions& options) {
   const auto s = read_settings<WallFrictionSettings>(values, "settings");
   const double fs = material.factors().stress;
+  const auto piston_spec = stiffen_normal(material.wall_law, s.wall_stiffness_factor);
+  auto bottom_spec = piston_spec;
+  bottom_spec.tangential.params["mu_s"] = s.bottom_friction;
+  const auto piston_law = simulated_law(material, piston_spec);
+  const auto bottom_law = simulated_law(material, bottom_spec);
   const auto& stresses = wall_friction_stresses();
-  const PistonBedRequest request = piston_bed_request(
-      s, stresses.back() * s.stress_factor * fs, [&](sim::World& w, double factor) {
-        const auto piston_spec = stiffen_normal(material.wall_law, factor);
-        auto bottom_spec = piston_spec;
-        bottom_spec.tangential.params["mu_s"] = s.bottom_friction;
-        w.change_wall_law(kWallPiston, 0, simulated_law(material, piston_spec));
-        w.change_wall_law(kWallBottom, 0, simulated_law(material, bottom_spec));
+  const PistonBedRequest request =
+      piston_bed_request(s, stresses.back() * s.stress_factor * fs, [&](sim::World& w) {
+        w.set_wall_law(kWallPiston, 0, piston_law);
+        w.set_wall_law(kWallBottom, 0, bottom_law);
       });
   // The stages: the bed, then each normal stress once turned.
   std::vector<std::string> names{kPistonBedStage};

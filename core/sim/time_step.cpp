@@ -105,10 +105,10 @@ Bounds bounds_over_laws(const World& world) {
   return bounds;
 }
 
-/// kStableFraction x sqrt(m*/k) of the stiffest contact of the last force evaluation
-/// (infinite without contacts).
-double in_use_time_step(const World& world) {
-  return world.contact_rate2 > 0.0 ? kStableFraction / std::sqrt(world.contact_rate2)
+/// safety x sqrt(m*/k) of the stiffest contact of the last force evaluation (infinite without
+/// contacts).
+double in_use_time_step(const World& world, double safety) {
+  return world.contact_rate2 > 0.0 ? safety / std::sqrt(world.contact_rate2)
                                    : std::numeric_limits<double>::infinity();
 }
 
@@ -127,11 +127,12 @@ double recommended_time_step(const World& world, double safety) {
 }
 
 double adapted_time_step(const World& world, double safety) {
-  return std::min(safety * fresh_contact_time_step(world).critical, in_use_time_step(world));
+  return std::min(safety * fresh_contact_time_step(world).critical,
+                  in_use_time_step(world, safety));
 }
 
 double next_time_step(const World& world, bool retune) {
-  const double in_use = in_use_time_step(world);
+  const double in_use = in_use_time_step(world, world.adaptive_safety);
   if (!retune) return std::min(world.dt, in_use);
   return std::min({world.dt * World::kStepGrowth, in_use,
                    world.adaptive_safety * fresh_contact_time_step(world).critical});

@@ -28,25 +28,19 @@ double recommended_time_step(const World& world, double safety);
 /// body's effective mass at the member in its worst normal direction.
 double contact_mass(const particles::ParticleStore& p, std::size_t i);
 
-/// A step so that a contact of stiffness k stays stable: omega dt = kStableFraction, below the
-/// velocity-Verlet limit 2 (sqrt(1 + z^2) - z) of a spring-dashpot at any damping ratio z <= 1
-/// (0.83 at z = 1).
-constexpr double kStableFraction = 0.7;
-
 /// A step for the stiffness in use, as Yade's GlobalStiffnessTimeStepper bounds the step by the
-/// stiffness of the current contacts: accurate for a contact as it forms, safety x
-/// fresh_contact_time_step(), and stable for the stiffest contact of the last force evaluation,
-/// kStableFraction x sqrt(m*/k) (World::contact_rate2). A Luding contact's un-/reloading
-/// stiffness k2* grows with its largest overlap from k1 to k2 (seed 000 eq. 5), so a bed under a
-/// light load needs far less than the law's largest stiffness, and a stiff wall far away does
-/// not count until a particle touches it.
+/// stiffness of the current contacts: safety x sqrt(m*/k) of the stiffest contact of the last
+/// force evaluation (World::contact_rate2), at most safety x fresh_contact_time_step(). A
+/// Luding contact's un-/reloading stiffness k2* grows with its largest overlap from k1 to k2
+/// (seed 000 eq. 5), so a bed under a light load needs far less than the law's largest
+/// stiffness, and a stiff wall that no particle touches does not count.
 double adapted_time_step(const World& world, double safety);
 
 /// The step after a force evaluation of an adaptive world (World::adaptive_safety > 0), with
-/// the safeguards of Yade's GlobalStiffnessTimeStepper: it shrinks at once to kStableFraction x
+/// the safeguards of Yade's GlobalStiffnessTimeStepper: it shrinks at once to safety x
 /// sqrt(m*/k) of the stiffest contact when a contact has stiffened; on a re-tuning step
 /// (`retune`, every World::kRetuneSteps) it may grow, by World::kStepGrowth at most, up to that
-/// bound and to adaptive_safety x fresh_contact_time_step().
+/// bound and to safety x fresh_contact_time_step().
 double next_time_step(const World& world, bool retune);
 
 /// Throws SimulationFailure(kUnstableTimeStep) naming both numbers when a fixed dt exceeds the

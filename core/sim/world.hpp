@@ -26,10 +26,9 @@ class World {
   Vec3 gravity{0.0, 0.0, -9.81};
   double dt = 0.0;  ///< time step (s)
   /// > 0: the step follows the stiffness of the contacts in use (sim::next_time_step): after
-  /// every force evaluation dt shrinks at once to sim::kStableFraction x sqrt(m*/k) of the
-  /// stiffest contact, every kRetuneSteps steps it may grow by kStepGrowth, never beyond
-  /// adaptive_safety x the bound of a fresh contact (sim::fresh_contact_time_step); 0: dt stays
-  /// as set.
+  /// every force evaluation dt shrinks at once to adaptive_safety x sqrt(m*/k) of the stiffest
+  /// contact, every kRetuneSteps steps it may grow by kStepGrowth, never beyond adaptive_safety
+  /// x the bound of a fresh contact (sim::fresh_contact_time_step); 0: dt stays as set.
   double adaptive_safety = 0.0;
   static constexpr int kRetuneSteps = 100;
   static constexpr double kStepGrowth = 1.1;

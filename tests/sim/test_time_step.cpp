@@ -180,7 +180,7 @@ TEST(SimTimeStep, AdaptedStepFollowsTheStiffestContactInUse) {
               1e-12 * std::sqrt(m_light / (f1 * k1)));
   EXPECT_NEAR(sim::adapted_time_step(w, 0.2), 0.2 * std::sqrt(m_light / k1), 1e-15);
   // The small sphere pressed into the floor, its contact's delta_max deeper still: the step is
-  // stable for k2*(delta_max), 0.7 sqrt(m / k2*), whichever branch the contact is on.
+  // 0.2 sqrt(m / k2*(delta_max)), whichever branch the contact is on.
   const double delta = 0.018 * 1e-3, delta_max = 0.02 * 1e-3;  // on the unloading branch
   w.particles.x[0].z = 1e-3 - delta;
   w.prepare();
@@ -189,14 +189,13 @@ TEST(SimTimeStep, AdaptedStepFollowsTheStiffestContactInUse) {
   const double k_in_use = luding.reached_stiffness(2e-3, delta_max);
   EXPECT_GT(k_in_use, k1);
   EXPECT_NEAR(w.contact_rate2, k_in_use / m_light, 1e-9 * k_in_use / m_light);
-  EXPECT_NEAR(sim::adapted_time_step(w, 0.2),
-              std::min(0.2 * std::sqrt(m_light / k1), 0.7 * std::sqrt(m_light / k_in_use)), 1e-15);
+  EXPECT_NEAR(sim::adapted_time_step(w, 0.2), 0.2 * std::sqrt(m_light / k_in_use), 1e-15);
   EXPECT_NE(sim::fresh_contact_time_step(w).basis.find("sqrt(m/k)"), std::string::npos);
 }
 
 TEST(SimTimeStep, StepShrinksAtOnceAndGrowsBackByBoundedSteps) {
   // A Luding sphere thrown onto a Luding floor (no gravity): its contact stiffens from k1
-  // towards k2 as it presses in, and lets go on the rebound. At every step dt <= 0.7 sqrt(m / k)
+  // towards k2 as it presses in, and lets go on the rebound. At every step dt <= 0.2 sqrt(m / k)
   // of the stiffest contact of that step's forces (the shrink is immediate), dt never exceeds
   // 0.2 x the bound of a fresh contact, and it grows only at re-tuning steps, by at most 10 %.
   const double k1 = 1e4, f1 = 100.0;
@@ -221,8 +220,7 @@ TEST(SimTimeStep, StepShrinksAtOnceAndGrowsBackByBoundedSteps) {
     sim::step(w);
     if (w.contact_rate2 > 0.0) {
       touched = true;
-      EXPECT_LE(w.dt, (1.0 + 1e-12) * sim::kStableFraction / std::sqrt(w.contact_rate2))
-          << "step " << s;
+      EXPECT_LE(w.dt, (1.0 + 1e-12) * 0.2 / std::sqrt(w.contact_rate2)) << "step " << s;
     }
     EXPECT_LE(w.dt, (1.0 + 1e-12) * ceiling);
     if (w.dt < before) ++shrinks;
@@ -244,7 +242,7 @@ TEST(SimTimeStep, StepShrinksAtOnceAndGrowsBackByBoundedSteps) {
   EXPECT_GT(w.dt, after_contact);
   EXPECT_LE(w.dt,
             (1.0 + 1e-12) * sim::World::kStepGrowth * sim::World::kStepGrowth * after_contact);
-  sim::run(w, 20 * sim::World::kRetuneSteps);
+  sim::run(w, 30 * sim::World::kRetuneSteps);
   EXPECT_NEAR(w.dt, ceiling, 1e-12 * ceiling);
 }
 
@@ -295,7 +293,7 @@ TEST(SimTimeStep, CohesiveCollisionKeepsItsEnergyBalanceWithTheAdaptedStep) {
 TEST(SimTimeStep, AdaptiveStepsSettleABedAsTheFixedStepDoes) {
   // Twenty Luding spheres dropped on a floor: with the step following the contacts in use, the
   // bed comes to rest at the height the law-maximum step gives, in fewer steps (the drop presses
-  // the contacts well into their plastic range, k2* near k2: the gain is less than f1^(1/2)).
+  // the contacts well into their plastic range, k2* near k2: the gain is small, 15 %).
   const auto luding =
       law({"luding", {{"k1", 200.0}, {"k2_ratio", 16.0}, {"phi_f", 0.05}, {"restitution", 0.3}}});
   auto bed = [&](bool adaptive) {
@@ -319,7 +317,7 @@ TEST(SimTimeStep, AdaptiveStepsSettleABedAsTheFixedStepDoes) {
   const auto [fixed_top, fixed_steps] = bed(false);
   const auto [adapted_top, adapted_steps] = bed(true);
   EXPECT_NEAR(adapted_top, fixed_top, 0.05 * fixed_top);
-  EXPECT_LT(adapted_steps, 0.8 * static_cast<double>(fixed_steps));
+  EXPECT_LT(adapted_steps, 0.9 * static_cast<double>(fixed_steps));
   std::printf("bed top: fixed %.5g m in %lld steps, adapted %.5g m in %lld steps\n", fixed_top,
               static_cast<long long>(fixed_steps), adapted_top,
               static_cast<long long>(adapted_steps));
