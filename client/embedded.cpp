@@ -123,6 +123,9 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
     wo.channel = channel_;
     wo.threads = local.threads;
     wo.id = local.workers == 1 ? "embedded" : "embedded-" + std::to_string(i);
+    // The local workers share the stages runs can start from (docs/lab-tests.md, "Work done
+    // once"), kept beside the campaign's database.
+    wo.stage_cache_dir = (workdir / "stages").string();
     ++running_;
     workers_.emplace_back([this, wo] {
       worker::run_worker(wo, flags_);
