@@ -51,7 +51,7 @@ tests:
 inline std::string tiny_spec(
     int particles, int centre = 0, const std::string& extra_factor = "",
     const std::string& calibration = "calibration: {rounds: 1, stages: 1}\n") {
-  return "name: tiny" + packing_material(particles) + R"(factors:
+  return "\nname: tiny" + packing_material(particles) + R"(factors:
   - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
   - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
 )" + extra_factor +
