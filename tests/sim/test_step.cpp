@@ -120,6 +120,33 @@ TEST(SimStep, ChangedLawOfTheSameModelsKeepsTheContactHistory) {
   EXPECT_TRUE(w.prepared());
 }
 
+TEST(SimStep, ChangedWallLawOfTheSameModelsKeepsEveryContactHistory) {
+  // The two spheres sheared against each other also slide along a floor: a stiffer floor law of
+  // the same models keeps the floor contacts' and the pair's history, and acts at the next step.
+  sim::World w = sheared_pair(sliding_law("none", 0.0));
+  w.set_wall_law(0, 0, sliding_law("none", 0.0));
+  w.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, -0.00099}, {0, 0, 1}}));
+  sim::run(w, 50);
+  ASSERT_GT(history_norm(w), 0.0);
+  const auto pairs = w.pair_history;
+  const auto walls = w.wall_history;
+  sim::World unchanged = w;
+  contact::ContactLawSpec stiff;
+  stiff.normal = {"linear", {{"kn", 3e3}}};
+  stiff.tangential = {"history", {{"mu_s", 0.5}}};
+  w.change_wall_law(0, 0, contact::ContactLaw::from_spec(stiff, "law"));
+  EXPECT_TRUE(w.prepared());
+  EXPECT_EQ(w.pair_history, pairs);
+  EXPECT_EQ(w.wall_history, walls);
+  sim::step(w);
+  sim::step(unchanged);
+  EXPECT_NEAR(w.walls[0].force.z, 3.0 * unchanged.walls[0].force.z,
+              1e-6 * std::abs(unchanged.walls[0].force.z));  // pushed three times as hard
+  // A law of other models starts the history afresh, as set_wall_law.
+  w.change_wall_law(0, 0, sliding_law("van_der_waals", 1e-7));
+  EXPECT_FALSE(w.prepared());
+}
+
 TEST(SimStep, ChangedLawOfOtherModelsStartsTheContactHistoryAfresh) {
   sim::World w = sheared_pair(sliding_law("van_der_waals", 1e-7));
   const double sheared = history_norm(w);  // 50 steps of sliding
