@@ -212,10 +212,7 @@ void World::prepare() {
              pair_history, pair_stride_, clump_bodies());
   balance_owners();
   clump_frames.reset(particles);
-  clump_inverse_mass_.clear();
-  if (particles.clumps.size())
-    for (std::size_t i = 0; i < particles.size(); ++i)
-      clump_inverse_mass_.push_back(1.0 / contact_mass(particles, i));
+  set_contact_masses();
   wall_history.assign(walls.size(), {});
   for (std::size_t w = 0; w < walls.size(); ++w)
     wall_history[w].assign(particles.size() * wall_strides_[w], 0.0);
@@ -224,6 +221,13 @@ void World::prepare() {
   // The forces of this configuration, for the first half kick of the next step: step() relies on
   // them whether it called prepare() itself or the caller did.
   compute_forces(*this);
+}
+
+void World::set_contact_masses() {
+  clump_inverse_mass_.clear();
+  if (particles.clumps.size())
+    for (std::size_t i = 0; i < particles.size(); ++i)
+      clump_inverse_mass_.push_back(1.0 / contact_mass(particles, i));
 }
 
 void World::remove_particles(const std::vector<char>& flags) {

@@ -162,6 +162,9 @@ class World {
 
  private:
   void grow_law_tables(int n);
+  /// The inverse contact masses of the clump members (contact_inverse_mass), for the particles
+  /// as they are.
+  void set_contact_masses();
   /// Why the arrays of a restored state do not fit together (empty: they do).
   std::string state_mismatch() const;
   /// The state save_state writes and restore_state reads, handed to `a.field` in record order

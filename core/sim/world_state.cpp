@@ -183,6 +183,7 @@ void World::restore_state(std::string_view state) {
   if (const std::string why = w.state_mismatch(); !why.empty()) throw InputError("checkpoint", why);
   w.deferred.clear();
   w.balance_owners();
+  w.set_contact_masses();
   *this = std::move(w);
 }
 
