@@ -35,6 +35,20 @@ struct NormalResult {
   double k_step = 0.0;
 };
 
+namespace normal {
+/// Whether the time step resolves a contact of normal model N at its stiffness in use
+/// (NormalResult::k_step; true unless N says otherwise with kAccuracyFromOwnBound): the step of a
+/// Hertz contact is accurate by the Rayleigh time (seed 000 eq. 1) as it is in common practice,
+/// and its tangent stiffness only has to stay stable (sim/time_step.hpp).
+template <class N>
+constexpr bool stiffness_sets_accuracy() {
+  if constexpr (requires { N::kAccuracyFromOwnBound; })
+    return !N::kAccuracyFromOwnBound;
+  else
+    return true;
+}
+}  // namespace normal
+
 struct PairOutput {
   double fn = 0.0;         ///< total normal force, > 0 repulsive (N)
   double stiffness = 0.0;  ///< NormalResult::k_step of a contact; 0 out of contact (N/m)

@@ -27,6 +27,18 @@ TypedLaw<N, C, T, R> typed(const contact::ContactLaw& law) {
           std::get<R>(law.rolling)};
 }
 
+/// The largest k / m* of a thread's contacts (World::contact_rate2 and contact_stable_rate2):
+/// kept in `accurate` for the normal models whose step resolves the stiffness in use, in
+/// `stable` for those whose accuracy comes from a bound of their own (Hertz: the Rayleigh time).
+struct Rates {
+  double accurate = 0.0, stable = 0.0;
+  template <class N>
+  void add(double k_over_m) {
+    double& rate = contact::normal::stiffness_sets_accuracy<N>() ? accurate : stable;
+    rate = std::max(rate, k_over_m);
+  }
+};
+
 /// A force and a torque, e.g. the particles' push on a wall.
 struct Wrench {
   Vec3 force, torque;
@@ -35,7 +47,7 @@ struct Wrench {
 /// Adds the contact forces of wall `wall_index` to the particles [lo, hi) and their reaction to
 /// `on_wall`.
 template <class N, class C, class T, class R>
-void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wall, double& rate2,
+void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wall, Rates& rates,
                  const N&, const C&, const T&, const R&) {
   using Law = TypedLaw<N, C, T, R>;
   constexpr int kStride = contact::History<N, C, T, R>::kSize;
@@ -71,7 +83,7 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
       in.dt = w.dt;
       const contact::PairOutput out = laws[p.material[i]].evaluate(in, h);
       if (out.stiffness > 0.0)
-        rate2 = std::max(rate2, out.stiffness * (inverse_mass ? inverse_mass[i] : 1.0 / in.m_star));
+        rates.add<N>(out.stiffness * (inverse_mass ? inverse_mass[i] : 1.0 / in.m_star));
       p.f[i] += out.force;
       p.torque[i] += out.torque_i;
       wf -= out.force;
@@ -152,11 +164,11 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
   }
 }
 
-void add_wall_forces(World& w, std::size_t k, int lo, int hi, Wrench& on_wall, double& rate2) {
+void add_wall_forces(World& w, std::size_t k, int lo, int hi, Wrench& on_wall, Rates& rates) {
   const int m0 = w.particles.material[0];
   contact::visit(w.wall_law(w.walls[k].material, m0),
                  [&](const auto& n, const auto& c, const auto& t, const auto& r) {
-                   wall_kernel(w, k, lo, hi, on_wall, rate2, n, c, t, r);
+                   wall_kernel(w, k, lo, hi, on_wall, rates, n, c, t, r);
                  });
 }
 
@@ -193,8 +205,8 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
   const int threads = w.active_threads();
   // Each wall's force and torque, per thread, summed in thread order after the region.
   std::vector<std::vector<Wrench>> on_walls(w.walls.size(), std::vector<Wrench>(threads));
-  // Each thread's largest k / m* of a contact (World::contact_rate2).
-  std::vector<double> rates(threads, 0.0);
+  // Each thread's largest k / m* of its contacts.
+  std::vector<Rates> rates(threads);
   const double* inverse_mass = w.contact_inverse_mass();
 
   if (static_cast<int>(w.deferred.size()) != threads) w.deferred.assign(threads, {});
@@ -209,7 +221,7 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
     const auto [lo, hi] = w.owned_range(tid);
     auto& deferred = w.deferred[tid];
     deferred.clear();
-    double rate2 = 0.0;
+    Rates rate;
     for (int i = lo; i < hi; ++i) {
       // A clump's weight acts at its centre of mass (rigid_body.hpp), not through its members.
       p.f[i] = p.motion[i] == particles::Motion::kClumpMember ? Vec3{} : w.gravity * p.mass[i];
@@ -235,8 +247,8 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
             d, std::sqrt(dist2), ri, rj, mi, p.mass[j], vi, p.v[j], wi, p.omega[j], dt);
         const contact::PairOutput out = law_row[p.material[j]].evaluate(in, h);
         if (out.stiffness > 0.0)
-          rate2 = std::max(rate2, out.stiffness * (inverse_mass ? inverse_mass[i] + inverse_mass[j]
-                                                                : 1.0 / in.m_star));
+          rate.add<N>(out.stiffness *
+                      (inverse_mass ? inverse_mass[i] + inverse_mass[j] : 1.0 / in.m_star));
         fi += out.force;
         ti += out.torque_i;
         if (j < hi) {
@@ -257,12 +269,16 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
           p.torque[c.particle] += c.torque;
         }
     for (std::size_t k = 0; k < w.walls.size(); ++k)
-      add_wall_forces(w, k, lo, hi, on_walls[k][tid], rate2);
-    rates[tid] = rate2;
+      add_wall_forces(w, k, lo, hi, on_walls[k][tid], rate);
+    rates[tid] = rate;
     if (after) after(lo, hi);
   }
   for (std::size_t k = 0; k < w.walls.size(); ++k) sum_wall_wrench(w.walls[k], on_walls[k]);
-  w.contact_rate2 = *std::max_element(rates.begin(), rates.end());
+  w.contact_rate2 = w.contact_stable_rate2 = 0.0;
+  for (const Rates& r : rates) {
+    w.contact_rate2 = std::max(w.contact_rate2, r.accurate);
+    w.contact_stable_rate2 = std::max(w.contact_stable_rate2, r.stable);
+  }
 }
 
 }  // namespace
@@ -270,7 +286,7 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
 void compute_forces(World& world, const OwnedRangeTask& after) {
   if (world.particles.size() == 0) {
     for (auto& wall : world.walls) wall.force = wall.torque = {};
-    world.contact_rate2 = 0.0;
+    world.contact_rate2 = world.contact_stable_rate2 = 0.0;
     return;
   }
   world.refresh_wall_reach();

@@ -105,11 +105,17 @@ Bounds bounds_over_laws(const World& world) {
   return bounds;
 }
 
-/// safety x sqrt(m*/k) of the stiffest contact of the last force evaluation (infinite without
-/// contacts).
+/// safety x sqrt(m*/k) of the stiffest contact of the last force evaluation whose stiffness
+/// sets the accuracy, kStableFraction x sqrt(m*/k) of the stiffest of the others (infinite
+/// without contacts).
 double in_use_time_step(const World& world, double safety) {
-  return world.contact_rate2 > 0.0 ? safety / std::sqrt(world.contact_rate2)
-                                   : std::numeric_limits<double>::infinity();
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  const double accurate =
+      world.contact_rate2 > 0.0 ? safety / std::sqrt(world.contact_rate2) : kNone;
+  const double stable = world.contact_stable_rate2 > 0.0
+                            ? kStableFraction / std::sqrt(world.contact_stable_rate2)
+                            : kNone;
+  return std::min(accurate, stable);
 }
 
 }  // namespace

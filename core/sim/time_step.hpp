@@ -28,9 +28,16 @@ double recommended_time_step(const World& world, double safety);
 /// body's effective mass at the member in its worst normal direction.
 double contact_mass(const particles::ParticleStore& p, std::size_t i);
 
+/// omega dt of a contact the step keeps stable without resolving it: below the velocity-Verlet
+/// limit 2 (sqrt(1 + z^2) - z) of a spring-dashpot at any damping ratio z <= 1 (0.83 at z = 1).
+constexpr double kStableFraction = 0.7;
+
 /// A step for the stiffness in use, as Yade's GlobalStiffnessTimeStepper bounds the step by the
 /// stiffness of the current contacts: safety x sqrt(m*/k) of the stiffest contact of the last
-/// force evaluation (World::contact_rate2), at most safety x fresh_contact_time_step(). A
+/// force evaluation (World::contact_rate2), at most safety x fresh_contact_time_step(); a Hertz
+/// contact, whose accuracy the Rayleigh time of fresh_contact_time_step() sets as in common
+/// practice (0.1-0.3 of it), only has to stay stable: kStableFraction x sqrt(m*/k) at its tangent
+/// stiffness (World::contact_stable_rate2). A
 /// Luding contact's un-/reloading stiffness k2* grows with its largest overlap from k1 to k2
 /// (seed 000 eq. 5), so a bed under a light load needs far less than the law's largest
 /// stiffness, and a stiff wall that no particle touches does not count.

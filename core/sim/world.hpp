@@ -27,8 +27,9 @@ class World {
   double dt = 0.0;  ///< time step (s)
   /// > 0: the step follows the stiffness of the contacts in use (sim::next_time_step): after
   /// every force evaluation dt shrinks at once to adaptive_safety x sqrt(m*/k) of the stiffest
-  /// contact, every kRetuneSteps steps it may grow by kStepGrowth, never beyond adaptive_safety
-  /// x the bound of a fresh contact (sim::fresh_contact_time_step); 0: dt stays as set.
+  /// contact (sim::kStableFraction x for a Hertz contact), every kRetuneSteps steps it may grow
+  /// by kStepGrowth, never beyond adaptive_safety x the bound of a fresh contact
+  /// (sim::fresh_contact_time_step); 0: dt stays as set.
   double adaptive_safety = 0.0;
   static constexpr int kRetuneSteps = 100;
   static constexpr double kStepGrowth = 1.1;
@@ -37,6 +38,9 @@ class World {
   /// moves (the reduced mass of a pair, the particle's at a wall; for clump members, with the
   /// bodies' effective masses, sim::contact_mass).
   double contact_rate2 = 0.0;
+  /// The same for the contacts whose normal model sets the step's accuracy by a bound of its own
+  /// (contact::normal::stiffness_sets_accuracy: Hertz), which the step only keeps stable.
+  double contact_stable_rate2 = 0.0;
   /// 1 / sim::contact_mass of each particle when there are clumps (set by prepare()), else null:
   /// the force kernel then takes 1 / m* of the pair.
   const double* contact_inverse_mass() const {

@@ -193,6 +193,33 @@ TEST(SimTimeStep, AdaptedStepFollowsTheStiffestContactInUse) {
   EXPECT_NE(sim::fresh_contact_time_step(w).basis.find("sqrt(m/k)"), std::string::npos);
 }
 
+TEST(SimTimeStep, AHertzContactBoundsTheStepOnlyForStability) {
+  // The Rayleigh time sets a Hertz step's accuracy (0.2 of it here); the tangent stiffness of a
+  // contact pressed deep enough bounds it at 0.7 sqrt(m* / k), at once.
+  const double y = 1e7, nu = 0.3;
+  const auto hertz = law({"hertz", {{"youngs_modulus", y}, {"poisson_ratio", nu}}});
+  sim::World w = two_spheres(hertz, hertz);
+  w.dt = 1e-7;
+  w.prepare();
+  const double rayleigh = sim::fresh_contact_time_step(w).critical;
+  EXPECT_NEAR(sim::adapted_time_step(w, 0.2), 0.2 * rayleigh, 1e-15);
+  const double m_light = 2500 * 4.0 / 3.0 * M_PI * 1e-9;
+  for (const double delta : {1e-7, 1e-4}) {
+    w.particles.x[0].z = 1e-3 - delta;
+    w.prepare();
+    const auto& model = std::get<contact::normal::Hertz>(hertz.normal);
+    const double k = 2.0 * model.y_star * std::sqrt(1e-3 * delta);  // R* = r at a wall
+    EXPECT_EQ(w.contact_rate2, 0.0);
+    EXPECT_NEAR(w.contact_stable_rate2, k / m_light, 1e-9 * k / m_light);
+    EXPECT_NEAR(sim::adapted_time_step(w, 0.2),
+                std::min(0.2 * rayleigh, sim::kStableFraction * std::sqrt(m_light / k)), 1e-15);
+  }
+  // Stability binds only for a coarse step: 10 % of the radius deep, 0.7 sqrt(m* / k) is 0.44
+  // of the Rayleigh time, so at safety 0.2 the Rayleigh time sets the step, at 0.6 the contact.
+  EXPECT_NEAR(sim::adapted_time_step(w, 0.2), 0.2 * rayleigh, 1e-15);
+  EXPECT_LT(sim::adapted_time_step(w, 0.6), 0.5 * rayleigh);
+}
+
 TEST(SimTimeStep, StepShrinksAtOnceAndGrowsBackByBoundedSteps) {
   // A Luding sphere thrown onto a Luding floor (no gravity): its contact stiffens from k1
   // towards k2 as it presses in, and lets go on the rebound. At every step dt <= 0.2 sqrt(m / k)

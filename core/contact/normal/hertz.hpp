@@ -17,6 +17,8 @@ namespace demcal::contact::normal {
 struct Hertz {
   static constexpr const char* kName = "hertz";
   static constexpr int kHistory = 0;
+  /// The step's accuracy comes from the Rayleigh time; k_step only bounds its stability.
+  static constexpr bool kAccuracyFromOwnBound = true;
 
   double youngs_modulus;   ///< Y (Pa)
   double poisson_ratio;    ///< nu (-)
