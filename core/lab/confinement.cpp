@@ -66,13 +66,18 @@ std::optional<PistonBed> cached_conditioned_bed(const MaterialModel& material,
   bed.world = make_material_world(material, options);
   const PistonBedRequest request = confinement_request(material, s);
   request.set_laws(bed.world);
-  ByteReader in(*record, "stage cache");
-  std::string state;
-  in.get(state);
-  bed.world.restore_state(state);
-  in.field(bed);
-  in.expect_end();
-  check_piston(bed);
+  // A record this build cannot read (another build's layout) counts as absent.
+  try {
+    ByteReader in(*record, "stage cache");
+    std::string state;
+    in.get(state);
+    bed.world.restore_state(state);
+    in.field(bed);
+    in.expect_end();
+    check_piston(bed);
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
   return bed;
 }
 

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <memory>
 
+#include "core/lab/confinement.hpp"
 #include "core/lab/lab_test.hpp"
 #include "core/lab/stage_cache.hpp"
 #include "core/model/tensile_settings.hpp"
@@ -76,6 +77,12 @@ TEST(Tensile, StartsFromTheBedAConfinedCompressionConditionedToTheBit) {
   std::vector<std::string> phases;
   for (const auto& p : reused.cost.phases) phases.push_back(p.name);
   EXPECT_EQ(phases, (std::vector<std::string>{"unload", "pull"}));
+  // A record this build cannot read counts as absent: the bed is conditioned afresh.
+  const auto cs = read_settings<ConfinedCompressionSettings>(conditioning(), "settings");
+  cached.stage_cache->keep(conditioned_bed_identity(m, cs, cached), "not a bed");
+  const LabOutput unreadable = run_lab_test("tensile", m, small(), cached);
+  EXPECT_EQ(unreadable.metrics.at("tensile_strength"), alone.metrics.at("tensile_strength"));
+  EXPECT_EQ(steps_of(unreadable), steps_of(alone));
   // Another seed is another bed: conditioned afresh, the same as without the cache.
   RunOptions other = cached;
   other.seed = 2;
