@@ -79,8 +79,11 @@ struct Luding {
   /// the un-/reloading k2*(delta_max) of eq. 5 or the adhesive kc. Under a light load k2* stays
   /// near k1, a step bounded by k2 alone would be f1^(1/2) times shorter than the contacts need.
   double reached_stiffness(double r_eff, double delta_max) const {
-    const double kl = loading_stiffness(r_eff);
-    const double k2 = kl + (k2_ratio - 1.0) * kl * std::min(1.0, delta_max / plastic_limit(r_eff));
+    return reached_stiffness(loading_stiffness(r_eff), delta_max, plastic_limit(r_eff));
+  }
+  /// The same from the pair's k1 and delta*_max, as the force law has them at hand.
+  double reached_stiffness(double kl, double delta_max, double delta_lim) const {
+    const double k2 = kl + (k2_ratio - 1.0) * kl * std::min(1.0, delta_max / delta_lim);
     return std::max(k2, kc_ratio * kl);
   }
   double damping(double m_star, double k) const {
@@ -125,7 +128,7 @@ struct Luding {
     r.gamma_n = damping(in.m_star, kl);
     r.fn = f_hys + r.gamma_n * in.vn;
     r.f_adhesive = kc * delta;
-    r.k_step = reached_stiffness(r_eff, delta_max);
+    r.k_step = reached_stiffness(kl, delta_max, delta_lim);
     return r;
   }
 
