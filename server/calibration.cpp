@@ -8,6 +8,7 @@
 #include <set>
 #include <string_view>
 
+#include "core/calib/multi_fidelity.hpp"
 #include "core/common/error.hpp"
 #include "server/analysis.hpp"
 #include "server/convert.hpp"
@@ -32,6 +33,10 @@ struct Loaded {
   calib::SequentialState state;
   calib::SequentialOptions options;
   bool pending = false;  ///< calibration jobs queued or leased
+  /// Multi-fidelity campaigns: per calibrated response, its high level from its low one, and
+  /// the high values of the design rows run at both levels.
+  std::vector<calib::FidelityModel> fidelity;
+  Eigen::MatrixXd low, high;
 };
 
 /// The polynomial models the calibration fits: main or 2fi (two-level designs).
@@ -75,6 +80,13 @@ std::optional<Eigen::VectorXd> round_values(const Loaded& l, const std::vector<i
   return v;
 }
 
+/// Particles x steps of a run's cost block (0 when it has none).
+double particle_steps(const std::string& cost_json) {
+  v1::RunCost cost;
+  from_json(cost_json, cost);
+  return static_cast<double>(cost.particles()) * static_cast<double>(cost.steps());
+}
+
 std::string box_to_json(const std::vector<doe::Factor>& box) {
   nlohmann::json j = nlohmann::json::array();
   for (const auto& f : box) j.push_back({{"low", f.low}, {"high", f.high}});
@@ -110,6 +122,39 @@ calib::StageRuns stage_runs(const Loaded& l, const std::vector<int>& columns,
   return st;
 }
 
+/// Multi-fidelity: the design's responses at the high level (fidelity models fitted on the rows
+/// run at both levels, multi_fidelity.hpp) in place of the low level's.
+void correct_design(Loaded& l) {
+  auto& st = l.state.stages.front();
+  l.low = st.responses;
+  l.high = Eigen::MatrixXd(st.responses.rows(), st.responses.cols());
+  const Eigen::MatrixXd high = response_matrix(l.plan, l.jobs, kHighDesignKind);
+  for (std::size_t m = 0; m < l.responses.size(); ++m) {
+    const Eigen::VectorXd low = st.responses.col(Eigen::Index(m));
+    l.high.col(Eigen::Index(m)) = high.col(column_of(l.plan, l.responses[m]));
+    const double noise = analyse(l.plan, low, l.options.model, 0.05).noise.sd;
+    const auto& model = l.fidelity.emplace_back(l.responses[m], st.coded, low,
+                                                l.high.col(Eigen::Index(m)), noise,
+                                                calib::GpOptions{8, l.options.calibration.seed});
+    st.responses.col(Eigen::Index(m)) = model.corrected(st.coded, low, l.high.col(Eigen::Index(m)));
+  }
+}
+
+/// A later stage's design, run at the low level, corrected to the high level with the models
+/// of the campaign's design.
+void correct_stage(const Loaded& l, calib::StageRuns& stage) {
+  for (Eigen::Index r = 0; r < stage.coded.rows(); ++r) {
+    Eigen::VectorXd x(stage.coded.cols());
+    for (Eigen::Index f = 0; f < x.size(); ++f)
+      x(f) = l.state.factors[std::size_t(f)].to_coded(
+          stage.box[std::size_t(f)].to_natural(stage.coded(r, f)));
+    for (std::size_t m = 0; m < l.fidelity.size(); ++m) {
+      double& y = stage.responses(r, Eigen::Index(m));
+      if (std::isfinite(y)) y = l.fidelity[m].correct(x, y);
+    }
+  }
+}
+
 /// The calibrated targets with the run-to-run noise of their metrics, from the campaign's
 /// design (pure error of its repeated points, else Lenth's PSE).
 void add_targets(Loaded& l) {
@@ -123,9 +168,14 @@ void add_targets(Loaded& l) {
       throw InputError(t.response, "only " + std::to_string(finite) +
                                        " design runs have a result; the campaign must run first");
     const doe::ResponseAnalysis a = analyse(l.plan, col, l.options.model, 0.05);
-    l.state.targets.push_back({t.response, t.value, t.weight, t.uncertainty, a.noise.sd});
+    const double correction =
+        l.fidelity.empty() ? 0.0
+                           : l.fidelity[m].mean_correction_sd(l.state.stages.front().coded,
+                                                              l.low.col(Eigen::Index(m)),
+                                                              l.high.col(Eigen::Index(m)));
+    l.state.targets.push_back(
+        {t.response, t.value, t.weight, t.uncertainty, a.noise.sd, correction});
     l.noise_df.push_back(a.noise.degrees_of_freedom);
-    l.responses.push_back(t.response);
     ++m;
   }
 }
@@ -145,7 +195,10 @@ Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& re
     throw InputError("spec.measurements", "the campaign has no measurements to calibrate against");
   std::vector<int> columns;
   for (const auto& t : l.plan.targets)
-    if (!t.holdout) columns.push_back(column_of(l.plan, t.response));
+    if (!t.holdout) {
+      columns.push_back(column_of(l.plan, t.response));
+      l.responses.push_back(t.response);
+    }
   if (columns.empty())
     throw InputError("spec.measurements", "every measurement is held out: nothing to calibrate");
   auto& s = l.state;
@@ -153,10 +206,13 @@ Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& re
   for (const auto& f : l.plan.factors) s.factors.push_back(f.factor);
   s.jobs_per_point = std::max(1, l.spec.tests_size());
   s.stages.push_back(stage_runs(l, columns, s.factors, "design"));
+  if (l.plan.fidelity) correct_design(l);
   add_targets(l);
-  for (const auto& st : store.calibration_stages(row.id))
+  for (const auto& st : store.calibration_stages(row.id)) {
     s.stages.push_back(stage_runs(l, columns, box_from_json(l.plan, st.box_json),
                                   std::string(kStagePrefix) + std::to_string(st.stage)));
+    if (l.plan.fidelity) correct_stage(l, s.stages.back());
+  }
   for (const auto& r : l.round_rows) {
     const auto j = nlohmann::json::parse(r.proposal_json);
     s.rounds.push_back({r.stage, vector_of(j.at("natural")), vector_of(j.at("predicted")),
@@ -293,7 +349,8 @@ std::vector<std::int64_t> queue_rounds(Store& store, const CampaignRow& row, con
     std::map<std::string, double> parameters;
     for (std::size_t f = 0; f < l.plan.factors.size(); ++f)
       parameters[l.plan.factors[f].path] = d.batch[b](Eigen::Index(f));
-    const auto jobs = jobs_at(l.spec, l.spec.material(), parameters, round, "verify",
+    const auto jobs = jobs_at(at_fidelity(l.spec, l.plan, true), l.spec.material(), parameters,
+                              round, "verify",
                               pinned ? 0 : kVerifySeedOffset + std::uint64_t(round));
     const auto queued = store.add_calibration_round(
         row.id,
@@ -313,10 +370,33 @@ std::vector<std::int64_t> queue_stage(Store& store, const CampaignRow& row, cons
   std::vector<PlannedFactor> box = l.plan.factors;
   for (std::size_t f = 0; f < box.size(); ++f) box[f].factor = d.next_box[f];
   const auto jobs =
-      design_jobs(l.spec, l.plan, box, std::string(kStagePrefix) + std::to_string(stage),
+      design_jobs(at_fidelity(l.spec, l.plan, false), l.plan, box,
+                  std::string(kStagePrefix) + std::to_string(stage),
                   (stage - 1) * l.plan.design.runs());
   spdlog::info("campaign {}: calibration stage {} queued ({} jobs)", row.id, stage, jobs.size());
   return store.add_calibration_stage(row.id, {stage, box_to_json(d.next_box), now_seconds()}, jobs);
+}
+
+void add_fidelity(v1::CalibrateReply& reply, const Loaded& l) {
+  for (std::size_t m = 0; m < l.fidelity.size(); ++m) {
+    const auto& model = l.fidelity[m];
+    auto* o = reply.add_fidelity();
+    o->set_response(l.responses[m]);
+    o->set_model(calib::to_string(model.form()));
+    o->set_rho(model.rho());
+    o->set_mean_bias(model.mean_bias());
+    o->set_correction_sd(l.state.targets[m].correction_sd);
+    o->set_pairs(model.pairs());
+    o->set_statement(model.statement());
+    for (Eigen::Index r = 0; r < l.high.rows(); ++r) {
+      if (!std::isfinite(l.high(r, Eigen::Index(m))) || !std::isfinite(l.low(r, Eigen::Index(m))))
+        continue;
+      o->add_rows(static_cast<int>(r) + 1);
+      o->add_low(l.low(r, Eigen::Index(m)));
+      o->add_high(l.high(r, Eigen::Index(m)));
+    }
+  }
+  *reply.mutable_fidelity_cost() = fidelity_cost(l.plan, l.jobs);
 }
 
 std::string running_conclusion(const Loaded& l) {
@@ -327,6 +407,30 @@ std::string running_conclusion(const Loaded& l) {
 }
 
 }  // namespace
+
+v1::FidelityCost fidelity_cost(const CampaignPlan& plan, const std::vector<JobRow>& jobs) {
+  v1::FidelityCost c;
+  for (const auto& j : jobs) {
+    if (j.state != "done") continue;
+    const double ps = particle_steps(j.cost_json);
+    if (j.kind == "design" || j.kind.starts_with(kStagePrefix)) {
+      c.set_low_particle_steps(c.low_particle_steps() + ps);
+      c.set_low_jobs(c.low_jobs() + 1);
+    } else if (j.kind == kHighDesignKind) {
+      c.set_high_particle_steps(c.high_particle_steps() + ps);
+      c.set_high_jobs(c.high_jobs() + 1);
+    } else if (is_calibration_job(j)) {
+      c.set_verify_particle_steps(c.verify_particle_steps() + ps);
+      c.set_verify_jobs(c.verify_jobs() + 1);
+    }
+  }
+  if (c.high_jobs() > 0) {
+    const double per_row = static_cast<double>(plan.tests.size()) * c.high_particle_steps() /
+                           static_cast<double>(c.high_jobs());
+    c.set_all_high_particle_steps(per_row * plan.design.runs());
+  }
+  return c;
+}
 
 calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
                                              const std::string& where) {
@@ -369,6 +473,7 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
     reply.set_conclusion(running_conclusion(l));
     if (!l.state.rounds.empty()) set_proposed(reply, l, l.state.rounds.back().natural);
     add_metrics(reply, l, nullptr);
+    if (l.plan.fidelity) add_fidelity(reply, l);
     return reply;
   }
   const calib::SequentialDecision d = calib::next_step(l.state, l.options);
@@ -389,6 +494,7 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
   }
   add_intervals(reply, l, d.proposal);
   add_trade_offs(reply, l, d.proposal);
+  if (l.plan.fidelity) add_fidelity(reply, l);
   std::vector<std::int64_t> queued;
   if (request.verify() && d.step == calib::NextStep::kVerify)
     queued = queue_rounds(store, row, l, d);

@@ -8,6 +8,7 @@
 
 #include "core/calib/sequential.hpp"
 #include "demcal/v1/campaign.pb.h"
+#include "server/plan.hpp"
 #include "server/store.hpp"
 
 namespace demcal::server {
@@ -21,6 +22,11 @@ calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
 /// InputError when there is nothing to calibrate yet (no measurements, design unfinished).
 v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
                                       const v1::CalibrateRequest& request);
+
+/// Particle-steps of a multi-fidelity campaign's finished jobs by level (design and stages at
+/// the low level, the design's high rows, the calibration's verifications at the high level),
+/// and the design at the high level in every row, from the high jobs' mean.
+v1::FidelityCost fidelity_cost(const CampaignPlan& plan, const std::vector<JobRow>& jobs);
 
 /// The stored rounds with their simulated values so far (status and export).
 std::vector<v1::CalibrationRound> calibration_rounds(Store& store, const CampaignRow& row);

@@ -8,10 +8,12 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include "core/common/error.hpp"
 #include "core/doe/alias_structure.hpp"
 #include "core/doe/minimum_aberration.hpp"
+#include "core/doe/nested_fraction.hpp"
 #include "core/model/catalog.hpp"
 #include "rpc/effects_convert.hpp"
 #include "rpc/material_convert.hpp"
@@ -336,7 +338,122 @@ void plan_targets(const v1::CampaignSpec& spec, CampaignPlan& plan) {
   }
 }
 
+constexpr std::string_view kSettingsPrefix = "settings.";
+
+/// Whether a test instance has the fidelity axis's setting.
+bool has_setting(const v1::LabTest& t, const std::string& name) {
+  const auto& info = lab::find_lab_info(t.test());
+  return std::any_of(info.settings.begin(), info.settings.end(),
+                     [&](const contact::ParamDoc& d) { return d.name == name; });
+}
+
+/// A fidelity level of a test setting: every instance that has the setting takes the value,
+/// checked against the setting's range and the instance's size limit.
+void check_setting_level(const v1::CampaignSpec& spec, const std::string& name, double value,
+                         const std::string& where) {
+  int users = 0;
+  for (int i = 0; i < spec.tests_size(); ++i) {
+    const auto& t = spec.tests(i);
+    if (!has_setting(t, name)) continue;
+    ++users;
+    lab::Settings settings = rpc::to_settings(t.settings());
+    settings[name] = value;
+    try {
+      lab::validate_settings(lab::find_lab_info(t.test()), settings, "settings");
+      lab::check_size(t.test(), instance_model(spec, t, where), settings, "settings");
+    } catch (const InputError& e) {
+      throw InputError(where, "test '" + instance_name(t) + "': " + e.where() + ": " + e.message());
+    }
+  }
+  if (users == 0)
+    throw InputError("spec.fidelity.path", "no test of the campaign has the setting '" + name + "'");
+}
+
+/// The high rows the coordinator chooses: the first centre point, and the smallest fraction
+/// nested in the design that still estimates every main effect when it is smaller than the
+/// design (else the centre point alone; a design without centre points: that fraction).
+std::vector<int> default_high_rows(const doe::Design& d) {
+  const std::vector<int> fraction = doe::nested_fraction(d, d.factors() + 1);
+  std::vector<int> rows;
+  int factorial = 0, centre = -1;
+  for (int r = 0; r < d.runs(); ++r) {
+    const auto type = d.point_type[std::size_t(r)];
+    if (type == doe::PointType::kFactorial && d.replicate[std::size_t(r)] == 1) ++factorial;
+    if (type == doe::PointType::kCentre && centre < 0) centre = r;
+  }
+  if (centre < 0 || static_cast<int>(fraction.size()) < factorial)
+    for (const int r : fraction) rows.push_back(r + 1);
+  if (centre >= 0) rows.push_back(centre + 1);
+  return rows;
+}
+
+std::vector<int> planned_high_rows(const v1::Fidelity& f, const doe::Design& d) {
+  if (f.high_rows().empty()) return default_high_rows(d);
+  std::set<int> seen;
+  for (int i = 0; i < f.high_rows_size(); ++i) {
+    const int r = f.high_rows(i);
+    const std::string where = "spec.fidelity." + idx("high_rows", i);
+    if (r < 1 || r > d.runs())
+      throw InputError(where, std::to_string(r) + " is not a design row (1.." +
+                                  std::to_string(d.runs()) + ", standard order)");
+    if (!seen.insert(r).second) throw InputError(where, "row " + std::to_string(r) + " twice");
+  }
+  return {f.high_rows().begin(), f.high_rows().end()};
+}
+
+/// The fidelity axis: a test setting or a material parameter no factor, tie or fixed value sets,
+/// two distinct finite levels inside its range, the high rows, and the jobs they add.
+void plan_fidelity(const v1::CampaignSpec& spec, const lab::MaterialModel& model,
+                   CampaignPlan& plan) {
+  if (!spec.has_fidelity()) return;
+  const auto& f = spec.fidelity();
+  if (f.path().empty()) throw InputError("spec.fidelity.path", "missing");
+  if (!std::isfinite(f.low())) throw InputError("spec.fidelity.low", "must be finite");
+  if (!std::isfinite(f.high())) throw InputError("spec.fidelity.high", "must be finite");
+  if (f.low() == f.high())
+    throw InputError("spec.fidelity.high", "must differ from low (" + fmt(f.low()) + ")");
+  if (f.path().starts_with(kSettingsPrefix)) {
+    const std::string name = f.path().substr(kSettingsPrefix.size());
+    check_setting_level(spec, name, f.low(), "spec.fidelity.low");
+    check_setting_level(spec, name, f.high(), "spec.fidelity.high");
+  } else {
+    lab::require_parameter(model, f.path(), "spec.fidelity.path");
+    for (const auto& factor : spec.factors()) {
+      const bool tied = std::find(factor.tied().begin(), factor.tied().end(), f.path()) !=
+                        factor.tied().end();
+      if (factor.path() == f.path() || tied)
+        throw InputError("spec.fidelity.path", "'" + f.path() + "' is also a factor or a tie");
+    }
+    if (spec.fixed().count(f.path()))
+      throw InputError("spec.fidelity.path", "'" + f.path() + "' is also in spec.fixed");
+    lab::with_parameters(model, {{f.path(), f.low(), "spec.fidelity.low"},
+                                 {f.path(), f.high(), "spec.fidelity.high"}});
+  }
+  plan.fidelity = FidelityPlan{f.path(), f.low(), f.high(), planned_high_rows(f, plan.design)};
+  const long jobs = static_cast<long>(plan.design.runs() + plan.fidelity->high_rows.size()) *
+                    std::max(1, spec.tests_size());
+  if (jobs > kMaxCampaignJobs)
+    throw InputError("spec.fidelity.high_rows",
+                     std::to_string(jobs) + " jobs with the high rows; at most " +
+                         std::to_string(kMaxCampaignJobs) + " per campaign");
+}
+
 }  // namespace
+
+v1::CampaignSpec at_fidelity(const v1::CampaignSpec& spec, const CampaignPlan& plan, bool high) {
+  if (!plan.fidelity) return spec;
+  const FidelityPlan& f = *plan.fidelity;
+  const double value = high ? f.high : f.low;
+  v1::CampaignSpec out = spec;
+  if (!f.path.starts_with(kSettingsPrefix)) {
+    (*out.mutable_fixed())[f.path] = value;
+    return out;
+  }
+  const std::string name = f.path.substr(kSettingsPrefix.size());
+  for (auto& t : *out.mutable_tests())
+    if (has_setting(t, name)) (*t.mutable_settings())[name] = value;
+  return out;
+}
 
 CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs) {
   CampaignPlan plan;
@@ -348,21 +465,28 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
   plan_factors(spec, model, instances, plan);
   plan_design(spec, plan);
   plan_targets(spec, plan);
+  plan_fidelity(spec, model, plan);
   // Checked at submission so that a bad calibration or diagnosis block is refused before
   // anything runs.
   (void)calibration_options(spec.calibration(), "spec.calibration");
   (void)diagnose_options(spec.diagnose(), "spec.diagnose");
-  jobs = design_jobs(spec, plan, plan.factors, "design", 0);
+  jobs = design_jobs(at_fidelity(spec, plan, false), plan, plan.factors, "design", 0);
+  if (plan.fidelity) {
+    const auto high = design_jobs(at_fidelity(spec, plan, true), plan, plan.factors,
+                                  kHighDesignKind, 0, &plan.fidelity->high_rows);
+    jobs.insert(jobs.end(), high.begin(), high.end());
+  }
   return plan;
 }
 
 std::vector<NewJob> design_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
                                 const std::vector<PlannedFactor>& box, const std::string& kind,
-                                int stage_offset) {
+                                int stage_offset, const std::vector<int>* rows) {
   std::vector<NewJob> jobs;
   const auto& design = plan.design;
   const bool pinned = spec.design().simulation_seeds() == v1::Design::PINNED;
   for (int r = 0; r < design.runs(); ++r) {
+    if (rows && std::find(rows->begin(), rows->end(), r + 1) == rows->end()) continue;
     std::map<std::string, double> parameters;
     for (std::size_t f = 0; f < box.size(); ++f)
       parameters[box[f].path] = box[f].factor.to_natural(design.coded(r, Eigen::Index(f)));

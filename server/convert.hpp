@@ -35,9 +35,14 @@ std::vector<NewJob> jobs_at(const v1::CampaignSpec& spec, const v1::Material& ma
 /// One job per design row and test, the plan's design laid over `box` (the campaign's factors
 /// or a calibration stage's narrowed box), of job kind `kind`. Seeds: see Design.Seeds in the
 /// proto; a later stage adds `stage_offset` to keep its runs' seeds apart from the first.
+/// With `rows` (1-based standard order), only those rows.
 std::vector<NewJob> design_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
                                 const std::vector<PlannedFactor>& box, const std::string& kind,
-                                int stage_offset);
+                                int stage_offset, const std::vector<int>* rows = nullptr);
+
+/// The spec at one level of the plan's fidelity axis (the low or the high value in every test
+/// instance that has the setting, or as a fixed material parameter); the spec itself without one.
+v1::CampaignSpec at_fidelity(const v1::CampaignSpec& spec, const CampaignPlan& plan, bool high);
 
 v1::DesignSummary design_summary(const CampaignPlan& plan, int jobs);
 v1::DesignReply design_reply(const CampaignPlan& plan, int jobs);

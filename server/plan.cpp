@@ -34,6 +34,11 @@ std::string plan_to_json(const CampaignPlan& plan) {
     if (t.holdout) tj["holdout"] = true;
     j["targets"].push_back(tj);
   }
+  if (plan.fidelity)
+    j["fidelity"] = {{"path", plan.fidelity->path},
+                     {"low", plan.fidelity->low},
+                     {"high", plan.fidelity->high},
+                     {"high_rows", plan.fidelity->high_rows}};
   return j.dump();
 }
 
@@ -68,6 +73,11 @@ CampaignPlan plan_from_json(const std::string& text) {
       tg.holdout = t.value("holdout", false);
       p.targets.push_back(tg);
     }
+  if (j.contains("fidelity")) {
+    const auto& f = j.at("fidelity");
+    p.fidelity = FidelityPlan{f.at("path"), f.at("low"), f.at("high"),
+                              f.at("high_rows").get<std::vector<int>>()};
+  }
   return p;
 }
 

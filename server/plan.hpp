@@ -25,12 +25,24 @@ struct Target {
   bool holdout = false;  ///< kept out of calibrations (reported by the diagnosis)
 };
 
+/// The fidelity axis of a multi-fidelity campaign: the design runs at `low`, the rows
+/// `high_rows` (1-based standard order) at `high` as well.
+struct FidelityPlan {
+  std::string path;  ///< settings.<name> or a material parameter path
+  double low = 0.0, high = 0.0;
+  std::vector<int> high_rows;
+};
+
+/// Job kind of the design rows run at the high fidelity level (the design's own: "design").
+inline constexpr const char* kHighDesignKind = "design:high";
+
 struct CampaignPlan {
   std::vector<PlannedFactor> factors;
   doe::Design design;
   std::vector<std::string> tests;
   std::vector<std::string> responses;  ///< test.metric, tests in spec order
   std::vector<Target> targets;
+  std::optional<FidelityPlan> fidelity;
 };
 
 std::string plan_to_json(const CampaignPlan& plan);

@@ -124,6 +124,8 @@ void validate(const CalibrationProblem& problem) {
     if (!m.uncertainty && !(m.weight >= 0.0)) throw InputError(where + ".weight", "must be >= 0");
     if (!(std::isfinite(m.noise_sd) && m.noise_sd >= 0.0))
       throw InputError(where + ".noise_sd", "must be finite and >= 0");
+    if (!(std::isfinite(m.correction_sd) && m.correction_sd >= 0.0))
+      throw InputError(where + ".correction_sd", "must be finite and >= 0");
     if (m.target == 0.0 && !m.uncertainty) {
       throw InputError(where + ".target",
                        "is 0: a relative error is undefined; give an "
@@ -307,7 +309,7 @@ double predict(const MetricTarget& m, const Eigen::VectorXd& x) {
 }
 
 double predictive_variance(const MetricTarget& m, const Eigen::VectorXd& x) {
-  return m.gp ? m.gp->variance(x) : 0.0;
+  return (m.gp ? m.gp->variance(x) : 0.0) + m.correction_sd * m.correction_sd;
 }
 
 double tolerance(const MetricTarget& m) {

@@ -29,13 +29,16 @@ struct MetricTarget {
   double weight = 1.0;
   std::optional<double> uncertainty;
   double noise_sd = 0.0;  ///< run-to-run noise of the simulated metric; 0 = none known
+  /// Standard deviation of the surrogate's data beyond their noise: in a multi-fidelity
+  /// campaign, the correction of low-level runs to the high level (multi_fidelity.hpp).
+  double correction_sd = 0.0;
   /// When set, the surrogate in place of `model`: a Gaussian process over the same coded box.
   std::shared_ptr<const GaussianProcess> gp;
 };
 
 /// The surrogate's prediction at a coded point (the GP's mean, else the polynomial).
 double predict(const MetricTarget& metric, const Eigen::VectorXd& coded);
-/// Its variance there: the GP's, 0 for a polynomial.
+/// Its variance there: the GP's (0 for a polynomial) plus correction_sd^2.
 double predictive_variance(const MetricTarget& metric, const Eigen::VectorXd& coded);
 
 /// How far a simulated value may lie from the target and still match it: the measurement's

@@ -19,6 +19,7 @@ MetricTarget metric_target(const SequentialTarget& t) {
   m.weight = t.weight;
   m.uncertainty = t.uncertainty;
   m.noise_sd = t.noise_sd;
+  m.correction_sd = t.correction_sd;
   return m;
 }
 

@@ -47,6 +47,9 @@ struct SequentialTarget {
   double weight = 1.0;
   std::optional<double> uncertainty;
   double noise_sd = 0.0;
+  /// A multi-fidelity campaign's uncertainty of its design responses corrected to the high
+  /// level (multi_fidelity.hpp), as MetricTarget::correction_sd.
+  double correction_sd = 0.0;
 };
 
 /// Its tolerance, as calib::tolerance(const MetricTarget&): sqrt(uncertainty^2 + noise_sd^2).

@@ -561,7 +561,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 8);
+    EXPECT_EQ(Store::latest_schema_version(), 9);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
@@ -601,11 +601,14 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
     js = s.jobs(1);
     ASSERT_EQ(js.size(), 2u);  // the rejected job left nothing behind
     EXPECT_EQ(js[1].kind, "diagnose:shape");
+    // The migrated table admits a multi-fidelity campaign's high rows, and keeps run keys.
+    EXPECT_EQ(s.add_jobs(1, {{1, 1, "packing", "design:high", "{}"}}).size(), 1u);
+    EXPECT_EQ(s.job(1)->run_key.key, "old-key");
   }
   {
     Store s(path.string());  // reopening does not migrate again
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());  // 5: campaigns.ready
-    EXPECT_EQ(s.jobs(1).size(), 2u);
+    EXPECT_EQ(s.jobs(1).size(), 3u);
     // Version 4 admits the calibration's stage designs and stores rounds and stages with them.
     const auto round_jobs = s.add_calibration_round(1, {1, 1, R"({"natural":[0.3]})", 300.0},
                                                     {{1, 1, "packing", "verify", "{}"}});
@@ -619,7 +622,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
     // A round stored twice is refused and leaves no job behind.
     EXPECT_ANY_THROW(
         s.add_calibration_round(1, {1, 1, "{}", 320.0}, {{1, 1, "packing", "verify", "{}"}}));
-    EXPECT_EQ(s.jobs(1).size(), 4u);
+    EXPECT_EQ(s.jobs(1).size(), 5u);
   }
   std::filesystem::remove(path);
   std::filesystem::remove(path.string() + "-wal");

@@ -1,0 +1,19 @@
+#pragma once
+// A fraction nested in a two-level design: the runs of a multi-fidelity campaign that run at the
+// high level as well, so that every high run has its low twin at the same point (nested designs
+// for two levels of accuracy: Qian, Tang and Wu 2009, Statistica Sinica 19:287). The design's
+// factorial runs are halved one defining word at a time; each word is the one that leaves the
+// highest resolution (then the fewest defining words of that length), among the words of up to
+// six of the design's base factors (the first k - p). Halving stops before fewer than
+// `min_runs` runs or a resolution below III would remain.
+#include <vector>
+
+#include "core/doe/design.hpp"
+
+namespace demcal::doe {
+
+/// Rows (0-based, standard order) of the first replicate's factorial runs that form the nested
+/// fraction; all of them when no halving keeps `min_runs` runs at resolution III or more.
+std::vector<int> nested_fraction(const Design& design, int min_runs);
+
+}  // namespace demcal::doe
