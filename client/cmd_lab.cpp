@@ -1,5 +1,6 @@
 // `demcal lab run SPEC.yaml --out DIR` runs one virtual lab test without the service;
 // `demcal lab list` shows every test with its metrics and settings.
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -13,6 +14,7 @@
 #include "client/study_journal.hpp"
 #include "core/io/csv.hpp"
 #include "core/lab/lab_spec.hpp"
+#include "core/lab/size_extrapolation.hpp"
 #include "core/lab/stage_cache.hpp"
 #include "core/lab/study.hpp"
 
@@ -62,6 +64,7 @@ struct StudyOptions {
   std::string spec, scale, particles, out_dir;
   int threads = 0;
   int seeds = 1;
+  std::optional<double> extrapolate;  ///< a value of the study's axis
 };
 
 std::vector<double> parse_list(const std::string& text, const std::string& flag) {
@@ -80,7 +83,48 @@ nlohmann::json optional_json(const std::optional<double>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
 
-nlohmann::json study_json(const lab::StudyResult& r, const std::string& test) {
+/// One metric's extrapolation (docs/lab-tests.md, "Size extrapolation"); without a fit (a
+/// replicate's value not finite) the estimate is null and a note says why.
+nlohmann::json extrapolation_json(const lab::StudyExtrapolation& e,
+                                  const lab::MetricExtrapolation& m) {
+  nlohmann::json j{{"value", e.value},
+                   {"x", e.x},
+                   {"particles", e.particles},
+                   {"form", e.form},
+                   {"confidence", lab::kExtrapolationConfidence},
+                   {"flagged", m.flagged}};
+  if (!m.fit) {
+    j["estimate"] = nullptr;
+    j["note"] = "a replicate's value is not finite: no fit";
+    return j;
+  }
+  const lab::LineExtrapolation& f = *m.fit;
+  j["m_inf"] = f.intercept;
+  j["slope"] = f.slope;
+  j["estimate"] = f.estimate;
+  j["ci_low"] = f.ci_low();
+  j["ci_high"] = f.ci_high();
+  j["ci_half_width"] = f.half_width;
+  j["t_quantile"] = f.t_quantile;
+  j["points"] = f.points;
+  j["distinct_values"] = f.distinct_x;
+  j["residual_sd"] = f.residual_sd;
+  if (f.lack_of_fit) {
+    const lab::LackOfFit& t = *f.lack_of_fit;
+    j["lack_of_fit"] = {{"f_ratio", t.f_ratio},
+                        {"df_lack", t.df_lack},
+                        {"df_pure", t.df_pure},
+                        {"p_value", t.p_value},
+                        {"rejected", t.rejected}};
+  } else {
+    j["lack_of_fit"] = nullptr;
+    j["lack_of_fit_note"] = f.lack_of_fit_note;
+  }
+  return j;
+}
+
+nlohmann::json study_json(const lab::StudyResult& r, const std::string& test,
+                          const std::optional<lab::StudyExtrapolation>& extrapolated) {
   nlohmann::json j;
   j["test"] = test;
   j["axis"] = r.axis == lab::StudyAxis::kScaleFactor ? "scale_factor" : "particles";
@@ -106,12 +150,42 @@ nlohmann::json study_json(const lab::StudyResult& r, const std::string& test) {
       j["converged_from"][name] = optional_json(from);
     j["chosen"] = optional_json(r.chosen);
   }
+  if (extrapolated)
+    for (const auto& [name, m] : extrapolated->metrics)
+      j["extrapolated"][name] = extrapolation_json(*extrapolated, m);
   return j;
 }
 
+std::string csv_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+/// The extrapolated row of summary.csv: the value, the particles it implies, seeds 0 (no run),
+/// and per metric the estimate and the half-width of its confidence interval in the mean and sd
+/// columns; empty cells for a metric not extrapolated (not catalogued, or no fit).
+void append_extrapolated_row(const std::string& path, const std::vector<std::string>& names,
+                             const lab::StudyExtrapolation& e) {
+  std::ofstream out(path, std::ios::app);
+  out << csv_number(e.value) << "," << csv_number(e.particles) << ",0";
+  for (const auto& n : names) {
+    const auto it = e.metrics.find(n);
+    if (it == e.metrics.end() || !it->second.fit) {
+      out << ",,";
+      continue;
+    }
+    out << "," << csv_number(it->second.fit->estimate) << ","
+        << csv_number(it->second.fit->half_width);
+  }
+  out << "\n";
+  if (!out) throw InputError(path, "cannot write file");
+}
+
 /// runs.csv: one row per value and seed (the curves behind a bed-size table); summary.csv: per
-/// value the mean and the seed-to-seed spread of every metric.
-void write_study_csv(const lab::StudyResult& r, const std::string& dir) {
+/// value the mean and the seed-to-seed spread of every metric, then the extrapolated row if any.
+void write_study_csv(const lab::StudyResult& r, const std::string& dir,
+                     const std::optional<lab::StudyExtrapolation>& extrapolated) {
   std::vector<std::string> names;
   for (const auto& [name, unused] : r.runs.front().metrics) names.push_back(name);
   std::vector<std::string> columns{"value", "particles", "seed", "wall_seconds"};
@@ -122,27 +196,31 @@ void write_study_csv(const lab::StudyResult& r, const std::string& dir) {
     columns.push_back(n + "_mean");
     columns.push_back(n + "_sd");
   }
-  io::CsvWriter summary(dir + "/summary.csv", columns);
-  for (const auto& run : r.runs) {
-    for (const auto& rep : run.replicates) {
-      std::vector<double> row{run.value, run.particles, static_cast<double>(rep.seed),
-                              rep.wall_seconds};
-      for (const auto& n : names) row.push_back(rep.metrics.at(n));
-      runs.row(row);
+  {
+    io::CsvWriter summary(dir + "/summary.csv", columns);
+    for (const auto& run : r.runs) {
+      for (const auto& rep : run.replicates) {
+        std::vector<double> row{run.value, run.particles, static_cast<double>(rep.seed),
+                                rep.wall_seconds};
+        for (const auto& n : names) row.push_back(rep.metrics.at(n));
+        runs.row(row);
+      }
+      std::vector<double> row{run.value, run.particles, static_cast<double>(run.replicates.size())};
+      for (const auto& n : names) {
+        row.push_back(run.metrics.at(n));
+        row.push_back(run.spread.at(n));
+      }
+      summary.row(row);
     }
-    std::vector<double> row{run.value, run.particles, static_cast<double>(run.replicates.size())};
-    for (const auto& n : names) {
-      row.push_back(run.metrics.at(n));
-      row.push_back(run.spread.at(n));
-    }
-    summary.row(row);
   }
+  if (extrapolated) append_extrapolated_row(dir + "/summary.csv", names, *extrapolated);
 }
 
-/// `demcal lab study SPEC.yaml --scale 1,2,4 | --particles 200,400,800 [--seeds 3]`: the same
-/// test at each value (and seed), how every metric moves, and with two or more seeds the size
-/// from which the metrics stay within their seed-to-seed spread (seed 000 §2.3, seed 001 App. B;
-/// seed 004 §3.1).
+/// `demcal lab study SPEC.yaml --scale 1,2,4 | --particles 200,400,800 [--seeds 3]
+/// [--extrapolate VALUE]`: the same test at each value (and seed), how every metric moves, with
+/// two or more seeds the size from which the metrics stay within their seed-to-seed spread (seed
+/// 000 §2.3, seed 001 App. B; seed 004 §3.1), and each catalogued metric extrapolated to VALUE
+/// (core/lab/size_extrapolation.hpp).
 void run_lab_study(const StudyOptions& opt) {
   auto spec = lab::read_lab_run(io::YamlNode::load_file(opt.spec));
   if (opt.threads > 0) spec.options.threads = opt.threads;
@@ -151,6 +229,7 @@ void run_lab_study(const StudyOptions& opt) {
   const bool by_scale = !opt.scale.empty();
   const auto values =
       by_scale ? parse_list(opt.scale, "--scale") : parse_list(opt.particles, "--particles");
+  if (opt.extrapolate) lab::check_extrapolation(values, *opt.extrapolate, "--extrapolate");
   std::optional<StudyJournalFile> kept;
   if (!opt.out_dir.empty()) {
     std::filesystem::create_directories(opt.out_dir);
@@ -169,10 +248,16 @@ void run_lab_study(const StudyOptions& opt) {
       lab::run_study(spec.test, spec.material, spec.settings, spec.options,
                      by_scale ? lab::StudyAxis::kScaleFactor : lab::StudyAxis::kParticles, values,
                      opt.seeds, kept ? kept->journal() : lab::StudyJournal{});
-  const nlohmann::json j = study_json(r, spec.test);
+  std::optional<lab::StudyExtrapolation> extrapolated;
+  if (opt.extrapolate) {
+    std::vector<std::string> catalogued;
+    for (const auto& m : lab::find_lab_info(spec.test).metrics) catalogued.push_back(m.name);
+    extrapolated = lab::extrapolate_study(r, catalogued, *opt.extrapolate, "--extrapolate");
+  }
+  const nlohmann::json j = study_json(r, spec.test, extrapolated);
   if (!opt.out_dir.empty()) {
     std::ofstream(opt.out_dir + "/study.json") << j.dump(2) << "\n";
-    write_study_csv(r, opt.out_dir);
+    write_study_csv(r, opt.out_dir, extrapolated);
   }
   std::cout << j.dump(2) << "\n";
 }
@@ -232,6 +317,11 @@ void add_lab_command(CLI::App& app) {
                    "seeds per value (the spec's seed and the next ones); 2 or more: the size "
                    "from which every metric stays within its seed-to-seed spread")
       ->check(CLI::Range(1, lab::kMaxStudySeeds));
+  study->add_option("--extrapolate", sopt->extrapolate,
+                    "a particle count (--particles) or scale factor (--scale) to extrapolate every "
+                    "catalogued metric to: m = m_inf + a x fitted over all runs (x = N^(-1/3), "
+                    "or the length factor of lambda), with its 95 % confidence interval and a "
+                    "lack-of-fit test; needs 3 or more values");
   study->add_option("--out", sopt->out_dir, "directory for study.json, runs.csv, summary.csv");
   study->add_option("--threads", sopt->threads, "override the spec's thread count");
   study->callback([sopt] { run_lab_study(*sopt); });

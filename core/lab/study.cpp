@@ -85,6 +85,7 @@ StudyResult run_study(const std::string& test, const MaterialModel& material,
   if (auto it = settings.find("particles"); it != settings.end()) n0 = it->second;
   StudyResult r;
   r.axis = axis;
+  r.scaling = material.scaling;
   r.seeds = seeds;
   const double l0 = axis == StudyAxis::kScaleFactor
                         ? contact::scale_factors(material.scaling, values[0]).length

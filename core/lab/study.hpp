@@ -42,6 +42,7 @@ struct StudyRun {
 
 struct StudyResult {
   StudyAxis axis = StudyAxis::kParticles;
+  contact::ScalingLaw scaling = contact::ScalingLaw::kNone;  ///< the material's
   int seeds = 1;
   std::vector<StudyRun> runs;
   /// Per metric: relative change of each run's mean against the previous one,

@@ -165,6 +165,62 @@ TEST(Cli, LabStudyGoesOnWhereItStopped) {
   fs::remove_all(dir);
 }
 
+TEST(Cli, LabStudyExtrapolatesToAnotherSize) {
+  const fs::path dir = scratch_dir("extrapolate");
+  std::ofstream(dir / "spec.yaml") << "test: packing\nseed: 1\nthreads: 1\nmaterial:\n"
+                                   << "  particle_law:\n"
+                                   << "    normal: {model: hertz, youngs_modulus: 5.0e6, "
+                                      "restitution: 0.3}\n"
+                                   << "    tangential: {model: history, mu_s: 0.3}\n"
+                                   << "  sizes: {monodisperse: {radius: 5.0e-4}}\n"
+                                   << "  density: 2500\n";
+  const std::string spec = (dir / "spec.yaml").string(), out = (dir / "out").string();
+  // Two values cannot give a line and its test: refused before anything runs.
+  const Result few =
+      demcal("lab study " + spec + " --particles 40,80 --seeds 2 --extrapolate 1000 --out " + out);
+  EXPECT_NE(few.exit_code, 0);
+  EXPECT_NE(few.out.find("--extrapolate: needs at least 3 distinct study values"),
+            std::string::npos)
+      << few.out;
+  EXPECT_FALSE(fs::exists(dir / "out" / "replicates.jsonl"));
+  const Result r = demcal("lab study " + spec +
+                          " --particles 40,60,80 --seeds 2 --extrapolate 1000 --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto j = nlohmann::json::parse(std::ifstream(dir / "out" / "study.json"));
+  for (const char* name : {"solid_fraction", "coordination_number"}) {
+    const auto& e = j["extrapolated"][name];
+    EXPECT_EQ(e["value"], 1000.0);
+    EXPECT_NEAR(e["x"].get<double>(), 0.1, 1e-12);
+    EXPECT_EQ(e["form"], "m = m_inf + a N^(-1/3)");
+    EXPECT_EQ(e["points"], 6);
+    EXPECT_LE(e["ci_low"].get<double>(), e["estimate"].get<double>());
+    EXPECT_GE(e["ci_high"].get<double>(), e["estimate"].get<double>());
+    EXPECT_TRUE(e["lack_of_fit"].is_object() || e["lack_of_fit_note"].is_string()) << e.dump();
+    EXPECT_TRUE(e["flagged"].is_boolean());
+  }
+  // summary.csv: the three values, then the extrapolated row (seeds 0, the estimate in the mean
+  // column, the interval's half-width in the sd column).
+  const auto lines = file_lines(dir / "out" / "summary.csv");
+  ASSERT_EQ(lines.size(), 5u);
+  const std::string header = lines[0];
+  std::vector<std::string> columns, cells;
+  std::stringstream h(header), row(lines[4]);
+  for (std::string c; std::getline(h, c, ',');) columns.push_back(c);
+  for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+  cells.resize(columns.size());
+  const auto cell = [&](const std::string& column) {
+    const auto at = std::find(columns.begin(), columns.end(), column) - columns.begin();
+    return cells.at(static_cast<std::size_t>(at));
+  };
+  EXPECT_EQ(cell("value"), "1000");
+  EXPECT_EQ(cell("particles"), "1000");
+  EXPECT_EQ(cell("seeds"), "0");
+  const auto& sf = j["extrapolated"]["solid_fraction"];
+  EXPECT_NEAR(std::stod(cell("solid_fraction_mean")), sf["estimate"].get<double>(), 1e-12);
+  EXPECT_NEAR(std::stod(cell("solid_fraction_sd")), sf["ci_half_width"].get<double>(), 1e-12);
+  fs::remove_all(dir);
+}
+
 TEST(Cli, ContactPrintsTheSummaryAndWritesTheSeries) {
   const fs::path dir = scratch_dir("contact");
   const Result r = demcal("contact " + source("examples/contact_hertz_collision.yaml") + " --csv " +
