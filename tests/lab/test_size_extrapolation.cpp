@@ -219,7 +219,7 @@ TEST(SizeExtrapolationSim, SmallPackingsPredictTheLargerBed) {
   // The packing test at 60, 120 and 240 particles, three seeds each, extrapolated to 960, and two
   // seeds run at 960: their mean lies inside the 95 % interval of every catalogued metric, and the
   // straight line in N^(-1/3) is not rejected (lack of fit on 1 and 6 degrees of freedom). About
-  // 9 s of one core (3.5 s the study, 5.5 s the two larger beds).
+  // 6.5 s of CPU on one thread (13 s of wall time on the loaded 2-core machine).
   const auto& info = find_lab_info("packing");
   std::vector<std::string> names;
   for (const auto& m : info.metrics) names.push_back(m.name);
