@@ -271,6 +271,27 @@ void print_rounds(std::ostream& out,
   }
 }
 
+/// A multi-fidelity campaign: per response the model of its high level (low and high at the
+/// rows run at both), and the particle-steps of each level against the all-high design.
+void print_fidelity(std::ostream& out, const v1::CalibrateReply& c) {
+  if (c.fidelity_size() == 0) return;
+  out << "\n  high fidelity level from the low one (docs/doe.md, \"Multi-fidelity calibration\"):\n";
+  for (const auto& f : c.fidelity()) {
+    out << "    " << f.statement() << "; correction sd " << f.correction_sd() << "\n";
+    for (int i = 0; i < f.rows_size(); ++i)
+      out << "      row " << f.rows(i) << ": low " << f.low(i) << ", high " << f.high(i) << "\n";
+  }
+  const auto& k = c.fidelity_cost();
+  const double design = k.low_particle_steps() + k.high_particle_steps();
+  out << "  particle-steps: low " << k.low_particle_steps() << " (" << k.low_jobs()
+      << " jobs), high " << k.high_particle_steps() << " (" << k.high_jobs()
+      << " jobs), verification " << k.verify_particle_steps() << " (" << k.verify_jobs()
+      << " jobs); the design at the high level in every row: " << k.all_high_particle_steps();
+  if (k.all_high_particle_steps() > 0)
+    out << " (this design: " << std::lround(100.0 * design / k.all_high_particle_steps()) << " %)";
+  out << "\n";
+}
+
 void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std::string& format) {
   if (format == "json") {
     out << message_json(c) << "\n";
@@ -299,6 +320,7 @@ void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std
   for (const auto& i : c.intervals()) out << "    " << i.statement() << "\n";
   if (c.trade_offs_size()) out << "\n  factors the data fix only in combination:\n";
   for (const auto& t : c.trade_offs()) out << "    " << t.statement() << "\n";
+  print_fidelity(out, c);
   print_rounds(out, c.rounds());
   out << "  verification: " << c.verification_state() << ", " << c.simulations()
       << " simulation(s) added by the calibration\n  " << c.conclusion() << "\n";
