@@ -10,7 +10,8 @@
 //   multi-fidelity   the same design at the low level, its centre run at the high level too, the
 //                    high level modelled from the low one: the hidden friction lies inside the
 //                    stated interval, and the design cost at most 40 % of the particle-steps of
-//                    running every row at the high level.
+//                    running every row at the high level; its report (rendered by headless
+//                    Chromium) shows the high level's model and the particle-steps per level.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -18,6 +19,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -126,6 +128,19 @@ TEST(MultiFidelityHidden, TheHighLevelModelFindsTheFrictionTheSmallBedMisses) {
   ASSERT_EQ(multi["calibration"]["fidelity"].size(), 2u);
   for (const auto& f : multi["calibration"]["fidelity"]) EXPECT_GT(f["mean_bias"].get<double>(), 0.0)
       << "the small bed is looser and less coordinated: " << f.dump();
+
+  // The report shows the high level's model and the cost of each level (rendered in Chromium).
+  const std::string report = std::string(DEMCAL_CLI_BIN) + " report " + (dir / "multi.yaml").string() +
+                             " --threads 1 --workdir " + (dir / "multi").string() + " -o " +
+                             (dir / "report").string() + " 2>/dev/null";
+  ASSERT_EQ(demcal::test::run_command(report).exit_code, 0) << report;
+  const auto dom = demcal::test::run_command(
+      "chromium --headless --no-sandbox --disable-gpu --user-data-dir=" +
+      (dir / "chromium-profile").string() + " --virtual-time-budget=10000 --dump-dom " +
+      (dir / "report" / "report.html").string() + " 2>/dev/null");
+  // Rendered elements, not the script's text (which the page also holds).
+  EXPECT_NE(dom.out.find("<h3>High fidelity level from the low one</h3>"), std::string::npos);
+  EXPECT_TRUE(std::regex_search(dom.out, std::regex(R"(\(this design: \d+ %\))")));
   std::filesystem::remove_all(dir);
 }
 

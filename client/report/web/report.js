@@ -407,6 +407,26 @@
     }
   }
 
+  // A multi-fidelity campaign: per response the high level's model from the low one, low against
+  // high at the rows run at both levels, and the particle-steps of each level (docs/doe.md).
+  function fidelityPart(s, cal) {
+    if (!cal.fidelity || !cal.fidelity.length) return;
+    s.appendChild(el('h3', {}, 'High fidelity level from the low one'));
+    s.appendChild(table(['response', 'model', 'rho', 'high - low (mean)', 'correction sd', 'rows at both levels'], cal.fidelity.map((f) => [
+      f.response, f.model, fmt(f.rho, 4), fmt(f.mean_bias, 4), fmt(f.correction_sd, 3), (f.rows || []).join(', '),
+    ])));
+    const pairs = [];
+    for (const f of cal.fidelity) (f.rows || []).forEach((r, i) => pairs.push({ response: f.response, row: r, low: f.low[i], high: f.high[i] }));
+    s.appendChild(table(['response', 'row', 'low', 'high'], pairs.map((p) => [p.response, p.row, fmt(p.low, 5), fmt(p.high, 5)])));
+    const c = cal.fidelity_cost || {};
+    const design = Number(c.low_particle_steps || 0) + Number(c.high_particle_steps || 0);
+    const all = Number(c.all_high_particle_steps || 0);
+    s.appendChild(el('p', {}, 'Particle-steps: low ' + fmt(Number(c.low_particle_steps || 0), 4) + ' (' + (c.low_jobs || 0) + ' jobs), high ' +
+      fmt(Number(c.high_particle_steps || 0), 4) + ' (' + (c.high_jobs || 0) + ' jobs), verification ' + fmt(Number(c.verify_particle_steps || 0), 4) +
+      ' (' + (c.verify_jobs || 0) + ' jobs); the design at the high level in every row: ' + fmt(all, 4) +
+      (all > 0 ? ' (this design: ' + Math.round(100 * design / all) + ' %)' : '') + '.'));
+  }
+
   function calibrationSection(root, data) {
     const s = section(root, 'calibration', 'Calibration rounds and verified errors', 'The proposed set, predicted / simulated / measured and deviations, round by round (seed 000 §3.3, Tables 12 and 15).');
     const cal = data.calibration;
@@ -435,6 +455,7 @@
         ],
       }, 'Bars inside the dashed lines are within tolerance = sqrt(uncertainty² + noise sd²).');
     }
+    fidelityPart(s, cal);
     const rounds = (data.campaign.calibration_rounds || []).filter((r) => r.state === 'done');
     if (rounds.length) {
       plot(s, 'calibration-rounds', {
