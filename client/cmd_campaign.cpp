@@ -61,6 +61,7 @@ void add_campaign_commands(CLI::App& app) {
       return;
     }
     print_campaign_row(c);
+    if (c.has_fidelity_cost()) print_fidelity_cost(std::cout, c.fidelity_cost());
     print_rounds(std::cout, c.calibration_rounds());
     const auto flagged = std::count_if(r.jobs().begin(), r.jobs().end(),
                                        [](const v1::JobResult& j) { return j.flags_size() > 0; });

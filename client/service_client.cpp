@@ -271,6 +271,8 @@ void print_rounds(std::ostream& out,
   }
 }
 
+namespace {
+
 /// A multi-fidelity campaign: per response the model of its high level (low and high at the
 /// rows run at both), and the particle-steps of each level against the all-high design.
 void print_fidelity(std::ostream& out, const v1::CalibrateReply& c) {
@@ -281,7 +283,12 @@ void print_fidelity(std::ostream& out, const v1::CalibrateReply& c) {
     for (int i = 0; i < f.rows_size(); ++i)
       out << "      row " << f.rows(i) << ": low " << f.low(i) << ", high " << f.high(i) << "\n";
   }
-  const auto& k = c.fidelity_cost();
+  print_fidelity_cost(out, c.fidelity_cost());
+}
+
+}  // namespace
+
+void print_fidelity_cost(std::ostream& out, const v1::FidelityCost& k) {
   const double design = k.low_particle_steps() + k.high_particle_steps();
   out << "  particle-steps: low " << k.low_particle_steps() << " (" << k.low_jobs()
       << " jobs), high " << k.high_particle_steps() << " (" << k.high_jobs()

@@ -39,6 +39,8 @@ v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const rpc::ChannelO
 /// table | csv | json
 void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::string& format);
 void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std::string& format);
+/// A multi-fidelity campaign's particle-steps per level against the all-high design.
+void print_fidelity_cost(std::ostream& out, const v1::FidelityCost& cost);
 /// The rounds of a sequential calibration as a table.
 void print_rounds(std::ostream& out,
                   const google::protobuf::RepeatedPtrField<v1::CalibrationRound>& rounds);

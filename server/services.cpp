@@ -132,6 +132,8 @@ grpc::Status CampaignServiceImpl::Get(grpc::ServerContext* ctx, const v1::GetReq
   try {
     *reply = campaign_message(*row, store_.counts(row->id), now_seconds(), true);
     for (auto& r : calibration_rounds(store_, *row)) *reply->add_calibration_rounds() = r;
+    const CampaignPlan plan = plan_from_json(row->design_json);
+    if (plan.fidelity) *reply->mutable_fidelity_cost() = fidelity_cost(plan, store_.jobs(row->id));
   } catch (const std::exception& e) {
     return internal(e);
   }

@@ -1119,5 +1119,44 @@ TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals)
     EXPECT_FALSE(i.at("statement").get<std::string>().empty()) << i.dump();
 }
 
+
+// A multi-fidelity campaign through the coordinator and a worker: the design's rows at the low
+// level, its centre at the high level too, the verification at the high level, and `status`
+// showing the particle-steps of each level against the all-high design.
+TEST_F(Service, AMultiFidelityCampaignVerifiesAtTheHighLevelAndStatusShowsTheCostOfEach) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(200, 1) + "fidelity: {path: settings.particles, low: 100, high: 200}\n",
+                     &id)
+                  .ok());
+  start_worker("w");
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 90)) << workers_[0]->log();
+  const std::string ids = std::to_string(id);
+  const auto cal = cli_json(dir_, "calibrate",
+                            {"calibrate", ids, "--verify", "--wait", "--format", "json"}, channel_);
+  ASSERT_EQ(cal.at("fidelity").size(), 1u) << cal.dump();
+  EXPECT_EQ(cal.at("fidelity").at(0).at("rows"), nlohmann::json::array({5}));
+  std::map<std::string, std::set<double>> particles;
+  const auto finished = results(id);
+  for (const auto& j : finished.jobs()) particles[j.kind()].insert(j.cost().particles());
+  EXPECT_EQ(particles.at("design"), (std::set<double>{100}));
+  EXPECT_EQ(particles.at("design:high"), (std::set<double>{200}));
+  EXPECT_EQ(particles.at("verify"), (std::set<double>{200}));
+
+  const auto status = cli_json(dir_, "status", {"status", ids, "--format", "json"}, channel_);
+  const auto& cost = status.at("fidelity_cost");
+  EXPECT_EQ(cost.at("low_jobs"), 5);
+  EXPECT_EQ(cost.at("high_jobs"), 1);
+  EXPECT_GE(cost.at("verify_jobs").get<int>(), 1);
+  EXPECT_GT(cost.at("all_high_particle_steps").get<double>(),
+            cost.at("high_particle_steps").get<double>());
+  Process table({DEMCAL_CLI_BIN, "status", ids, "--coordinator", channel_.address, "--token",
+                 kToken},
+                path("status.log"));
+  ASSERT_EQ(table.wait_exit(30), 0) << table.log();
+  EXPECT_NE(table.log().find("the design at the high level in every row"), std::string::npos)
+      << table.log();
+}
+
 }  // namespace
 }  // namespace demcal::test
