@@ -8,6 +8,9 @@
 #          "hertz lh100 lh220"
 # Materials are bench/materials/NAME.yaml; SETTINGS is a YAML flow mapping added to particles
 # (default "wall_stiffness_factor: 3"). The runs of A and B go two at a time, one thread each.
+# KEEP=DIR keeps the specs and results there. PREP_A / PREP_B (YAML flow mappings, e.g. PREP_B="{method: growth}") give side A or B the
+# material's preparation, so that one build compares two preparations:
+#   PREP_B="{method: growth}" bench/protocol_compare.sh build/client/demcal build/client/demcal
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 A=$(realpath "$1"); B=$(realpath "$2")
@@ -20,11 +23,14 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 for mat in $MATERIALS; do
   for seed in ${SEEDS//,/ }; do
-    spec="$work/$mat-$seed.yaml"
-    { printf "test: %s\nsettings: {particles: %s, %s}\nseed: %s\nthreads: 1\n" "$TEST" "$N" "$EXTRA" "$seed"
-      grep -v '^#' "$root/bench/materials/$mat.yaml"; } > "$spec"
-    "$A" lab run "$spec" > "$work/A-$mat-$seed.json" 2> "$work/A-$mat-$seed.err" &
-    "$B" lab run "$spec" > "$work/B-$mat-$seed.json" 2> "$work/B-$mat-$seed.err" &
+    for side in A B; do
+      prep_var="PREP_$side"
+      { printf "test: %s\nsettings: {particles: %s, %s}\nseed: %s\nthreads: 1\n" "$TEST" "$N" "$EXTRA" "$seed"
+        grep -v '^#' "$root/bench/materials/$mat.yaml"
+        [ -z "${!prep_var:-}" ] || printf "  preparation: %s\n" "${!prep_var}"; } > "$work/$side-$mat-$seed.yaml"
+    done
+    "$A" lab run "$work/A-$mat-$seed.yaml" > "$work/A-$mat-$seed.json" 2> "$work/A-$mat-$seed.err" &
+    "$B" lab run "$work/B-$mat-$seed.yaml" > "$work/B-$mat-$seed.json" 2> "$work/B-$mat-$seed.err" &
     wait
   done
 done
@@ -56,4 +62,10 @@ for mat in materials:
         unreached = sum(1 for r in runs[t] for p in r.get("cost", {}).get("phases", []) if not p["reached"])
         flagged = sum(1 for r in runs[t] if r.get("flags"))
         print(f"  {t}: steps {steps}, wall s {[round(w, 1) for w in wall if w]}, phases short of target {unreached}, runs with flags {flagged}")
+        for s, r in zip(seeds, runs[t]):
+            phases = ", ".join(f"{p['name']} {p['steps']}" for p in r["cost"]["phases"] if p["name"] in ("fill", "settle") or p["name"].startswith("prepare") or p["name"] == "load 1")
+            bed = r.get("series", {}).get("settled_bed", {}).get("rows", [[]])[0]
+            bed = f", settled bed phi {bed[1]:.4f} Z {bed[2]:.2f}" if len(bed) == 3 else ""
+            print(f"     seed {s}: {phases}{bed}")
 PY
+[ -z "${KEEP:-}" ] || cp -r "$work/." "$KEEP/"

@@ -28,6 +28,15 @@ struct BedSpec {
   /// bed's height per real second over the last five checks (0.01 s real).
   double rest_sink_rate = 1e-3;
   double max_settle_time = 2.0;  ///< (s), real: x the material's time factor when simulated
+  /// The creep rule and budget of a bed that starts where it ends (the growth preparation;
+  /// 0 = off, the rules above alone): checks every fifth of `creep_window` (s, simulated) from
+  /// one window on, and the bed is at rest only if, besides the rules above, its height h (twice
+  /// its centre of mass above its bottom) changed over the last window at an inertial number
+  /// I_h = (|dh| / h / dt) d_mean sqrt(rho_p / sigma_ref) below `creep_inertial_number`
+  /// (sigma_ref the quiet rule's stress); it ends unsettled at `settle_budget` (s, simulated).
+  double creep_window = 0.0;
+  double creep_inertial_number = 0.0;
+  double settle_budget = 0.0;
 };
 
 /// Wall materials used by the lab tests: the particle-wall law of the material model is given
@@ -82,6 +91,25 @@ double metrics_top(const sim::World& world);
 PhaseCost settle(sim::World& world, const BedSpec& spec, const sim::HealthLimits& limits,
                  double time_factor);
 
+/// What the growth preparation built before gravity came on (grow_bed).
+struct GrownBed {
+  double critical_time = 0.0;    ///< sqrt(m / k1) of a fresh particle contact (Rayleigh: Hertz)
+  double start_factor = 0.0;     ///< radius factor the particles were inserted at
+  double growth_time = 0.0;      ///< (s, simulated) to full size, quench after it excluded
+  double height = 0.0;           ///< the lid's height: the die volume at the target fraction (m)
+  double largest_overlap = 0.0;  ///< largest particle-particle overlap over the smaller radius
+  double solid_fraction = 0.0;   ///< one largest diameter from die, floor and lid
+  double coordination = 0.0;     ///< of the particles whose centres lie there
+};
+
+/// Method growth (material.preparation): the particles, inserted by make_die_world at reduced
+/// radii with their full masses, grow at `growth_rate` per critical time without gravity under
+/// a lid at the height of the die volume at `solid_fraction`, their motion quenched, cohesion only
+/// in contact; then the lid goes and gravity comes back. Throws InputError naming
+/// material.preparation.method for a bed not inserted so (clumps, the hopper's bin).
+GrownBed grow_bed(sim::World& world, const MaterialModel& material,
+                  const sim::HealthLimits& limits);
+
 /// Refuses a preparation other than pouring for a test that builds its bed only so
 /// (pours_only), naming the field: material.preparation.method.
 void require_pour(const MaterialModel& material, const std::string& test);
@@ -90,6 +118,7 @@ void require_pour(const MaterialModel& material, const std::string& test);
 struct PreparedBed {
   PhaseCost prepared;  ///< "prepare <method>": no steps for pouring
   PhaseCost settled;
+  GrownBed grown;  ///< growth only
 };
 /// Builds the bed by the material's preparation method (material.preparation, seed 000 §2.7.1)
 /// from the particles inserted below `lid` (the top of the insertion region, where the lid of

@@ -8,6 +8,7 @@
 #include "core/common/rng.hpp"
 #include "core/lab/bed.hpp"
 #include "core/lab/lab_test.hpp"
+#include "core/lab/piston.hpp"
 #include "core/metrics/bulk.hpp"
 #include "core/model/packing_settings.hpp"
 
@@ -27,6 +28,13 @@ LabOutput PackingTest::run(const MaterialModel& material, const Settings& values
   const auto limits = die_limits(w, radius, top);
   const PreparedBed built = prepare_and_settle(w, material, bed, limits, top, options.seed);
   auto& p = w.particles;
+  // The settled bed before any cut, sampled as the piston tests sample theirs.
+  const double h0 = metrics_top(w);
+  const metrics::SamplingCylinder settled = bed_sample(w, radius, h0);
+  const bool sampled = settled.radius > 0.0 && settled.z_hi > settled.z_lo;
+  Series settled_bed{{"h0_m", "solid_fraction", "coordination_number"},
+                     {{h0, sampled ? metrics::solid_fraction(w, settled) : 0.0,
+                       sampled ? metrics::coordination_number(w, settled) : 0.0}}};
 
   if (s.cut_fraction < 1.0) {
     // The bed cut to height (seed 000 §2.7.1: the simulation box shrunk after settling).
@@ -52,6 +60,7 @@ LabOutput PackingTest::run(const MaterialModel& material, const Settings& values
   write_snapshot(w, options, "packing", out);
   out.metrics["solid_fraction"] = metrics::solid_fraction(w, region);
   out.metrics["coordination_number"] = metrics::coordination_number(w, region);
+  out.series["settled_bed"] = std::move(settled_bed);
   out.cost.close(w);
   return out;
 }

@@ -6,10 +6,11 @@ namespace demcal::lab {
 
 PreparationMethod parse_preparation_method(const std::string& text, const std::string& where) {
   for (auto m : {PreparationMethod::kClusters, PreparationMethod::kRandomMotion,
-                 PreparationMethod::kTerminalVelocity, PreparationMethod::kPour})
+                 PreparationMethod::kTerminalVelocity, PreparationMethod::kPour,
+                 PreparationMethod::kGrowth})
     if (text == preparation_method_name(m)) return m;
   throw InputError(where, "unknown preparation method '" + text +
-                              "' (known: clusters, random_motion, terminal_velocity, pour)");
+                              "' (known: clusters, random_motion, terminal_velocity, pour, growth)");
 }
 
 std::string preparation_method_name(PreparationMethod method) {
@@ -22,6 +23,8 @@ std::string preparation_method_name(PreparationMethod method) {
       return "terminal_velocity";
     case PreparationMethod::kPour:
       return "pour";
+    case PreparationMethod::kGrowth:
+      return "growth";
   }
   return "pour";
 }
@@ -33,6 +36,8 @@ std::vector<std::string> preparation_params(PreparationMethod method) {
       return {"agitation_speed", "agitation_time", "cluster_time"};
     case PreparationMethod::kTerminalVelocity:
       return {"terminal_velocity"};
+    case PreparationMethod::kGrowth:
+      return {"solid_fraction", "growth_rate"};
     case PreparationMethod::kPour:
       return {};
   }

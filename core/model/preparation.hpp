@@ -10,6 +10,12 @@
 //   3 terminal_velocity limited settling velocity: poured with every particle's speed capped at
 //                       its Stokes terminal velocity in air, cohesion only in contact;
 //   4 pour              plain pouring (the default), cohesion only in contact.
+// and one of demcal's own, for beds that start near where they end:
+//   5 growth            inserted at reduced radii (real masses) in the die up to the height of
+//                       the bed at `solid_fraction`, grown to full size without gravity under a
+//                       lid with the motion quenched, cohesion only in contact; then gravity on
+//                       and a settle that also waits out creep, within a budget
+//                       (docs/lab-tests.md, "Bed preparation").
 // "Cohesion only in contact" is the van der Waals law with D_max = 1.01 D_min. This header
 // holds the description only (no physics); bed.hpp runs it.
 #include <array>
@@ -21,7 +27,13 @@
 
 namespace demcal::lab {
 
-enum class PreparationMethod { kClusters = 1, kRandomMotion = 2, kTerminalVelocity = 3, kPour = 4 };
+enum class PreparationMethod {
+  kClusters = 1,
+  kRandomMotion = 2,
+  kTerminalVelocity = 3,
+  kPour = 4,
+  kGrowth = 5
+};
 
 struct PreparationSpec {
   static constexpr const char* kName = "preparation";
@@ -30,8 +42,14 @@ struct PreparationSpec {
   double agitation_time = 0.0;     ///< (s, simulated); 0 = 3 d_mean / agitation_speed
   double cluster_time = 0.0;       ///< (s, simulated); clusters: 0 = agitation_time
   double terminal_velocity = 0.0;  ///< (m/s); 0 = Stokes rho g d^2 / (18 mu_air) per particle
+  /// growth: solid fraction of the die volume the particles are grown in (its height)
+  double solid_fraction = kGrowthSolidFraction;
+  /// growth: relative radius growth per critical time sqrt(m / k) of a fresh contact
+  double growth_rate = kGrowthRate;
+  static constexpr double kGrowthSolidFraction = 0.5;
+  static constexpr double kGrowthRate = 1e-3;
 
-  static std::array<contact::ParamInfo<PreparationSpec>, 4> table() {
+  static std::array<contact::ParamInfo<PreparationSpec>, 6> table() {
     using S = PreparationSpec;
     return {{{"agitation_speed", "m/s", 0.0, 1e3, 0.0,
               "clusters, random_motion: Gaussian velocity per component; 0 = sqrt(g d_mean)",
@@ -45,7 +63,13 @@ struct PreparationSpec {
               &S::cluster_time},
              {"terminal_velocity", "m/s", 0.0, 1e3, 0.0,
               "terminal_velocity: speed cap; 0 = Stokes rho g d^2 / (18 mu_air) per particle",
-              &S::terminal_velocity}}};
+              &S::terminal_velocity},
+             {"solid_fraction", "-", 0.3, 0.64, kGrowthSolidFraction,
+              "growth: solid fraction of the die volume the bed is grown in (sets its height)",
+              &S::solid_fraction},
+             {"growth_rate", "-", 1e-4, 1e-2, kGrowthRate,
+              "growth: relative radius growth per critical time sqrt(m / k1) of a fresh contact",
+              &S::growth_rate}}};
   }
   void finalize(const std::string&) {}
 };

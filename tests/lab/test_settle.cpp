@@ -1,6 +1,7 @@
 // Settling (docs/lab-tests.md, "Settling"): a bed ends its settle phase when its motion is
 // quiet against its weight stress, or when it no longer sinks and its motion is quasi-static
-// against the test's stress level.
+// against the test's stress level; with the creep rule (growth preparation) only once its height
+// has also stopped changing, within a budget.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -74,6 +75,50 @@ TEST(Settle, ALayerStillSinkingIsNotSettledHoweverSlow) {
   EXPECT_FALSE(sinking.reached) << sinking.target;
   const lab::PhaseCost tolerated = settle(ringing_layer(0.0, 1e-4), 0.1);
   EXPECT_TRUE(tolerated.reached) << "a sinking rate of 0.1 height per second lets it through";
+}
+
+/// A layer of 10 x 10 spheres at rest on a floor under gravity (no ringing); with `creep` the
+/// floor sinks at that speed (m/s) and the layer rides down on it: a bed whose motion is far
+/// below every kinetic limit while its height keeps changing.
+sim::World creeping_layer(double creep) {
+  sim::World w = ringing_layer(0.0, 0.0);
+  w.walls[0].velocity = {0.0, 0.0, -creep};
+  for (auto& v : w.particles.v) v = {0.0, 0.0, -creep};
+  return w;
+}
+
+lab::PhaseCost settle_with_creep_rule(sim::World w, double budget) {
+  lab::BedSpec spec;
+  spec.rest_sink_rate = 1e3;  // the static rule's own sinking check out of the way
+  spec.creep_window = 0.01;
+  spec.creep_inertial_number = 1e-5;
+  spec.settle_budget = budget;
+  sim::HealthLimits limits;
+  limits.lo = {-0.01, -0.01, -0.01};
+  limits.hi = {0.03, 0.03, 0.01};
+  return lab::settle(w, spec, limits, 1.0);
+}
+
+TEST(Settle, TheCreepRuleWaitsForTheHeightAndEndsFlaggedOnItsBudget) {
+  // A standing layer: settled after its first window.
+  const lab::PhaseCost standing = settle_with_creep_rule(creeping_layer(0.0), 0.1);
+  EXPECT_TRUE(standing.reached) << standing.target;
+  EXPECT_LT(standing.simulated_time, 0.02);
+  // Sinking at 1e-5 m/s (1 % of its height per second): its kinetic stress is ~1e-8 of its
+  // weight stress, so the quiet rule alone ends it at once ...
+  lab::BedSpec quiet_only;
+  quiet_only.rest_sink_rate = 1e3;
+  sim::HealthLimits limits;
+  limits.lo = {-0.01, -0.01, -0.01};
+  limits.hi = {0.03, 0.03, 0.01};
+  sim::World quiet = creeping_layer(1e-5);
+  EXPECT_TRUE(lab::settle(quiet, quiet_only, limits, 1.0).reached);
+  // ... but its height changes at I_h = (1e-5 / 1e-3 m) x 2 mm x sqrt(2500 / 30 Pa) ~ 2e-4, so
+  // the creep rule keeps it going, and it ends on the budget, flagged.
+  const lab::PhaseCost creeping = settle_with_creep_rule(creeping_layer(1e-5), 0.05);
+  EXPECT_FALSE(creeping.reached) << creeping.target;
+  EXPECT_NEAR(creeping.simulated_time, 0.05, 0.01);
+  EXPECT_NE(creeping.target.find("I_h < 1e-05"), std::string::npos) << creeping.target;
 }
 
 }  // namespace
