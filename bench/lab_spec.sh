@@ -3,7 +3,8 @@
 # tests use wall_stiffness_factor 3 and the tensile test wall_k2_factor 1, as
 # examples/lh220_diagnosis_campaign.yaml; everything else is each test's default. The rotating
 # drum is sized by its geometry: it gets the drum (D x 0.44 D, 43 % fill) that holds about N of
-# the material's simulated spheres (monodisperse radius x the kottlan2018 factor).
+# the material's simulated spheres (monodisperse radius x the kottlan2018 factor). PREP (a YAML
+# flow mapping, e.g. PREP="{method: growth}") gives the material that preparation.
 lab_spec_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # drum_mm N: the diameter and length (mm) of the seed-shaped drum that holds N of the material's
@@ -30,4 +31,5 @@ lab_spec() {
   esac
   printf "test: %s\nsettings: %s\nseed: 1\nthreads: %s\n" "$test" "$settings" "$threads"
   grep -v '^#' "$lab_spec_root/bench/materials/$MATERIAL.yaml"
+  [ -z "${PREP:-}" ] || printf "  preparation: %s\n" "$PREP"
 }

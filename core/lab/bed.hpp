@@ -123,7 +123,8 @@ struct PreparedBed {
 /// Builds the bed by the material's preparation method (material.preparation, seed 000 §2.7.1)
 /// from the particles inserted below `lid` (the top of the insertion region, where the lid of
 /// the methods with free motion sits), settles it under the law the method settles with (the
-/// full van der Waals law after clusters, cohesion only in contact otherwise), and gives the
+/// full van der Waals law after clusters, cohesion only in contact otherwise; growth with the
+/// creep rule and budget of BedSpec, in critical times of its grown bed), and gives the
 /// particles back the material's full law.
 PreparedBed prepare_and_settle(sim::World& world, const MaterialModel& material,
                                const BedSpec& spec, const sim::HealthLimits& limits, double lid,
