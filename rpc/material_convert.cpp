@@ -1,5 +1,10 @@
 #include "rpc/material_convert.hpp"
 
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
 #include "core/common/error.hpp"
 
 namespace demcal::rpc {
@@ -38,6 +43,77 @@ std::string proto_path(const std::string& core_where, const std::string& base) {
   return base + "." + slot + ".params." + param;
 }
 
+/// The valid range of the material parameter `path` of `model` (lab::parameters).
+lab::ParameterInfo range_of(const lab::MaterialModel& model, const std::string& path) {
+  for (const auto& p : lab::parameters(model))
+    if (p.path == path) return p;
+  throw std::logic_error("no parameter " + path);
+}
+
+/// `value` inside the range of `info`, else an InputError naming `where` (a NaN never is).
+void check_in_range(double value, const lab::ParameterInfo& info, const std::string& where) {
+  if (value >= info.lo && value <= info.hi) return;
+  std::ostringstream s;
+  s << std::setprecision(6) << value << " is outside the valid range [" << info.lo << ", "
+    << info.hi << "] " << info.unit;
+  throw InputError(where, s.str());
+}
+
+/// The truncation of a log-normal size distribution, in geometric standard deviations: below
+/// 0.1 sampling a radius rejects almost every draw, beyond 5 the tails hold nothing.
+constexpr double kMinTruncateK = 0.1, kMaxTruncateK = 5.0;
+
+/// Every number of the size distribution inside its parameter's range; a discrete class's radius
+/// has the range of a monodisperse radius.
+void check_sizes(const v1::SizeDistribution& sizes, const lab::MaterialModel& model,
+                 const std::string& where) {
+  switch (sizes.kind_case()) {
+    case v1::SizeDistribution::kMonodisperse:
+      check_in_range(sizes.monodisperse().radius(), range_of(model, "sizes.radius"),
+                     where + ".monodisperse.radius");
+      break;
+    case v1::SizeDistribution::kDiscrete: {
+      lab::MaterialModel mono;
+      mono.sizes = particles::Monodisperse{};
+      const lab::ParameterInfo radius = range_of(mono, "sizes.radius");
+      const auto& d = sizes.discrete();
+      for (int k = 0; k < d.radii_size(); ++k)
+        check_in_range(d.radii(k), radius, where + ".discrete.radii[" + std::to_string(k) + "]");
+      for (int k = 0; k < d.mass_fractions_size(); ++k)
+        if (!std::isfinite(d.mass_fractions(k)))
+          throw InputError(where + ".discrete.mass_fractions[" + std::to_string(k) + "]",
+                           "must be finite");
+      break;
+    }
+    case v1::SizeDistribution::kLognormal: {
+      const auto& l = sizes.lognormal();
+      check_in_range(l.median_radius(), range_of(model, "sizes.median_radius"),
+                     where + ".lognormal.median_radius");
+      check_in_range(l.sigma_g(), range_of(model, "sizes.sigma_g"), where + ".lognormal.sigma_g");
+      if (l.truncate_k() != 0.0)
+        check_in_range(l.truncate_k(), {"", "standard deviations", kMinTruncateK, kMaxTruncateK},
+                       where + ".lognormal.truncate_k");
+      break;
+    }
+    default:
+      break;
+  }
+}
+
+/// Every number of the material that no parameter table read (the contact laws', the shape's
+/// and the preparation's are checked as they are read) inside its parameter's range: a value
+/// sent over gRPC has not passed the spec reader's checks.
+void check_material_values(const v1::Material& m, const lab::MaterialModel& model,
+                           const std::string& where) {
+  check_in_range(m.density(), range_of(model, "density"), where + ".density");
+  if (m.size_scale() != 0.0)
+    check_in_range(m.size_scale(), range_of(model, "sizes.scale"), where + ".size_scale");
+  if (m.has_scaling() && m.scaling().factor() != 0.0)
+    check_in_range(m.scaling().factor(), range_of(model, "scaling.factor"),
+                   where + ".scaling.factor");
+  check_sizes(m.sizes(), model, where + ".sizes");
+}
+
 }  // namespace
 
 lab::MaterialModel to_material_model(const v1::Material& m, const std::string& where) {
@@ -67,13 +143,13 @@ lab::MaterialModel to_material_model(const v1::Material& m, const std::string& w
     default:
       throw InputError(where + ".sizes", "needs one of: monodisperse, discrete, lognormal");
   }
-  model.size_scale = m.size_scale() > 0 ? m.size_scale() : 1.0;
-  if (!(m.density() > 0)) throw InputError(where + ".density", "missing or not positive");
+  model.size_scale = m.size_scale() != 0.0 ? m.size_scale() : 1.0;
+  if (m.density() == 0.0) throw InputError(where + ".density", "missing");
   model.density = m.density();
   if (m.has_scaling()) {
     const std::string law = m.scaling().law().empty() ? "none" : m.scaling().law();
     model.scaling = contact::scaling_law_from_name(law, where + ".scaling.law");
-    model.scale_factor = m.scaling().factor() > 0 ? m.scaling().factor() : 1.0;
+    model.scale_factor = m.scaling().factor() != 0.0 ? m.scaling().factor() : 1.0;
   }
   if (m.has_shape()) {
     std::map<std::string, double> params(m.shape().params().begin(), m.shape().params().end());
@@ -87,6 +163,7 @@ lab::MaterialModel to_material_model(const v1::Material& m, const std::string& w
         lab::make_preparation(m.preparation().method().empty() ? "pour" : m.preparation().method(),
                               params, where + ".preparation.params");
   }
+  check_material_values(m, model, where);
   try {
     model.validate();
   } catch (const InputError& e) {

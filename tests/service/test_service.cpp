@@ -284,6 +284,49 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
          return s;
        }(),
        "spec.tests[0].settings.particles"},
+      // Every material value against its parameter's range: an infinite density, radius, size
+      // scale or scaling factor would make every job's result non-finite.
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_density(inf); },
+       "spec.material.density"},
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_density(-2500); },
+       "spec.material.density"},
+      {[&](v1::CampaignSpec& s) {
+         s.mutable_material()->mutable_sizes()->mutable_monodisperse()->set_radius(inf);
+       },
+       "spec.material.sizes.monodisperse.radius"},
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_size_scale(inf); },
+       "spec.material.size_scale"},
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_size_scale(-1); },
+       "spec.material.size_scale"},
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->mutable_scaling()->set_factor(inf); },
+       "spec.material.scaling.factor"},
+      {[&](v1::CampaignSpec& s) {
+         auto* l = s.mutable_material()->mutable_sizes()->mutable_lognormal();
+         l->set_median_radius(5e-4);
+         l->set_sigma_g(inf);
+       },
+       "spec.material.sizes.lognormal.sigma_g"},
+      {[&](v1::CampaignSpec& s) {
+         auto* l = s.mutable_material()->mutable_sizes()->mutable_lognormal();
+         l->set_median_radius(5e-4);
+         l->set_sigma_g(1.2);
+         l->set_truncate_k(1e-12);
+       },
+       "spec.material.sizes.lognormal.truncate_k"},
+      {[&](v1::CampaignSpec& s) {
+         auto* d = s.mutable_material()->mutable_sizes()->mutable_discrete();
+         d->add_radii(5e-4);
+         d->add_radii(inf);
+         d->add_mass_fractions(0.5);
+         d->add_mass_fractions(0.5);
+       },
+       "spec.material.sizes.discrete.radii[1]"},
+      {[&](v1::CampaignSpec& s) {
+         auto* d = s.mutable_material()->mutable_sizes()->mutable_discrete();
+         d->add_radii(5e-4);
+         d->add_mass_fractions(inf);
+       },
+       "spec.material.sizes.discrete.mass_fractions[0]"},
       {tiny_spec(30, 100000), "spec.design.centre_points"},
       {[] {
          auto s = tiny_spec(30);
