@@ -179,6 +179,13 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
   return o;
 }
 
+/// The failure that replaces a result the coordinator refused as invalid: not retryable.
+Outcome refused_result(const grpc::Status& refusal) {
+  Outcome o;
+  o.reason = "the coordinator refused the result: " + refusal.error_message();
+  return o;
+}
+
 /// This process's name for the coordinator: --id, or host:pid.
 std::string worker_id(const WorkerOptions& opt) {
   if (!opt.id.empty()) return opt.id;
@@ -346,7 +353,6 @@ class Worker {
     }
     sim.join();
     const Outcome out = future.get();
-    heartbeat.stop();
     const double wall = std::chrono::duration<double>(Clock::now() - started).count();
     if (out.cancelled && job_stop.lease_lost) {
       // Nobody wants this result any more: the coordinator refuses it and may have given the
@@ -354,8 +360,11 @@ class Worker {
       ++stats_.abandoned;
       spdlog::warn("job {}: simulation stopped after {:.2f} s: {}", job.job_id(), wall, out.reason);
     } else {
+      // Heartbeats go on while the report is retried: the lease must outlive a coordinator
+      // that is slow or restarting.
       report(job, out, wall);
     }
+    heartbeat.stop();
     idle_since_ = Clock::now();
     return true;
   }
@@ -378,7 +387,8 @@ class Worker {
   }
 
   /// Reports the outcome; retried while the coordinator is away (a restart must not lose a
-  /// result).
+  /// result). A result the coordinator refuses as invalid is never sent again: the job fails,
+  /// not retryable, with the coordinator's message (another worker would compute the same).
   void report(const v1::JobSpec& job, const Outcome& out, double wall) {
     for (int tries = 0;; ++tries) {
       const grpc::Status s =
@@ -393,12 +403,20 @@ class Worker {
         }
         return;
       }
-      if (s.error_code() == grpc::StatusCode::FAILED_PRECONDITION) {
+      if (out.ok && s.error_code() == grpc::StatusCode::INVALID_ARGUMENT) {
+        spdlog::error("job {}: coordinator refused the result: {}", job.job_id(),
+                      s.error_message());
+        report(job, refused_result(s), wall);
+        return;
+      }
+      if (s.error_code() == grpc::StatusCode::FAILED_PRECONDITION ||
+          s.error_code() == grpc::StatusCode::PERMISSION_DENIED) {
         ++stats_.rejected;
         spdlog::warn("job {}: coordinator refused the report: {}", job.job_id(), s.error_message());
         return;
       }
-      if (s.error_code() == grpc::StatusCode::UNAUTHENTICATED || flags_.abort || tries > 200) {
+      if (s.error_code() == grpc::StatusCode::UNAUTHENTICATED ||
+          s.error_code() == grpc::StatusCode::INVALID_ARGUMENT || flags_.abort || tries > 200) {
         spdlog::error("job {}: report not delivered: {}", job.job_id(), s.error_message());
         return;
       }
