@@ -335,7 +335,7 @@ void create_private_file(const std::string& path) {
 }  // namespace
 
 Store::Store(const std::string& path, StoreLimits limits, std::optional<double> opened)
-    : limits_(limits) {
+    : lock_(path), limits_(limits) {
   create_private_file(path);
   if (sqlite3_open_v2(path.c_str(), &db_,
                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,

@@ -38,6 +38,8 @@
 #include <utility>
 #include <vector>
 
+#include "server/store_lock.hpp"
+
 namespace demcal::server {
 
 struct CampaignRow {
@@ -155,7 +157,9 @@ enum class LeaseAnswer {
 
 class Store {
  public:
-  /// Opens (creating if needed) and migrates; path ":memory:" for tests. Leases found in the
+  /// Opens (creating if needed) and migrates; path ":memory:" for tests. Refused (naming the
+  /// file and the holder's pid) while another store has the file open (store_lock.hpp). Leases
+  /// found in the
   /// file get the deadline `opened + max(lease, restart grace)` (opened: steady_seconds()
   /// unless given), or are given back (StoreLimits::give_back_leases_at_opening).
   explicit Store(const std::string& path, StoreLimits limits = {},
@@ -279,6 +283,7 @@ class Store {
   /// Finalises the cached statements and closes the connection.
   void close();
 
+  StoreLock lock_;  ///< first in, last out: held while the file is open
   sqlite3* db_ = nullptr;
   /// Prepared statements not in use, by their SQL (Statement takes and gives back); guarded by
   /// mutex_ like the connection.

@@ -254,6 +254,22 @@ TEST_F(Service, AMissingOrEmptyTokenFileStopsServerAndWorkerInsteadOfTurningAuth
   }
 }
 
+TEST_F(Service, ASecondCoordinatorOnTheSameFileRefusesToStartNamingTheFileAndThePid) {
+  start_server();
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  Process second({DEMCAL_SERVER_BIN, "--listen", "127.0.0.1:0", "--db", path("c.db"), "--token",
+                  kToken, "--port-file", path("port2")},
+                 path("second.log"));
+  EXPECT_EQ(second.wait_exit(20), 1) << second.log();
+  EXPECT_NE(second.log().find("refusing to open " + path("c.db")), std::string::npos)
+      << second.log();
+  EXPECT_NE(second.log().find("pid " + std::to_string(server_->pid())), std::string::npos)
+      << second.log();
+  EXPECT_FALSE(fs::exists(path("port2"))) << "the second coordinator listened";
+  EXPECT_EQ(results(id).jobs_size(), 4) << "the first coordinator still serves";
+}
+
 TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
   start_server();
   struct Case {

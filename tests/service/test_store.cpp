@@ -66,6 +66,30 @@ TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
   std::filesystem::remove(path.string() + "-shm");
 }
 
+TEST(Store, ASecondStoreOnTheSameFileIsRefusedNamingTheFileAndTheHolderUntilTheFirstCloses) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("demcal_store_lock_" + std::to_string(::getpid()) + ".db");
+  std::filesystem::remove(path);
+  {
+    Store first(path.string());
+    first.create_campaign("c", "{}", "{}", jobs(2), 0.0);
+    try {
+      Store second(path.string());
+      ADD_FAILURE() << "two stores opened one file";
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("refusing to open " + path.string()), std::string::npos) << what;
+      EXPECT_NE(what.find("(pid " + std::to_string(::getpid()) + ")"), std::string::npos) << what;
+    }
+    // The refused store changed nothing: the first one goes on leasing.
+    EXPECT_TRUE(first.lease("w", 1.0));
+  }
+  Store again(path.string());  // the lock went with the first store
+  EXPECT_EQ(again.counts(1).total(), 2);
+  for (const std::string suffix : {"", "-wal", "-shm", ".lock"})
+    std::filesystem::remove(path.string() + suffix);
+}
+
 TEST(Store, LeasesOfAnEarlierRunOfTheEmbeddedDefaultGoBackUncountedAtOpening) {
   const auto path = std::filesystem::temp_directory_path() /
                     ("demcal_store_give_back_" + std::to_string(::getpid()) + ".db");
