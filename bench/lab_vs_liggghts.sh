@@ -21,8 +21,12 @@
 # compressions (whole processes, summed over the seeds; 2 threads vs 2 ranks, then 1 vs 1) and,
 # last, "ratio: X" = LIGGGHTS wall time / demcal wall time, 2 threads vs 2 ranks. The
 # environment passes through (e.g. OMP_WAIT_POLICY for demcal's OpenMP threads).
+# With DEMCAL_STEP=own, demcal takes its own time step instead of LIGGGHTS's: 0.2 of the
+# Rayleigh time of the smallest sphere (`time_step_safety: 0.2`, docs/engine.md), and as many
+# steps as that step needs for the same piston path; LIGGGHTS keeps dt = 1e-5 s, the step its
+# users take. The stress-strain agreement stays the referee.
 # Usage: bench/lab_vs_liggghts.sh [seeds...]   (default 1 2 3; a spread needs 2 or more);
-#        DEMCAL=path/to/demcal
+#        DEMCAL=path/to/demcal DEMCAL_STEP=fixed|own
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 demcal=${DEMCAL:-$root/build/client/demcal}
@@ -31,6 +35,9 @@ seeds=("$@")
 speed=0.01      # piston speed (m/s)
 strain=0.10     # final strain of the bed height
 dt=1.0e-5       # time step (s), as in both scene files
+own_safety=0.2  # DEMCAL_STEP=own: demcal's step, this fraction of the Rayleigh time
+step_rule=${DEMCAL_STEP:-fixed}
+case $step_rule in fixed|own) ;; *) echo "DEMCAL_STEP must be fixed or own" >&2; exit 2 ;; esac
 every=50        # steps between force records
 die=0.01        # die radius (m), as in bench/lab_die_bed.yaml
 work=$(mktemp -d)
@@ -69,8 +76,16 @@ for seed in "${seeds[@]}"; do
   "$demcal" simulate "$d/die_bed.yaml" --bed "$d/bed.data" --piston-stl "$d/piston.stl" > "$d/settle.json"
   h0=$(json_field '["metrics"]["bed_top"]' < "$d/settle.json")
   steps=$(python3 -c "import math; print(math.ceil($strain * $h0 / ($speed * $dt)))")
+  demcal_dt=$dt
+  time_step_line="time_step: $dt"
+  if [ "$step_rule" = own ]; then
+    demcal_dt=$(python3 -c "import json; print($own_safety * json.load(open('$d/settle.json'))['critical_time_step'])")
+    time_step_line="time_step_safety: $own_safety"
+  fi
+  demcal_steps=$(python3 -c "import math; print(math.ceil($strain * $h0 / ($speed * $demcal_dt)))")
   sed -e "s/velocity: \[0, 0, -0.01\]/velocity: [0, 0, -$speed]/" \
-      -e "s/steps: [0-9]*, record_every: [0-9]*/steps: $steps, record_every: $every/" \
+      -e "s/steps: [0-9]*, record_every: [0-9]*/steps: $demcal_steps, record_every: $every/" \
+      -e "s/^time_step: .*/$time_step_line/" \
       "$root/bench/lab_compression.yaml" > "$d/compression.yaml"
   cp "$root/bench/liggghts/in.lab_compression" "$d/"
   {
@@ -79,7 +94,11 @@ for seed in "${seeds[@]}"; do
     timed run_demcal "$d" 1 demcal_serial
     timed run_liggghts "$d" 1 "$steps" liggghts_serial
   } | tr '\n' ' ' > "$d/wall_times"
-  echo "seed $seed: h0 = $h0 m, $steps steps; wall times (s) demcal 2 threads, LIGGGHTS 2 ranks," \
+  ran_dt=$(json_field '["time_step"]' < "$d/demcal.json")
+  python3 -c "import sys; sys.exit(abs($ran_dt / $demcal_dt - 1) > 1e-9)" ||
+    { echo "demcal ran at dt $ran_dt s, not the $demcal_dt s its steps were counted for" >&2; exit 1; }
+  echo "seed $seed: h0 = $h0 m, demcal $demcal_steps steps of $demcal_dt s, LIGGGHTS $steps steps" \
+    "of $dt s; wall times (s) demcal 2 threads, LIGGGHTS 2 ranks," \
     "demcal 1 thread, LIGGGHTS 1 rank: $(cat "$d/wall_times")" >&2
 done
 
@@ -138,7 +157,7 @@ def mean_std(values):
 
 h0 = statistics.mean(h0s)
 print(f"confined compression, {len(seeds)} beds (seeds {' '.join(seeds)}), h0 = {h0 * 1e3:.2f} mm, "
-      f"piston {speed * 1e3:g} mm/s, dt {dt:g} s; stress in kPa, mean +- std over the beds")
+      f"piston {speed * 1e3:g} mm/s, LIGGGHTS dt {dt:g} s; stress in kPa, mean +- std over the beds")
 print(f"{'strain %':>8} {'demcal':>16} {'LIGGGHTS':>16} {'diff':>8} {'spread':>8} {'agree':>6} "
       f"{'paired diff':>17} {'I':>8}")
 agreed = 0
