@@ -1,5 +1,6 @@
 #include "client/embedded.hpp"
 
+#include <google/protobuf/util/message_differencer.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -89,7 +90,8 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
 }
 
 EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local,
-                                 bool verbose) {
+                                 bool verbose)
+    : workdir_(workdir) {
   watch_stop_signals();
   // The work directory holds the campaign's database: a new one is its owner's alone (0700).
   if (std::filesystem::create_directories(workdir))
@@ -163,6 +165,18 @@ EmbeddedService::~EmbeddedService() {
   coordinator_->shutdown();
 }
 
+void EmbeddedService::refuse_if_another_spec(std::int64_t id, const SpecFile& file) {
+  v1::GetRequest req;
+  req.set_id(id);
+  v1::Campaign stored;
+  check(stub_->Get(rpc::make_context(channel_, 60).get(), req, &stored), "get");
+  if (google::protobuf::util::MessageDifferencer::Equals(stored.spec(), file.spec)) return;
+  throw InputError("", "campaign " + std::to_string(id) + " '" + file.spec.name() + "' in " +
+                           workdir_.string() + " was submitted with another spec than " +
+                           file.name + ": give another --workdir (or another name) to run it, "
+                           "or the spec it was submitted with to resume it");
+}
+
 std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostream& out) {
   v1::ListReply list;
   check(stub_->List(rpc::make_context(channel_, 30).get(), {}, &list), "list");
@@ -170,6 +184,7 @@ std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostrea
   for (const auto& c : list.campaigns())
     if (c.name() == file.spec.name() && c.state() != v1::CANCELLED) id = std::max(id, c.id());
   if (id) {
+    refuse_if_another_spec(id, file);
     out << "resuming campaign " << id << " '" << file.spec.name() << "'\n";
     return id;
   }

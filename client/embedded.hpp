@@ -43,7 +43,8 @@ class EmbeddedService {
   std::string db() const { return db_; }
 
   /// The campaign of the spec's name in this work directory (the newest one not cancelled),
-  /// or the spec submitted now (its design summary printed to `out`). Returns its id.
+  /// or the spec submitted now (its design summary printed to `out`). Returns its id. A campaign
+  /// of that name submitted with another spec is not resumed: InputError naming the directory.
   std::int64_t submit_or_resume(const SpecFile& file, std::ostream& out);
 
   /// Serves the live report page on `address` (HOST:PORT, loopback or with the embedded
@@ -62,6 +63,10 @@ class EmbeddedService {
   void stop_on_signal(int sig);
 
  private:
+  /// Throws InputError unless campaign `id` was submitted with the spec of `file`.
+  void refuse_if_another_spec(std::int64_t id, const SpecFile& file);
+
+  std::filesystem::path workdir_;
   std::string db_;
   std::unique_ptr<server::Coordinator> coordinator_;
   std::unique_ptr<server::HttpPage> http_;

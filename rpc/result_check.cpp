@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <set>
+#include <string_view>
 
 namespace demcal::rpc {
 namespace {
@@ -84,6 +85,15 @@ std::string result_error(const v1::CompleteRequest& result) {
 
 std::string result_error(const v1::JournalRun& result) {
   return check_result(result);
+}
+
+std::string fail_reason(const std::string& reason) {
+  if (reason.size() <= kMaxFailureReason) return reason;
+  constexpr std::string_view kCut = "...";
+  std::size_t cut = kMaxFailureReason - kCut.size();
+  // Not inside a UTF-8 sequence: back to the start of its character.
+  while (cut > 0 && (static_cast<unsigned char>(reason[cut]) & 0xC0) == 0x80) --cut;
+  return reason.substr(0, cut) + std::string(kCut);
 }
 
 }  // namespace demcal::rpc

@@ -3,6 +3,7 @@
 // the two ways a result arrives: a worker's Complete and a journal line (a CLI reading a journal
 // checks its lines with them too, so that a bad line is refused with its file and line before
 // anything is sent).
+#include <cstddef>
 #include <string>
 
 #include "demcal/v1/campaign.pb.h"
@@ -18,5 +19,12 @@ namespace demcal::rpc {
 /// negative. (A NaN would be stored as null and break every later analysis of the campaign.)
 std::string result_error(const v1::CompleteRequest& result);
 std::string result_error(const v1::JournalRun& result);
+
+/// A worker's failure reason, at most (bytes): a coordinator refuses a longer one, so a worker
+/// cuts its own to it (fail_reason).
+constexpr std::size_t kMaxFailureReason = 4096;
+
+/// `reason` cut to kMaxFailureReason bytes at a character boundary, "..." marking the cut.
+std::string fail_reason(const std::string& reason);
 
 }  // namespace demcal::rpc

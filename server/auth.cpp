@@ -42,6 +42,12 @@ grpc::Status authorize(const grpc::ServerContext& context, const Tokens& tokens,
   return {grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"};
 }
 
+std::string token_name(const grpc::ServerContext& context, const Tokens& tokens) {
+  if (presents(context, tokens.both)) return "operator";
+  if (presents(context, tokens.client)) return "client";
+  return {};
+}
+
 namespace {
 std::string read_file(const std::string& path) {
   std::ifstream in(path);

@@ -27,6 +27,10 @@ enum class Caller { kWorker, kClient };
 /// Tokens are compared in constant time.
 grpc::Status authorize(const grpc::ServerContext& context, const Tokens& tokens, Caller caller);
 
+/// Which token an admitted client call carries: "operator" (`both`), "client", or "" when auth
+/// is disabled. What a campaign's owner is recorded as (its unfinished jobs are bounded).
+std::string token_name(const grpc::ServerContext& context, const Tokens& tokens);
+
 /// Server credentials for an address: TLS when a certificate is given, local (LOCAL_TCP) on a
 /// loopback address, plain TCP only when `insecure` is asked for.
 std::shared_ptr<grpc::ServerCredentials> server_credentials(const std::string& address,

@@ -17,8 +17,10 @@
 #include "core/model/catalog.hpp"
 #include "rpc/effects_convert.hpp"
 #include "rpc/material_convert.hpp"
+#include "server/admission.hpp"
 #include "server/calibration.hpp"
 #include "server/diagnosis.hpp"
+#include "server/limits.hpp"
 #include "server/run_key.hpp"
 
 namespace demcal::server {
@@ -39,12 +41,10 @@ std::uint64_t base_seed(const v1::LabTest& t) {
   return t.seed() ? t.seed() : 1;
 }
 
-/// Limits on what one submission can ask the coordinator to build and store: centre points and
-/// replicates each within their range, and the campaign's jobs (design rows x replicates x
-/// tests) at most kMaxCampaignJobs, so a submission cannot stall the store's lock or its disk.
-constexpr int kMaxCentrePoints = 64, kMaxReplicates = 16, kMaxCampaignJobs = 8192;
-/// Simulation threads a test may ask for (each worker caps them at its own --threads).
-constexpr int kMaxThreads = 256;
+/// Limits on what one submission can ask the coordinator to build and store (limits.hpp):
+/// centre points and replicates each within their range, and the campaign's jobs (design rows x
+/// replicates x tests) at most kMaxCampaignJobs, so a submission cannot stall the store's lock or
+/// its disk.
 void check_repeats(const v1::Design& d, int runs, int tests) {
   if (d.centre_points() < 0 || d.centre_points() > kMaxCentrePoints)
     throw InputError("spec.design.centre_points",
@@ -105,7 +105,8 @@ void check_instance_name(const std::string& name, const std::string& where) {
   const bool ok =
       !name.empty() && name.size() <= 64 &&
       name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") == std::string::npos;
-  if (!ok) throw InputError(where, "'" + name + "' is not an instance name (1-64 of a-z, 0-9, _)");
+  if (!ok)
+    throw InputError(where, "'" + echo(name) + "' is not an instance name (1-64 of a-z, 0-9, _)");
 }
 
 /// The model of a test instance: the campaign's with the instance's wall law; errors in that law
@@ -319,7 +320,8 @@ void plan_targets(const v1::CampaignSpec& spec, CampaignPlan& plan) {
         matches.push_back(r);
     }
     if (!m.test().empty() && !tests.count(m.test()))
-      throw InputError(where + ".test", "'" + m.test() + "' is not one of the campaign's tests");
+      throw InputError(where + ".test",
+                       "'" + echo(m.test()) + "' is not one of the campaign's tests");
     if (matches.empty())
       throw InputError(where + ".metric", "no test of the campaign reports '" + m.metric() + "'");
     if (matches.size() > 1)
@@ -455,9 +457,30 @@ v1::CampaignSpec at_fidelity(const v1::CampaignSpec& spec, const CampaignPlan& p
   return out;
 }
 
+namespace {
+
+/// The bytes the campaign's jobs would store at most kMaxCampaignPayloadBytes: the material is
+/// copied into every job, so its size times the jobs, checked before any job is built.
+void check_campaign_bytes(const v1::CampaignSpec& spec, const CampaignPlan& plan) {
+  const std::size_t rows =
+      std::size_t(plan.design.runs()) + (plan.fidelity ? plan.fidelity->high_rows.size() : 0);
+  const std::size_t jobs = rows * std::size_t(std::max(1, spec.tests_size()));
+  const std::size_t material = to_json(spec.material()).size();
+  if (jobs * material > kMaxCampaignPayloadBytes)
+    throw InputError("spec.material",
+                     std::to_string(material) + " bytes copied into each of " +
+                         std::to_string(jobs) + " jobs, more than the " +
+                         std::to_string(kMaxCampaignPayloadBytes / kMiB) +
+                         " MiB a campaign may store (fewer size classes or fewer jobs)");
+}
+
+}  // namespace
+
 CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs) {
   CampaignPlan plan;
+  check_sizes(spec, "spec");
   if (spec.name().empty()) throw InputError("spec.name", "missing");
+  check_printable(spec.name(), "spec.name");
   if (!spec.has_material()) throw InputError("spec.material", "missing");
   lab::MaterialModel model = rpc::to_material_model(spec.material(), "spec.material");
   Instances instances = plan_tests(spec, plan);
@@ -466,6 +489,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
   plan_design(spec, plan);
   plan_targets(spec, plan);
   plan_fidelity(spec, model, plan);
+  check_campaign_bytes(spec, plan);
   // Checked at submission so that a bad calibration or diagnosis block is refused before
   // anything runs.
   (void)calibration_options(spec.calibration(), "spec.calibration");

@@ -20,6 +20,10 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
                                 std::to_string(options_.lease_seconds) + " s)");
   if (options_.max_attempts < 1) throw std::invalid_argument("max attempts must be >= 1");
   const Tokens tokens{options_.token, options_.worker_token, options_.client_token};
+  if (tokens.empty() && !options_.no_auth)
+    throw std::invalid_argument(
+        "no token: give --token-file (or --worker-token-file and --client-token-file), or "
+        "--no-auth to serve without authentication (loopback only)");
   if (tokens.empty() && !is_loopback(options_.listen))
     throw std::invalid_argument(
         "a coordinator listening beyond loopback needs --token-file (or "
@@ -42,12 +46,16 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
     throw std::invalid_argument("the idle retry must lie in [0.01, 60] s");
   if (!(options_.max_checkpoint_mb >= 1.0 && options_.max_checkpoint_mb <= 1024.0))
     throw std::invalid_argument("--max-checkpoint-mb must lie in [1, 1024]");
+  if (options_.max_jobs_per_client < 1 || options_.max_jobs < 1)
+    throw std::invalid_argument("--max-jobs-per-client and --max-jobs must be >= 1");
   ServiceConfig config{tokens,
                        options_.heartbeat_seconds,
                        std::min(options_.idle_retry_seconds, options_.heartbeat_seconds),
                        options_.max_starts,
                        options_.max_watch_interval,
-                       options_.max_checkpoint_mb};
+                       options_.max_checkpoint_mb,
+                       options_.max_jobs_per_client,
+                       options_.max_jobs};
   campaigns_ = std::make_unique<CampaignServiceImpl>(*store_, config, stopping_);
   workers_ = std::make_unique<WorkerServiceImpl>(*store_, config);
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 
+#include "server/limits.hpp"
 #include "server/reflection.hpp"
 #include "server/services.hpp"
 #include "server/store.hpp"
@@ -19,10 +20,12 @@ namespace demcal::server {
 struct CoordinatorOptions {
   std::string listen = "127.0.0.1:7311";  ///< port 0 picks a free one (see port())
   std::string db = "demcal.db";
-  std::string token;         ///< opens both services (all three empty: no auth, loopback only)
+  std::string token;         ///< opens both services (all three empty: refused unless no_auth)
   std::string worker_token;  ///< opens only the WorkerService
   std::string client_token;  ///< opens only the CampaignService
   bool reflection = false;   ///< serve gRPC server reflection (behind the client token)
+  /// Serve without any token (loopback only): must be asked for, never the default.
+  bool no_auth = false;
   double lease_seconds = 60.0;
   double heartbeat_seconds = 10.0;
   double reaper_seconds = 1.0;
@@ -41,6 +44,9 @@ struct CoordinatorOptions {
   int max_starts = 256;              ///< Calibrate `starts`, at most
   double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
   double max_checkpoint_mb = 64.0;   ///< a worker's checkpoint, at most (MiB)
+  /// Unfinished jobs of one token's campaigns, and of the store, at most.
+  long max_jobs_per_client = kDefaultMaxJobsPerClient;
+  long max_jobs = kDefaultMaxJobs;
   std::string tls_cert, tls_key;
   bool insecure = false;  ///< plain TCP (behind a trusted network or a TLS-terminating proxy)
 };

@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
                  "the token of workers: Lease, Heartbeat, Complete, Fail only");
   app.add_option("--client-token-file", client_token_file,
                  "the token of clients: the campaign service only (submit, cancel, queries)");
+  app.add_flag("--no-auth", o.no_auth,
+               "serve without any token (loopback only); without it a token is required");
   app.add_flag("--reflection", o.reflection,
                "serve gRPC server reflection (off by default; needs the client token)");
   app.add_option("--lease", o.lease_seconds, "lease duration (s)")->capture_default_str();
@@ -59,6 +61,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-checkpoint-mb", o.max_checkpoint_mb,
                  "a worker's checkpoint of a running job, at most (MiB, 1-1024)")
+      ->capture_default_str();
+  app.add_option("--max-jobs-per-client", o.max_jobs_per_client,
+                 "unfinished (queued or leased) jobs of one token's campaigns, at most")
+      ->capture_default_str();
+  app.add_option("--max-jobs", o.max_jobs, "unfinished jobs of the whole store, at most")
       ->capture_default_str();
   app.add_option("--tls-cert", o.tls_cert, "PEM certificate chain (enables TLS)");
   app.add_option("--tls-key", o.tls_key, "PEM private key");

@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -10,12 +12,14 @@
 #include "core/lab/protocol.hpp"
 #include "rpc/effects_convert.hpp"
 #include "rpc/result_check.hpp"
+#include "server/admission.hpp"
 #include "server/analysis.hpp"
 #include "server/auth.hpp"
 #include "server/calibration.hpp"
 #include "server/convert.hpp"
 #include "server/diagnosis.hpp"
 #include "server/journal.hpp"
+#include "server/limits.hpp"
 
 namespace demcal::server {
 
@@ -72,13 +76,45 @@ grpc::Status internal(const std::exception& e) {
   return {grpc::StatusCode::INTERNAL, e.what()};
 }
 
-/// The authorization check (auth.hpp) and its log line; every handler starts with it.
-grpc::Status admit(const grpc::ServerContext& ctx, const Tokens& tokens, Caller caller) {
+/// The authorization check (auth.hpp) and its log line, then the request's size: at most
+/// `max_bytes` (limits.hpp). Every handler starts with it. gRPC's server has one receive limit
+/// for all methods, the checkpoint's; the smaller limits of the others are checked here, before
+/// the request is read further or stored.
+grpc::Status admit(const grpc::ServerContext& ctx, const Tokens& tokens, Caller caller,
+                   const google::protobuf::Message& request,
+                   std::size_t max_bytes = kMaxRequestBytes) {
   auto s = authorize(ctx, tokens, caller);
-  if (!s.ok())
+  if (!s.ok()) {
     spdlog::warn("{} call from {}: {}", caller == Caller::kWorker ? "worker" : "client", ctx.peer(),
                  s.error_message());
-  return s;
+    return s;
+  }
+  if (const std::string e = request_size_error(request.ByteSizeLong(), max_bytes,
+                                               request.GetDescriptor()->name());
+      !e.empty()) {
+    spdlog::warn("call from {} refused: {}", ctx.peer(), e);
+    return {grpc::StatusCode::INVALID_ARGUMENT, e};
+  }
+  return grpc::Status::OK;
+}
+
+/// A worker's id and failure reason within their bounds (limits.hpp); "" when they are.
+std::string worker_text_error(const std::string& worker, const std::string& reason = "") {
+  if (worker.size() > kMaxWorkerId)
+    return fmt::format("worker: {} bytes, at most {}", worker.size(), kMaxWorkerId);
+  if (reason.size() > kMaxReason)
+    return fmt::format("reason: {} bytes, at most {}", reason.size(), kMaxReason);
+  return {};
+}
+
+/// The metric values of a result within kMaxMetricMagnitude (finite is checked before); "" when
+/// they are. Names are not checked against the test's catalogue entry: the lab tests report
+/// more (a drum's centrifuging_<rpm>, drum_diameter) than their entries list.
+std::string metrics_error(const google::protobuf::Map<std::string, double>& metrics) {
+  for (const auto& [name, value] : metrics)
+    if (std::abs(value) > kMaxMetricMagnitude)
+      return fmt::format("metrics.{}: {:g} is beyond +-{:g}", name, value, kMaxMetricMagnitude);
+  return {};
 }
 
 doe::ModelKind model_kind(const std::string& text, const std::string& where) {
@@ -86,6 +122,16 @@ doe::ModelKind model_kind(const std::string& text, const std::string& where) {
 }
 
 }  // namespace
+
+void CampaignServiceImpl::wait_watch_interval(const grpc::ServerContext& ctx, double seconds) {
+  // In slices: a client gone or the coordinator stopping ends the wait within one.
+  using Clock = std::chrono::steady_clock;
+  constexpr Clock::duration kSlice = std::chrono::milliseconds(50);
+  const Clock::time_point until = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                     std::chrono::duration<double>(seconds));
+  while (!ctx.IsCancelled() && !stopping_ && Clock::now() < until)
+    std::this_thread::sleep_for(std::min(kSlice, until - Clock::now()));
+}
 
 WatchReads::Read WatchReads::read(std::int64_t campaign_id) {
   // Readers of one campaign wait for the one read under way instead of each reading.
@@ -103,14 +149,37 @@ WatchReads::Read WatchReads::read(std::int64_t campaign_id) {
   return r;
 }
 
+grpc::Status CampaignServiceImpl::check_job_bounds(const std::string& owner, std::size_t jobs) {
+  const auto refuse = [&](long unfinished, const std::string& whose, const std::string& flag,
+                          long max) {
+    const std::string e = fmt::format(
+        "{} jobs more would make {} unfinished (queued or leased) {}, beyond the coordinator's "
+        "{} {}: wait for jobs to finish or cancel a campaign",
+        jobs, unfinished + long(jobs), whose, flag, max);
+    spdlog::warn("submit refused: {}", e);
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, e);
+  };
+  if (const long own = store_.unfinished_jobs(owner);
+      own + long(jobs) > config_.max_jobs_per_client)
+    return refuse(own, "of this token's campaigns", "--max-jobs-per-client",
+                  config_.max_jobs_per_client);
+  if (const long all = store_.unfinished_jobs(); all + long(jobs) > config_.max_jobs)
+    return refuse(all, "in the store", "--max-jobs", config_.max_jobs);
+  return grpc::Status::OK;
+}
+
 grpc::Status CampaignServiceImpl::Submit(grpc::ServerContext* ctx, const v1::SubmitRequest* req,
                                          v1::SubmitReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req, kMaxSpecBytes); !s.ok())
+    return s;
   try {
     std::vector<NewJob> jobs;
     const CampaignPlan plan = plan_campaign(req->spec(), jobs);
+    const std::string owner = token_name(*ctx, config_.tokens);
+    std::lock_guard lock(submit_mutex_);
+    if (auto s = check_job_bounds(owner, jobs.size()); !s.ok()) return s;
     const auto id = store_.create_campaign(req->spec().name(), to_json(req->spec()),
-                                           plan_to_json(plan), jobs, now_seconds());
+                                           plan_to_json(plan), jobs, now_seconds(), owner);
     reply->set_id(id);
     *reply->mutable_design() = design_summary(plan, int(jobs.size()));
     spdlog::info("campaign {} '{}' submitted: {} runs, {} jobs", id, req->spec().name(),
@@ -126,7 +195,7 @@ grpc::Status CampaignServiceImpl::Submit(grpc::ServerContext* ctx, const v1::Sub
 
 grpc::Status CampaignServiceImpl::Get(grpc::ServerContext* ctx, const v1::GetRequest* req,
                                       v1::Campaign* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   try {
@@ -140,9 +209,9 @@ grpc::Status CampaignServiceImpl::Get(grpc::ServerContext* ctx, const v1::GetReq
   return grpc::Status::OK;
 }
 
-grpc::Status CampaignServiceImpl::List(grpc::ServerContext* ctx, const v1::ListRequest*,
+grpc::Status CampaignServiceImpl::List(grpc::ServerContext* ctx, const v1::ListRequest* req,
                                        v1::ListReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   const double now = now_seconds();
   for (const auto& row : store_.campaigns())
     *reply->add_campaigns() = campaign_message(row, store_.counts(row.id), now, false);
@@ -151,7 +220,7 @@ grpc::Status CampaignServiceImpl::List(grpc::ServerContext* ctx, const v1::ListR
 
 grpc::Status CampaignServiceImpl::Cancel(grpc::ServerContext* ctx, const v1::CancelRequest* req,
                                          v1::Campaign* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   if (!store_.cancel(req->id(), now_seconds())) {
     const auto row = store_.campaign(req->id());
     if (!row) return not_found(req->id());
@@ -167,7 +236,7 @@ grpc::Status CampaignServiceImpl::Cancel(grpc::ServerContext* ctx, const v1::Can
 
 grpc::Status CampaignServiceImpl::Watch(grpc::ServerContext* ctx, const v1::WatchRequest* req,
                                         grpc::ServerWriter<v1::Progress>* writer) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   const double interval = req->interval_seconds() != 0.0 ? req->interval_seconds() : 0.5;
   if (!(interval >= kMinWatchInterval && interval <= config_.max_watch_interval))
     return {grpc::StatusCode::INVALID_ARGUMENT,
@@ -190,14 +259,14 @@ grpc::Status CampaignServiceImpl::Watch(grpc::ServerContext* ctx, const v1::Watc
       last_sent = now;
     }
     if (row->state != "running") return grpc::Status::OK;
-    std::this_thread::sleep_for(std::chrono::duration<double>(interval));
+    wait_watch_interval(*ctx, interval);
   }
   return {grpc::StatusCode::CANCELLED, "watch ended"};
 }
 
 grpc::Status CampaignServiceImpl::GetDesign(grpc::ServerContext* ctx, const v1::GetRequest* req,
                                             v1::DesignReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   *reply = design_reply(plan_from_json(row->design_json), int(store_.counts(row->id).total()));
@@ -206,7 +275,7 @@ grpc::Status CampaignServiceImpl::GetDesign(grpc::ServerContext* ctx, const v1::
 
 grpc::Status CampaignServiceImpl::GetResults(grpc::ServerContext* ctx, const v1::GetRequest* req,
                                              v1::ResultsReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   if (!store_.campaign(req->id())) return not_found(req->id());
   try {
     for (const auto& job : store_.jobs(req->id())) *reply->add_jobs() = job_message(job);
@@ -219,7 +288,7 @@ grpc::Status CampaignServiceImpl::GetResults(grpc::ServerContext* ctx, const v1:
 grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
                                              const v1::EffectsRequest* req,
                                              v1::EffectsReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   try {
@@ -269,7 +338,7 @@ grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
 grpc::Status CampaignServiceImpl::Calibrate(grpc::ServerContext* ctx,
                                             const v1::CalibrateRequest* req,
                                             v1::CalibrateReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   if (req->starts() < 0 || req->starts() > config_.max_starts)
     return {grpc::StatusCode::INVALID_ARGUMENT,
             "starts: must lie in [0, " + std::to_string(config_.max_starts) + "] (0 for 16)"};
@@ -294,7 +363,7 @@ grpc::Status CampaignServiceImpl::Calibrate(grpc::ServerContext* ctx,
 
 grpc::Status CampaignServiceImpl::Diagnose(grpc::ServerContext* ctx, const v1::DiagnoseRequest* req,
                                            v1::DiagnoseReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   if (auto s = refuse_if_cancelled(*row, "diagnose"); !s.ok()) return s;
@@ -312,7 +381,7 @@ grpc::Status CampaignServiceImpl::Diagnose(grpc::ServerContext* ctx, const v1::D
 
 grpc::Status CampaignServiceImpl::Export(grpc::ServerContext* ctx, const v1::ExportRequest* req,
                                          grpc::ServerWriter<v1::ExportReply>* writer) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   const std::string format = req->format().empty() ? "json" : req->format();
@@ -343,7 +412,9 @@ grpc::Status CampaignServiceImpl::Export(grpc::ServerContext* ctx, const v1::Exp
 grpc::Status CampaignServiceImpl::ImportRuns(grpc::ServerContext* ctx,
                                              const v1::ImportRunsRequest* req,
                                              v1::ImportRunsReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req, kMaxResultRequestBytes);
+      !s.ok())
+    return s;
   try {
     const ImportCounts counts = import_runs(store_, *req);
     reply->set_kept(counts.kept);
@@ -364,7 +435,9 @@ grpc::Status CampaignServiceImpl::ImportRuns(grpc::ServerContext* ctx,
 
 grpc::Status WorkerServiceImpl::Lease(grpc::ServerContext* ctx, const v1::LeaseRequest* req,
                                       v1::LeaseReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker, *req); !s.ok()) return s;
+  if (const std::string error = worker_text_error(req->worker()); !error.empty())
+    return {grpc::StatusCode::INVALID_ARGUMENT, error};
   reply->set_lease_seconds(store_.limits().lease_seconds);
   reply->set_heartbeat_seconds(config_.heartbeat_seconds);
   reply->set_retry_after_seconds(config_.idle_retry_seconds);
@@ -392,7 +465,9 @@ grpc::Status WorkerServiceImpl::Lease(grpc::ServerContext* ctx, const v1::LeaseR
 
 grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* ctx, const v1::HeartbeatRequest* req,
                                           v1::HeartbeatReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker, *req); !s.ok()) return s;
+  if (const std::string error = worker_text_error(req->worker()); !error.empty())
+    return {grpc::StatusCode::INVALID_ARGUMENT, error};
   if (const auto answer =
           store_.heartbeat(req->job_id(), req->attempt(), req->worker(), steady_seconds());
       answer != LeaseAnswer::kOk)
@@ -403,8 +478,14 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* ctx, const v1::He
 
 grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::CompleteRequest* req,
                                          v1::CompleteReply*) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker, *req, kMaxResultRequestBytes);
+      !s.ok())
+    return s;
+  if (const std::string error = worker_text_error(req->worker()); !error.empty())
+    return {grpc::StatusCode::INVALID_ARGUMENT, error};
   if (const std::string error = rpc::result_error(*req); !error.empty())
+    return {grpc::StatusCode::INVALID_ARGUMENT, error};
+  if (const std::string error = metrics_error(req->metrics()); !error.empty())
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
   std::map<std::string, double> metrics(req->metrics().begin(), req->metrics().end());
   const nlohmann::json flags(
@@ -425,7 +506,9 @@ grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::Com
 
 grpc::Status WorkerServiceImpl::Fail(grpc::ServerContext* ctx, const v1::FailRequest* req,
                                      v1::FailReply*) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker, *req); !s.ok()) return s;
+  if (const std::string error = worker_text_error(req->worker(), req->reason()); !error.empty())
+    return {grpc::StatusCode::INVALID_ARGUMENT, error};
   if (const auto answer = store_.fail(req->job_id(), req->attempt(), req->worker(), req->reason(),
                                       req->retryable(), req->give_back(), steady_seconds());
       answer != LeaseAnswer::kOk)
@@ -437,7 +520,10 @@ grpc::Status WorkerServiceImpl::Fail(grpc::ServerContext* ctx, const v1::FailReq
 
 grpc::Status WorkerServiceImpl::Checkpoint(grpc::ServerContext* ctx,
                                            const v1::CheckpointRequest* req, v1::CheckpointReply*) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker); !s.ok()) return s;
+  // The one large request: its state is bounded below by --max-checkpoint-mb.
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker, *req, SIZE_MAX); !s.ok()) return s;
+  if (const std::string error = worker_text_error(req->worker()); !error.empty())
+    return {grpc::StatusCode::INVALID_ARGUMENT, error};
   if (req->stage().empty() || req->stage().size() > 64)
     return {grpc::StatusCode::INVALID_ARGUMENT, "stage: 1-64 characters"};
   const double max_bytes = config_.max_checkpoint_mb * 1024.0 * 1024.0;

@@ -22,6 +22,8 @@ struct ServiceConfig {
   int max_starts = 256;              ///< Calibrate `starts`, at most
   double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
   double max_checkpoint_mb = 64.0;   ///< a checkpoint's state, at most (MiB)
+  long max_jobs_per_client = 0;      ///< unfinished jobs of one token's campaigns, at most
+  long max_jobs = 0;                 ///< unfinished jobs of the store, at most
 };
 
 /// The shortest Watch interval.
@@ -78,10 +80,19 @@ class CampaignServiceImpl final : public v1::CampaignService::Service {
                           v1::ImportRunsReply*) override;
 
  private:
+  /// Sleeps `seconds` between two ticks of a Watch, ending early when the client goes away or
+  /// the coordinator stops (shutdown waits for every handler).
+  void wait_watch_interval(const grpc::ServerContext& ctx, double seconds);
+  /// RESOURCE_EXHAUSTED when `jobs` more would take the unfinished jobs of `owner`'s campaigns
+  /// or of the store beyond their bounds.
+  grpc::Status check_job_bounds(const std::string& owner, std::size_t jobs);
+
   Store& store_;
   ServiceConfig config_;
   const std::atomic<bool>& stopping_;
   WatchReads watch_reads_;
+  /// One submission at a time: the unfinished jobs counted are those the bounds apply to.
+  std::mutex submit_mutex_;
   std::mutex diagnose_mutex_;
   std::mutex calibrate_mutex_;
 };

@@ -201,6 +201,11 @@ const std::vector<const char*>& migrations() {
       CREATE INDEX jobs_campaign ON jobs (campaign_id);
       CREATE INDEX jobs_run_key ON jobs (run_key, state);
       )sql",
+      // 10: the token a campaign was submitted with (auth.hpp, token_name), whose unfinished
+      // jobs are bounded (limits.hpp).
+      R"sql(
+      ALTER TABLE campaigns ADD COLUMN owner TEXT NOT NULL DEFAULT '';
+      )sql",
   };
   return m;
 }
@@ -488,15 +493,16 @@ void Store::migrate() {
 
 std::int64_t Store::create_campaign(const std::string& name, const std::string& spec_json,
                                     const std::string& design_json, const std::vector<NewJob>& jobs,
-                                    double now) {
+                                    double now, const std::string& owner) {
   std::int64_t id = 0;
   {
     Guard lock(*this);
     Transaction tx(*this);
-    Statement c(*this,
-                "INSERT INTO campaigns (name, state, spec_json, design_json, created, ready) "
-                "VALUES (?, 'running', ?, ?, ?, 0)");
-    c.bind(1, name).bind(2, spec_json).bind(3, design_json).bind(4, now).step();
+    Statement c(
+        *this,
+        "INSERT INTO campaigns (name, state, spec_json, design_json, created, ready, owner) "
+        "VALUES (?, 'running', ?, ?, ?, 0, ?)");
+    c.bind(1, name).bind(2, spec_json).bind(3, design_json).bind(4, now).bind(5, owner).step();
     id = sqlite3_last_insert_rowid(db_);
     tx.commit();
   }
@@ -513,6 +519,16 @@ std::int64_t Store::create_campaign(const std::string& name, const std::string& 
   r.bind(1, id).step();
   tx.commit();
   return id;
+}
+
+std::int64_t Store::unfinished_jobs(const std::optional<std::string>& owner) {
+  Guard lock(*this);
+  Statement s(*this,
+              "SELECT COUNT(*) FROM jobs j JOIN campaigns c ON c.id = j.campaign_id "
+              "WHERE j.state IN ('queued', 'leased') AND (? OR c.owner = ?)");
+  s.bind(1, owner ? 0 : 1).bind(2, owner.value_or(std::string()));
+  s.step();
+  return s.i64(0);
 }
 
 std::vector<std::int64_t> Store::insert_job_rows(std::int64_t campaign_id,

@@ -179,9 +179,12 @@ class Store {
   /// A new running campaign with its jobs, inserted in batches of kInsertBatch (each its own
   /// transaction, the lock free in between); the campaign is leased from, listed and finished
   /// only once all of them are in, and dropped on opening if the coordinator stopped before.
+  /// `owner` names the token it was submitted with (auth.hpp, token_name).
   std::int64_t create_campaign(const std::string& name, const std::string& spec_json,
                                const std::string& design_json, const std::vector<NewJob>& jobs,
-                               double now);
+                               double now, const std::string& owner = "");
+  /// Jobs queued or leased, of the campaigns of `owner` (all campaigns without one).
+  std::int64_t unfinished_jobs(const std::optional<std::string>& owner = std::nullopt);
   std::optional<CampaignRow> campaign(std::int64_t id);
   std::vector<CampaignRow> campaigns();
   Counts counts(std::int64_t campaign_id, const std::string& kind = "");

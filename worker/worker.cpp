@@ -19,6 +19,7 @@
 #include "core/lab/stage_cache.hpp"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "rpc/material_convert.hpp"
+#include "rpc/result_check.hpp"
 
 namespace demcal::worker {
 namespace {
@@ -462,7 +463,7 @@ class Worker {
     f.set_job_id(job.job_id());
     f.set_attempt(job.attempt());
     f.set_worker(id_);
-    f.set_reason(reason);
+    f.set_reason(rpc::fail_reason(reason));
     f.set_retryable(retryable);
     f.set_give_back(give_back);
     v1::FailReply fr;

@@ -300,49 +300,6 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
          return s;
        }(),
        "spec.tests[0].settings.particles"},
-      // Every material value against its parameter's range: an infinite density, radius, size
-      // scale or scaling factor would make every job's result non-finite.
-      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_density(inf); },
-       "spec.material.density"},
-      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_density(-2500); },
-       "spec.material.density"},
-      {[&](v1::CampaignSpec& s) {
-         s.mutable_material()->mutable_sizes()->mutable_monodisperse()->set_radius(inf);
-       },
-       "spec.material.sizes.monodisperse.radius"},
-      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_size_scale(inf); },
-       "spec.material.size_scale"},
-      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_size_scale(-1); },
-       "spec.material.size_scale"},
-      {[&](v1::CampaignSpec& s) { s.mutable_material()->mutable_scaling()->set_factor(inf); },
-       "spec.material.scaling.factor"},
-      {[&](v1::CampaignSpec& s) {
-         auto* l = s.mutable_material()->mutable_sizes()->mutable_lognormal();
-         l->set_median_radius(5e-4);
-         l->set_sigma_g(inf);
-       },
-       "spec.material.sizes.lognormal.sigma_g"},
-      {[&](v1::CampaignSpec& s) {
-         auto* l = s.mutable_material()->mutable_sizes()->mutable_lognormal();
-         l->set_median_radius(5e-4);
-         l->set_sigma_g(1.2);
-         l->set_truncate_k(1e-12);
-       },
-       "spec.material.sizes.lognormal.truncate_k"},
-      {[&](v1::CampaignSpec& s) {
-         auto* d = s.mutable_material()->mutable_sizes()->mutable_discrete();
-         d->add_radii(5e-4);
-         d->add_radii(inf);
-         d->add_mass_fractions(0.5);
-         d->add_mass_fractions(0.5);
-       },
-       "spec.material.sizes.discrete.radii[1]"},
-      {[&](v1::CampaignSpec& s) {
-         auto* d = s.mutable_material()->mutable_sizes()->mutable_discrete();
-         d->add_radii(5e-4);
-         d->add_mass_fractions(inf);
-       },
-       "spec.material.sizes.discrete.mass_fractions[0]"},
       {tiny_spec(30, 100000), "spec.design.centre_points"},
       {[] {
          auto s = tiny_spec(30);
@@ -388,6 +345,49 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
          (*s.mutable_tests(0)->mutable_settings())["particles"] = std::nan("");
        },
        "spec.tests[0].settings.particles"},
+      // Every material value against its parameter's range: an infinite density, radius, size
+      // scale or scaling factor would make every job's result non-finite.
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_density(inf); },
+       "spec.material.density"},
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_density(-2500); },
+       "spec.material.density"},
+      {[&](v1::CampaignSpec& s) {
+         s.mutable_material()->mutable_sizes()->mutable_monodisperse()->set_radius(inf);
+       },
+       "spec.material.sizes.monodisperse.radius"},
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_size_scale(inf); },
+       "spec.material.size_scale"},
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_size_scale(-1); },
+       "spec.material.size_scale"},
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->mutable_scaling()->set_factor(inf); },
+       "spec.material.scaling.factor"},
+      {[&](v1::CampaignSpec& s) {
+         auto* l = s.mutable_material()->mutable_sizes()->mutable_lognormal();
+         l->set_median_radius(5e-4);
+         l->set_sigma_g(inf);
+       },
+       "spec.material.sizes.lognormal.sigma_g"},
+      {[&](v1::CampaignSpec& s) {
+         auto* l = s.mutable_material()->mutable_sizes()->mutable_lognormal();
+         l->set_median_radius(5e-4);
+         l->set_sigma_g(1.2);
+         l->set_truncate_k(1e-12);
+       },
+       "spec.material.sizes.lognormal.truncate_k"},
+      {[&](v1::CampaignSpec& s) {
+         auto* d = s.mutable_material()->mutable_sizes()->mutable_discrete();
+         d->add_radii(5e-4);
+         d->add_radii(inf);
+         d->add_mass_fractions(0.5);
+         d->add_mass_fractions(0.5);
+       },
+       "spec.material.sizes.discrete.radii[1]"},
+      {[&](v1::CampaignSpec& s) {
+         auto* d = s.mutable_material()->mutable_sizes()->mutable_discrete();
+         d->add_radii(5e-4);
+         d->add_mass_fractions(inf);
+       },
+       "spec.material.sizes.discrete.mass_fractions[0]"},
   };
   for (const auto& [spoil, field] : numbers) {
     v1::SubmitRequest req;
@@ -782,6 +782,242 @@ TEST_F(Service, OutOfRangeNumbersInRequestsAreInvalidArgumentNamingTheField) {
   }
 }
 
+// What one request may carry (docs/security.md, "Limits"): every repeated field and string of
+// a spec, the spec's bytes, the bytes its jobs would store, and a worker's id and failure
+// reason. Each refused call names the field and stores nothing.
+TEST_F(Service, OversizedSpecsAndWorkerTextsAreRefusedNamingTheFieldAndNothingIsStored) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  const std::string text(4097, 'x');
+  const auto discrete = [](v1::CampaignSpec& s, int classes) {
+    auto* d = s.mutable_material()->mutable_sizes()->mutable_discrete();
+    for (int k = 0; k < classes; ++k) {
+      d->add_radii(5.12345678912345e-4 + 1e-9 * k);
+      d->add_mass_fractions(1.0);
+    }
+  };
+  const std::vector<std::pair<std::function<void(v1::CampaignSpec&)>, std::string>> cases = {
+      {[&](v1::CampaignSpec& s) { discrete(s, 1001); }, "spec.material.sizes.discrete.radii"},
+      {[&](v1::CampaignSpec& s) { s.set_name(text); }, "spec.name"},
+      {[&](v1::CampaignSpec& s) { s.set_description(text); }, "spec.description"},
+      {[&](v1::CampaignSpec& s) { s.mutable_factors(0)->set_name(text); },
+       "spec.factors[0].name"},
+      {[&](v1::CampaignSpec& s) {
+         for (int i = 0; i < 1001; ++i) s.mutable_factors(0)->add_tied("density");
+       },
+       "spec.factors[0].tied"},
+      {[&](v1::CampaignSpec& s) { s.mutable_measurements(0)->set_source(text); },
+       "spec.measurements[0].source"},
+      {[&](v1::CampaignSpec& s) { s.mutable_design()->set_generators(text); },
+       "spec.design.generators"},
+      {[&](v1::CampaignSpec& s) {
+         for (int i = 0; i < 1001; ++i) s.mutable_diagnose()->add_candidates("shape");
+       },
+       "spec.diagnose.candidates"},
+      {[&](v1::CampaignSpec& s) {
+         s.mutable_fidelity()->set_path("settings.particles");
+         s.mutable_fidelity()->set_low(30);
+         s.mutable_fidelity()->set_high(60);
+         for (int i = 0; i < 1001; ++i) s.mutable_fidelity()->add_high_rows(1);
+       },
+       "spec.fidelity.high_rows"},
+      {[&](v1::CampaignSpec& s) {
+         (*s.mutable_tests(0)->mutable_settings())[text] = 1;
+       },
+       "spec.tests[0].settings"},
+      // 100 sources of 4,000 characters: each within its bound, the spec over 256 KiB.
+      {[&](v1::CampaignSpec& s) {
+         for (int i = 0; i < 100; ++i) {
+           auto* m = s.add_measurements();
+           *m = s.measurements(0);
+           m->set_source(std::string(4000, 'y'));
+         }
+       },
+       "at most 262144"},
+      // 1,000 size classes (allowed) copied into 2 x 64 x 16 = 2,048 jobs: about 45 MB.
+      {[&](v1::CampaignSpec& s) {
+         discrete(s, 1000);
+         s.mutable_measurements(0)->set_test("packing");
+         s.mutable_design()->set_centre_points(60);
+         s.mutable_design()->set_replicates(16);
+         auto* second = s.add_tests();
+         *second = s.tests(0);
+         second->set_name("packing_2");
+       },
+       "spec.material: "},
+  };
+  for (const auto& [spoil, field] : cases) {
+    v1::SubmitRequest req;
+    *req.mutable_spec() = cli::parse_campaign_spec(tiny_spec(30), "spec.yaml").spec;
+    spoil(*req.mutable_spec());
+    v1::SubmitReply reply;
+    const auto st = campaigns_->Submit(ctx().get(), req, &reply);
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << field;
+    EXPECT_NE(st.error_message().find(field), std::string::npos) << st.error_message();
+    EXPECT_LT(st.error_message().size(), 1000u) << "the refusal echoes the input whole";
+  }
+  v1::ListReply list;
+  ASSERT_TRUE(campaigns_->List(ctx().get(), {}, &list).ok());
+  EXPECT_EQ(list.campaigns_size(), 0) << "a refused spec was stored";
+
+  // A worker's id and its failure reason are bounded too; a refused Fail leaves the lease as it
+  // was.
+  ASSERT_TRUE(submit(tiny_spec(30)).ok());
+  v1::LeaseRequest long_id;
+  long_id.set_worker(std::string(257, 'w'));
+  v1::LeaseReply refused;
+  auto st = workers_stub_->Lease(ctx().get(), long_id, &refused);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(st.error_message().find("worker: "), std::string::npos) << st.error_message();
+  v1::JobSpec job;
+  v1::CompleteRequest c;
+  ASSERT_NO_FATAL_FAILURE(lease_request("w1", job, c));
+  v1::FailRequest fail;
+  fail.set_job_id(job.job_id());
+  fail.set_attempt(job.attempt());
+  fail.set_worker("w1");
+  fail.set_reason(text);
+  v1::FailReply fr;
+  st = workers_stub_->Fail(ctx().get(), fail, &fr);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(st.error_message().find("reason: "), std::string::npos) << st.error_message();
+  // Only the checkpoint may be large: a heartbeat of 1 MB is refused, not read further.
+  v1::HeartbeatRequest beat;
+  beat.set_job_id(job.job_id());
+  beat.set_attempt(job.attempt());
+  beat.set_worker(std::string(1 << 20, 'w'));
+  v1::HeartbeatReply hr;
+  st = workers_stub_->Heartbeat(ctx().get(), beat, &hr);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(st.error_message().find("bytes"), std::string::npos) << st.error_message();
+  beat.set_worker("w1");
+  EXPECT_TRUE(workers_stub_->Heartbeat(ctx().get(), beat, &hr).ok()) << "the lease was lost";
+}
+
+// A result's metric values are finite and within 1e100 in magnitude.
+TEST_F(Service, AResultWithAMetricBeyondTheBoundIsRefused) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  ASSERT_TRUE(submit(tiny_spec(30)).ok());
+  v1::JobSpec job;
+  v1::CompleteRequest c;
+  ASSERT_NO_FATAL_FAILURE(lease_request("w1", job, c));
+  const std::vector<std::pair<std::map<std::string, double>, std::string>> cases = {
+      {{{"solid_fraction", 1e308}}, "metrics.solid_fraction"},
+      {{{"solid_fraction", -2e100}}, "metrics.solid_fraction"},
+  };
+  for (const auto& [metrics, field] : cases) {
+    v1::CompleteRequest bad = c;
+    for (const auto& [k, v] : metrics) (*bad.mutable_metrics())[k] = v;
+    v1::CompleteReply cr;
+    const auto st = workers_stub_->Complete(ctx().get(), bad, &cr);
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << field;
+    EXPECT_NE(st.error_message().find(field), std::string::npos) << st.error_message();
+  }
+  (*c.mutable_metrics())["solid_fraction"] = 0.6;
+  (*c.mutable_metrics())["coordination_number"] = 4.0;
+  v1::CompleteReply cr;
+  const auto st = workers_stub_->Complete(ctx().get(), c, &cr);
+  EXPECT_TRUE(st.ok()) << st.error_message();
+}
+
+// Campaign names are printed by `demcal list`: a control character (a terminal escape) is
+// refused.
+TEST_F(Service, ACampaignNameWithAControlCharacterIsRefused) {
+  start_server();
+  // ESC, LF and the one-character CSI U+009B (as UTF-8).
+  for (const std::string name : {"tiny\x1b[2J", "a\nb", "x\xc2\x9b" "31m"}) {
+    v1::SubmitRequest req;
+    *req.mutable_spec() = cli::parse_campaign_spec(tiny_spec(30), "spec.yaml").spec;
+    req.mutable_spec()->set_name(name);
+    v1::SubmitReply reply;
+    const auto st = campaigns_->Submit(ctx().get(), req, &reply);
+    EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(st.error_message().find("spec.name"), std::string::npos) << st.error_message();
+  }
+}
+
+// Fail closed: a coordinator without a token refuses to start unless told --no-auth.
+TEST_F(Service, ACoordinatorWithoutATokenStartsOnlyWithNoAuth) {
+  Process refused({DEMCAL_SERVER_BIN, "--listen", "127.0.0.1:0", "--db", path("c.db"),
+                   "--port-file", path("port")},
+                  path("refused.log"));
+  EXPECT_NE(refused.wait_exit(20), 0) << refused.log();
+  EXPECT_NE(refused.log().find("--no-auth"), std::string::npos) << refused.log();
+  EXPECT_FALSE(fs::exists(path("port"))) << "it listened";
+  Process unguarded({DEMCAL_SERVER_BIN, "--listen", "127.0.0.1:0", "--db", path("c.db"),
+                "--port-file", path("port"), "--no-auth"},
+               path("open.log"));
+  ASSERT_TRUE(wait_until([&] { return fs::exists(path("port")); }, 20)) << unguarded.log();
+  rpc::ChannelOptions ch;
+  std::ifstream(path("port")) >> port_;
+  ch.address = "127.0.0.1:" + std::to_string(port_);
+  auto stub = v1::CampaignService::NewStub(rpc::make_channel(ch));
+  v1::ListReply list;
+  EXPECT_TRUE(stub->List(rpc::make_context(ch, 10).get(), {}, &list).ok());
+}
+
+// A Watch stream waiting out its interval does not hold up the coordinator's shutdown.
+TEST_F(Service, AWatchWaitingOutALongIntervalDoesNotHoldUpShutdown) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  v1::WatchRequest req;
+  req.set_id(id);
+  req.set_interval_seconds(60);
+  auto context = ctx(120);
+  auto reader = campaigns_->Watch(context.get(), req);
+  v1::Progress p;
+  ASSERT_TRUE(reader->Read(&p));  // the stream is open and sleeping
+  const auto start = std::chrono::steady_clock::now();
+  server_->signal(SIGTERM);
+  EXPECT_EQ(server_->wait_exit(30), 0) << server_->log();
+  const double took =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(took, 5.0) << "the coordinator took " << took << " s to stop";
+  context->TryCancel();
+}
+
+// Unfinished jobs (queued or leased) are bounded per client token and in the whole store
+// (HTCondor's MAX_JOBS_PER_OWNER, Slurm's MaxSubmitJobs): a Submit beyond either bound is
+// refused with RESOURCE_EXHAUSTED naming it and stores nothing; a cancelled campaign's jobs no
+// longer count. Small bounds here (4 jobs per campaign).
+TEST_F(Service, SubmissionsBeyondTheUnfinishedJobsOfATokenOrOfTheStoreAreRefused) {
+  std::ofstream(path("client.token")) << "client-token-456\n";
+  start_server(1.5, 0.3, 0,
+               {"--client-token-file", path("client.token"), "--max-jobs-per-client", "8",
+                "--max-jobs", "12"});
+  std::int64_t first = 0, id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &first).ok());
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  auto st = submit(tiny_spec(30));
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << st.error_message();
+  EXPECT_NE(st.error_message().find("--max-jobs-per-client 8"), std::string::npos)
+      << st.error_message();
+  // Another token has its own bound, but the store's is shared.
+  rpc::ChannelOptions client = channel_;
+  client.token = "client-token-456";
+  auto client_stub = v1::CampaignService::NewStub(rpc::make_channel(client));
+  const auto client_submit = [&] {
+    v1::SubmitRequest req;
+    *req.mutable_spec() = cli::parse_campaign_spec(tiny_spec(30), "spec.yaml").spec;
+    v1::SubmitReply reply;
+    return client_stub->Submit(rpc::make_context(client, 30).get(), req, &reply);
+  };
+  EXPECT_TRUE(client_submit().ok());
+  st = client_submit();
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << st.error_message();
+  EXPECT_NE(st.error_message().find("--max-jobs 12"), std::string::npos) << st.error_message();
+  v1::ListReply list;
+  ASSERT_TRUE(campaigns_->List(ctx().get(), {}, &list).ok());
+  EXPECT_EQ(list.campaigns_size(), 3);
+  // Cancelled jobs are finished: room again.
+  v1::CancelRequest cancel;
+  cancel.set_id(first);
+  v1::Campaign cancelled;
+  ASSERT_TRUE(campaigns_->Cancel(ctx().get(), cancel, &cancelled).ok());
+  st = submit(tiny_spec(30));
+  EXPECT_TRUE(st.ok()) << st.error_message();
+}
+
 TEST_F(Service, WorkersRacingNeverShareAJob) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
@@ -885,6 +1121,34 @@ TEST_F(Service, CoordinatorKilledAndRestartedCampaignCompletesNothingLostOrDupli
     EXPECT_EQ(j.metrics().size(), 2u);
   }
   EXPECT_NE(server_->log().find("resuming campaign"), std::string::npos);
+}
+
+// `demcal run` on a work directory whose campaign of that name was submitted with another spec
+// refuses, naming the directory, instead of resuming the old campaign as if it were this one.
+TEST_F(Service, RunOnAWorkDirectoryWhoseCampaignHasAnotherSpecRefuses) {
+  const std::string spec = path("tiny.yaml");
+  std::ofstream(spec) << tiny_spec(200);
+  Process first({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1",
+                 "--no-verify"},
+                path("first.log"));
+  ASSERT_EQ(first.wait_exit(150), 0) << first.log();
+  std::string edited = tiny_spec(200);
+  edited.replace(edited.find("low: 0.1, high: 0.5"), 19, "low: 0.1, high: 0.4");
+  std::ofstream(spec) << edited;
+  Process second({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1",
+                  "--no-verify"},
+                 path("second.log"));
+  EXPECT_NE(second.wait_exit(150), 0) << second.log();
+  EXPECT_NE(second.log().find("another spec"), std::string::npos) << second.log();
+  EXPECT_NE(second.log().find(path("work")), std::string::npos) << second.log();
+  EXPECT_EQ(second.log().find("resuming campaign"), std::string::npos) << second.log();
+  // The unchanged spec still resumes.
+  std::ofstream(spec) << tiny_spec(200);
+  Process third({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1",
+                 "--no-verify"},
+                path("third.log"));
+  EXPECT_EQ(third.wait_exit(150), 0) << third.log();
+  EXPECT_NE(third.log().find("resuming campaign 1"), std::string::npos) << third.log();
 }
 
 TEST_F(Service, CliRunsACampaignEndToEnd) {
