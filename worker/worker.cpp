@@ -8,10 +8,12 @@
 #include <cmath>
 #include <condition_variable>
 #include <future>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <random>
 #include <thread>
+#include <utility>
 
 #include "core/common/error.hpp"
 #include "core/lab/lab_test.hpp"
@@ -320,8 +322,11 @@ class Worker {
                    s.ok() ? "reported" : s.error_message());
       return true;
     }
-    std::atomic<double> progress{0.0};
-    JobStop job_stop;
+    // Shared with the simulation's thread, which a give-back on abort detaches: it may write
+    // them after this function has returned (until the process exits).
+    const auto shared = std::make_shared<std::pair<std::atomic<double>, JobStop>>();
+    std::atomic<double>& progress = shared->first;
+    JobStop& job_stop = shared->second;
     job_stop.max_seconds = opt_.max_job_seconds;
     if (opt_.max_job_seconds > 0)
       job_stop.deadline = started + std::chrono::duration_cast<Clock::duration>(
@@ -329,13 +334,12 @@ class Worker {
     Heartbeat heartbeat(*stub_, opt_.channel, job, id_,
                         lease.heartbeat_seconds() > 0 ? lease.heartbeat_seconds() : 10.0, progress,
                         job_stop.lease_lost);
-    // The simulation runs on its own thread so that a stop request can give the lease back.
-    // It reads `progress` and `job_stop` only until it returns; a detached simulation (give-back
-    // on abort) is followed by the process exiting.
+    // The simulation runs on its own thread so that a stop request can give the lease back; a
+    // detached simulation (give-back on abort) is followed by the process exiting.
     auto task = std::make_shared<std::packaged_task<Outcome()>>(
-        [this, job, threads = opt_.threads, &progress, &job_stop] {
+        [this, job, threads = opt_.threads, shared] {
           return run_job(
-              job, threads, progress, job_stop,
+              job, threads, shared->first, shared->second,
               [this, &job](const std::string& stage, std::string state) {
                 send_checkpoint(job, stage, std::move(state));
               },
