@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -10,6 +11,7 @@
 
 #include "core/common/error.hpp"
 #include "core/lab/protocol.hpp"
+#include "core/model/catalog.hpp"
 #include "rpc/effects_convert.hpp"
 #include "rpc/result_check.hpp"
 #include "server/admission.hpp"
@@ -108,12 +110,30 @@ std::string worker_text_error(const std::string& worker, const std::string& reas
 }
 
 /// The metric values of a result within kMaxMetricMagnitude (finite is checked before); "" when
-/// they are. Names are not checked against the test's catalogue entry: the lab tests report
-/// more (a drum's centrifuging_<rpm>, drum_diameter) than their entries list.
+/// they are.
 std::string metrics_error(const google::protobuf::Map<std::string, double>& metrics) {
   for (const auto& [name, value] : metrics)
     if (std::abs(value) > kMaxMetricMagnitude)
       return fmt::format("metrics.{}: {:g} is beyond +-{:g}", name, value, kMaxMetricMagnitude);
+  return {};
+}
+
+/// Whether a run of the test `info` describes reports a metric of that name: one of its metrics
+/// or of what it also reports.
+bool reports_metric(const lab::LabTestInfo& info, const std::string& metric) {
+  return std::ranges::any_of(info.metrics,
+                             [&metric](const lab::MetricInfo& m) { return m.name == metric; }) ||
+         std::ranges::find(info.also_reported, metric) != info.also_reported.end();
+}
+
+/// The names of a result's metrics against the lab test `test` of its job; "" when the test
+/// reports each.
+std::string metric_names_error(const google::protobuf::Map<std::string, double>& metrics,
+                               const std::string& test) {
+  const lab::LabTestInfo& info = lab::find_lab_info(test);
+  for (const auto& [name, value] : metrics)
+    if (!reports_metric(info, name))
+      return fmt::format("metrics.{}: not a metric the {} test reports", echo(name), test);
   return {};
 }
 
@@ -487,6 +507,18 @@ grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::Com
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
   if (const std::string error = metrics_error(req->metrics()); !error.empty())
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
+  try {
+    // A job not in the store is answered by the lease check below.
+    if (const auto job = store_.job(req->job_id())) {
+      v1::JobSpec spec;
+      from_json(job->payload, spec);
+      if (const std::string error = metric_names_error(req->metrics(), spec.test());
+          !error.empty())
+        return {grpc::StatusCode::INVALID_ARGUMENT, error};
+    }
+  } catch (const std::exception& e) {
+    return internal(e);
+  }
   std::map<std::string, double> metrics(req->metrics().begin(), req->metrics().end());
   const nlohmann::json flags(
       std::map<std::string, std::string>(req->flags().begin(), req->flags().end()));

@@ -28,6 +28,9 @@ struct LabTestInfo {
   std::string source;  ///< seed section
   std::vector<MetricInfo> metrics;
   std::vector<contact::ParamDoc> settings;  ///< name, unit, range, default, meaning
+  /// What the runner reports beside its metrics, as context and never as a response (a drum's
+  /// particle count, its centrifuging at every speed): a result may carry these names too.
+  std::vector<std::string> also_reported = {};
 };
 
 /// All lab tests, in a fixed order.

@@ -54,7 +54,8 @@ struct HopperTest {
          {"arched", "0/1", "1 when no particle left for arch_time before the hopper emptied"},
          {"beverloo_rate", "kg/s", "Beverloo's slot-form rate with the wall factor"},
          {"beverloo_ratio", "-", "discharge_rate over beverloo_rate"}},
-        settings_docs<HopperSettings>()};
+        settings_docs<HopperSettings>(),
+        {"discharged_fraction", "bulk_density"}};
   }
   static LabOutput run(const MaterialModel& material, const Settings& settings,
                        const RunOptions& options);

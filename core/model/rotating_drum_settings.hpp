@@ -98,7 +98,9 @@ struct RotatingDrumTest {
          {"csa_occupied_105", "%", "occupied cross-sectional area at 105 rpm (eq. 20)"},
          {"csa_occupied_116", "%", "occupied cross-sectional area at 116 rpm (eq. 20)"},
          {"centrifuging_116", "0/1", "1 when the bed centrifuges at 116 rpm"}},
-        settings_docs<RotatingDrumSettings>()};
+        settings_docs<RotatingDrumSettings>(),
+        {"centrifuging_4", "centrifuging_40", "centrifuging_80", "centrifuging_105",
+         "drum_diameter", "drum_diameter_ratio", "particles"}};
   }
   static LabOutput run(const MaterialModel& material, const Settings& settings,
                        const RunOptions& options);

@@ -86,7 +86,10 @@ struct ShearCellTest {
          {"unconfined_yield_strength", "kPa", "sigma_c of the Mohr circle through the origin"},
          {"major_consolidation_stress", "kPa",
           "sigma_1 of the circle through the pre-shear point touching the locus"}},
-        settings_docs<ShearCellSettings>()};
+        settings_docs<ShearCellSettings>(),
+        // the yield shear stress at each of kShearNormalKPa ('.' written 'p')
+        {"pre_shear_normal_stress", "yield_shear_stress_2", "yield_shear_stress_1p75",
+         "yield_shear_stress_1p5", "yield_shear_stress_1p25", "yield_shear_stress_1"}};
   }
   static LabOutput run(const MaterialModel& material, const Settings& settings,
                        const RunOptions& options);

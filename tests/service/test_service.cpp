@@ -919,6 +919,27 @@ TEST_F(Service, AResultWithAMetricBeyondTheBoundIsRefused) {
   EXPECT_TRUE(st.ok()) << st.error_message();
 }
 
+// A result names only metrics its test reports (its catalogue entry: the metrics and what the
+// test also reports): another name is refused naming it, and nothing is stored.
+TEST_F(Service, AResultWithAMetricItsTestDoesNotReportIsRefused) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  ASSERT_TRUE(submit(tiny_spec(30)).ok());
+  v1::JobSpec job;
+  v1::CompleteRequest c;
+  ASSERT_NO_FATAL_FAILURE(lease_request("w1", job, c));
+  (*c.mutable_metrics())["solid_fraction"] = 0.6;
+  (*c.mutable_metrics())["coordination_number"] = 4.0;
+  v1::CompleteRequest bad = c;
+  (*bad.mutable_metrics())["centrifuging_116"] = 1.0;  // the drum's, not the packing's
+  v1::CompleteReply cr;
+  auto st = workers_stub_->Complete(ctx().get(), bad, &cr);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(st.error_message().find("metrics.centrifuging_116"), std::string::npos)
+      << st.error_message();
+  st = workers_stub_->Complete(ctx().get(), c, &cr);
+  EXPECT_TRUE(st.ok()) << st.error_message();
+}
+
 // Campaign names are printed by `demcal list`: a control character (a terminal escape) is
 // refused.
 TEST_F(Service, ACampaignNameWithAControlCharacterIsRefused) {
