@@ -78,16 +78,35 @@ std::unique_ptr<httplib::Server> make_server(const HttpPageOptions& o) {
   return s;
 }
 
+/// The gRPC port's rule (server_credentials): beyond loopback, TLS or an explicit --insecure.
+void check_transport(const HttpPageOptions& o) {
+  if (!o.tls_cert.empty() || is_loopback(o.listen)) return;
+  if (!o.insecure)
+    throw std::invalid_argument(
+        "--http beyond loopback needs --tls-cert/--tls-key, or --insecure (the bearer token "
+        "would travel in clear text)");
+  spdlog::warn("live page on {} without TLS (--insecure): the bearer token travels in clear text",
+               o.listen);
+}
+
 }  // namespace
+
+std::string page_token(const Tokens& tokens, const std::string& listen) {
+  if (!tokens.client.empty() || tokens.empty()) return tokens.client;
+  if (!tokens.both.empty() && is_loopback(listen)) return tokens.both;
+  throw std::invalid_argument(
+      "--http needs --client-token-file" +
+      std::string(tokens.both.empty() ? "" : " beyond loopback") +
+      ": the page's readers send its token, and the operator's would open the worker service "
+      "to them");
+}
 
 HttpPage::HttpPage(std::shared_ptr<grpc::Channel> coordinator, HttpPageOptions options)
     : coordinator_(std::move(coordinator)), options_(std::move(options)) {
   if (options_.token.empty() && !is_loopback(options_.listen))
     throw std::invalid_argument("--http beyond loopback needs a token");
   if (options_.poll_ms < 200) throw std::invalid_argument("--http: poll interval below 200 ms");
-  if (options_.tls_cert.empty() && !is_loopback(options_.listen))
-    spdlog::warn("live page on {} without TLS: the bearer token travels in clear text",
-                 options_.listen);
+  check_transport(options_);
   server_ = make_server(options_);
   routes();
   const auto [host, port] = split_address(options_.listen);

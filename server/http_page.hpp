@@ -17,6 +17,8 @@
 #include <thread>
 #include <unordered_map>
 
+#include "server/auth.hpp"
+
 namespace httplib {
 class Server;
 struct Request;
@@ -29,8 +31,16 @@ struct HttpPageOptions {
   std::string listen;  ///< host:port; port 0 picks a free one (see HttpPage::port)
   std::string token;   ///< empty: no auth, allowed on loopback only (fails closed otherwise)
   std::string tls_cert, tls_key;  ///< PEM files: HTTPS, as the coordinator's gRPC port
-  int poll_ms = 3000;             ///< how often the pages ask for new data
+  /// Plain HTTP beyond loopback, as the coordinator's --insecure: the token in clear text.
+  bool insecure = false;
+  int poll_ms = 3000;  ///< how often the pages ask for new data
 };
+
+/// The token of the readers of a page listening on `listen`: the client token (the page is a
+/// read-only client); without one, the operator's on loopback only (its readers are on the
+/// operator's machine); "" when auth is off. Throws std::invalid_argument otherwise: the
+/// operator's token would open the worker service to readers elsewhere.
+std::string page_token(const Tokens& tokens, const std::string& listen);
 
 class HttpPage {
  public:

@@ -96,11 +96,12 @@ int main(int argc, char** argv) {
     write_port_file(port_file, coordinator.port());
     std::unique_ptr<demcal::server::HttpPage> page;
     if (!http.empty()) {
-      // The page is a read-only client: it takes the client token where one is set.
-      const std::string& page_token = o.client_token.empty() ? o.token : o.client_token;
       page = std::make_unique<demcal::server::HttpPage>(
           coordinator.in_process_channel(),
-          demcal::server::HttpPageOptions{http, page_token, o.tls_cert, o.tls_key});
+          demcal::server::HttpPageOptions{
+              http,
+              demcal::server::page_token({o.token, o.worker_token, o.client_token}, http),
+              o.tls_cert, o.tls_key, o.insecure});
       write_port_file(http_port_file, page->port());
     }
     int sig = 0;

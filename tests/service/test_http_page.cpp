@@ -1,6 +1,7 @@
 // The live page's HTTP side in process: a coordinator with its page; the token checked on the
 // JSON endpoints (401 without or with a wrong one), the pages themselves carry no data, the
-// page refuses to serve beyond loopback without a token, and serves HTTPS with a certificate.
+// page refuses to serve beyond loopback without a token or in plain HTTP unless told
+// --insecure, takes the client token, and serves HTTPS with a certificate.
 #include <gtest/gtest.h>
 #include <httplib.h>
 #include <unistd.h>
@@ -46,6 +47,31 @@ httplib::Headers bearer(const std::string& token) {
 
 TEST(HttpPage, RefusesToServeBeyondLoopbackWithoutAToken) {
   EXPECT_THROW(HttpPage(nullptr, page_options("0.0.0.0:0", "")), std::invalid_argument);
+}
+
+// The gRPC port's rule: beyond loopback, TLS or an explicit --insecure; never a token in clear
+// text unasked.
+TEST(HttpPage, RefusesPlainHttpBeyondLoopbackUnlessInsecure) {
+  EXPECT_THROW(HttpPage(nullptr, page_options("0.0.0.0:0", "secret")), std::invalid_argument);
+  HttpPageOptions insecure = page_options("0.0.0.0:0", "secret");
+  insecure.insecure = true;
+  HttpPage page(nullptr, insecure);
+  const auto index = httplib::Client("127.0.0.1", page.port()).Get("/");
+  ASSERT_TRUE(index) << "no plain HTTP answer";
+  EXPECT_EQ(index->status, 200);
+  page.stop();
+}
+
+// The page is a read-only client: it takes the client token; the operator's only on loopback,
+// where its readers are on the operator's machine; never a worker's.
+TEST(HttpPage, TakesTheClientTokenAndTheOperatorsOnlyOnLoopback) {
+  const Tokens operator_and_client{"op", "", "cl"}, operator_only{"op", "", ""};
+  EXPECT_EQ(page_token(operator_and_client, "0.0.0.0:8080"), "cl");
+  EXPECT_EQ(page_token(operator_and_client, "127.0.0.1:8080"), "cl");
+  EXPECT_EQ(page_token(operator_only, "127.0.0.1:8080"), "op");
+  EXPECT_THROW(page_token(operator_only, "0.0.0.0:8080"), std::invalid_argument);
+  EXPECT_THROW(page_token(Tokens{"", "wk", ""}, "127.0.0.1:8080"), std::invalid_argument);
+  EXPECT_EQ(page_token(Tokens{}, "127.0.0.1:8080"), "");
 }
 
 TEST(HttpPage, JsonNeedsTheCoordinatorsTokenAndThePagesCarryNoData) {
