@@ -49,6 +49,10 @@ inline constexpr std::size_t kMaxReason = rpc::kMaxFailureReason;
 /// A metric's magnitude: far beyond any quantity a lab test measures (stresses in Pa, energies
 /// in J), and small enough that sums and squares of many stay finite.
 inline constexpr double kMaxMetricMagnitude = 1e100;
+/// Watch streams open at once per client token (the operator's, the client's; every caller when
+/// auth is off): each holds a coordinator thread while its campaign runs. Above the 50 watchers
+/// of bench/coordinator.sh.
+inline constexpr int kMaxWatchStreamsPerClient = 64;
 /// Characters of a client's text an error message repeats (the rest is cut, "...").
 inline constexpr std::size_t kMaxEcho = 80;
 

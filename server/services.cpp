@@ -153,6 +153,19 @@ void CampaignServiceImpl::wait_watch_interval(const grpc::ServerContext& ctx, do
     std::this_thread::sleep_for(std::min(kSlice, until - Clock::now()));
 }
 
+std::optional<WatchStreams::Slot> WatchStreams::open(const std::string& client) {
+  std::lock_guard lock(mutex_);
+  int& open = open_[client];
+  if (open >= kMaxWatchStreamsPerClient) return std::nullopt;
+  ++open;
+  return std::optional<Slot>(std::in_place, *this, client);
+}
+
+void WatchStreams::close(const std::string& client) {
+  std::lock_guard lock(mutex_);
+  if (--open_[client] == 0) open_.erase(client);
+}
+
 WatchReads::Read WatchReads::read(std::int64_t campaign_id) {
   // Readers of one campaign wait for the one read under way instead of each reading.
   std::lock_guard lock(mutex_);
@@ -262,6 +275,11 @@ grpc::Status CampaignServiceImpl::Watch(grpc::ServerContext* ctx, const v1::Watc
     return {grpc::StatusCode::INVALID_ARGUMENT,
             fmt::format("interval_seconds: must lie in [{}, {}] (or 0 for 0.5)", kMinWatchInterval,
                         config_.max_watch_interval)};
+  const auto slot = watch_streams_.open(token_name(*ctx, config_.tokens));
+  if (!slot)
+    return {grpc::StatusCode::RESOURCE_EXHAUSTED,
+            fmt::format("Watch: this token has {} streams open, at most {} (close one)",
+                        kMaxWatchStreamsPerClient, kMaxWatchStreamsPerClient)};
   std::string last;
   double last_sent = 0.0;
   while (!ctx->IsCancelled() && !stopping_) {

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
@@ -55,6 +56,37 @@ class WatchReads {
   std::map<std::int64_t, Entry> entries_;
 };
 
+/// The Watch streams open per client token, each at most kMaxWatchStreamsPerClient: a stream
+/// holds one of the coordinator's threads for as long as its campaign runs.
+class WatchStreams {
+ public:
+  /// One open stream of a client, counted until it is destroyed.
+  class Slot {
+   public:
+    Slot(WatchStreams& streams, std::string client)
+        : streams_(&streams), client_(std::move(client)) {}
+    Slot(Slot&& other) noexcept
+        : streams_(std::exchange(other.streams_, nullptr)), client_(std::move(other.client_)) {}
+    Slot(const Slot&) = delete;
+    Slot& operator=(const Slot&) = delete;
+    Slot& operator=(Slot&&) = delete;
+    ~Slot() {
+      if (streams_) streams_->close(client_);
+    }
+
+   private:
+    WatchStreams* streams_;
+    std::string client_;
+  };
+  /// A slot for a new stream of `client`; none when it has kMaxWatchStreamsPerClient open.
+  std::optional<Slot> open(const std::string& client);
+
+ private:
+  void close(const std::string& client);
+  std::mutex mutex_;
+  std::map<std::string, int> open_;
+};
+
 class CampaignServiceImpl final : public v1::CampaignService::Service {
  public:
   CampaignServiceImpl(Store& store, ServiceConfig config, const std::atomic<bool>& stopping)
@@ -91,6 +123,7 @@ class CampaignServiceImpl final : public v1::CampaignService::Service {
   ServiceConfig config_;
   const std::atomic<bool>& stopping_;
   WatchReads watch_reads_;
+  WatchStreams watch_streams_;
   /// One submission at a time: the unfinished jobs counted are those the bounds apply to.
   std::mutex submit_mutex_;
   std::mutex diagnose_mutex_;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -14,6 +15,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <thread>
 
 #include "client/service_client.hpp"
 #include "client/spec_yaml.hpp"
@@ -24,6 +26,7 @@
 #include "grpc/reflection/v1alpha/reflection.grpc.pb.h"
 #include "rpc/channel.hpp"
 #include "rpc/material_convert.hpp"
+#include "server/limits.hpp"
 #include "tests/service/service_fixture.hpp"
 
 namespace demcal::test {
@@ -995,6 +998,48 @@ TEST_F(Service, AWatchWaitingOutALongIntervalDoesNotHoldUpShutdown) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(took, 5.0) << "the coordinator took " << took << " s to stop";
   context->TryCancel();
+}
+
+// Watch streams are capped per client token (each holds a coordinator thread while its campaign
+// runs): one beyond the cap is refused with RESOURCE_EXHAUSTED; a closed stream frees its slot.
+TEST_F(Service, WatchStreamsBeyondTheCapOfATokenAreRefused) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  v1::WatchRequest req;
+  req.set_id(id);
+  req.set_interval_seconds(60);
+  struct Stream {
+    std::unique_ptr<grpc::ClientContext> context;
+    std::unique_ptr<grpc::ClientReader<v1::Progress>> reader;
+  };
+  const auto open = [&] {
+    Stream s{ctx(120), nullptr};
+    s.reader = campaigns_->Watch(s.context.get(), req);
+    return s;
+  };
+  std::vector<Stream> streams;
+  for (int i = 0; i < server::kMaxWatchStreamsPerClient; ++i) {
+    streams.push_back(open());
+    v1::Progress p;
+    ASSERT_TRUE(streams.back().reader->Read(&p)) << "stream " << i;
+  }
+  Stream beyond = open();
+  v1::Progress p;
+  EXPECT_FALSE(beyond.reader->Read(&p));
+  const grpc::Status st = beyond.reader->Finish();
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << st.error_message();
+  EXPECT_NE(st.error_message().find("at most 64"), std::string::npos) << st.error_message();
+  streams.front().context->TryCancel();
+  bool reopened = false;
+  for (int tries = 0; tries < 40 && !reopened; ++tries) {
+    Stream again = open();
+    reopened = again.reader->Read(&p);
+    again.context->TryCancel();
+    if (!reopened) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_TRUE(reopened) << "a closed stream's slot was not freed";
+  for (auto& s : streams) s.context->TryCancel();
 }
 
 // Unfinished jobs (queued or leased) are bounded per client token and in the whole store
