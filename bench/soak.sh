@@ -3,7 +3,9 @@
 # workers on loopback: once undisturbed, once while a chaos loop SIGKILLs workers (restarted by
 # their supervisor loops) and the coordinator (restarted on the same port and file) at random
 # moments. Prints jobs, results, duplicates, lost, attempts, the kills, and whether the effect
-# tables of the two runs are bitwise equal.
+# tables of the two runs are bitwise equal. Fails on a duplicate, a lost job, unequal tables, a
+# job over the attempt cap (MAX_ATTEMPTS), or attempts the kills do not explain (beyond one per
+# job, at most one per worker kill and one per worker for each coordinator kill).
 #   bench/soak.sh [BUILD_DIR] [WORKER_KILLS] [COORDINATOR_KILLS] [REPLICATES]
 # Defaults: 20 worker kills, 3 coordinator kills, 4 replicates (100 jobs: 4 runs + 21 centre
 # points, x 4). SOAK_SHORT=1: 8 worker kills, 1 coordinator kill, 1 replicate (25 jobs).
@@ -14,6 +16,8 @@ if [ "${SOAK_SHORT:-0}" = 1 ]; then WK=${2:-8}; CK=${3:-1}; REPL=${4:-1}; else
   WK=${2:-20}; CK=${3:-3}; REPL=${4:-4}; fi
 SERVER=$BUILD/server/demcal-server WORKER=$BUILD/worker/demcal-worker CLI=$BUILD/client/demcal
 for b in "$SERVER" "$WORKER" "$CLI"; do [ -x "$b" ] || { echo "no $b" >&2; exit 1; }; done
+# Leases per job before it fails (the coordinator's --max-attempts), and the supervised workers.
+MAX_ATTEMPTS=5 WORKERS=4
 TMP=$(mktemp -d)
 # Every process is ended by its id: the coordinator's in SERVER_PID, each worker's in its pid file.
 cleanup() {
@@ -45,7 +49,7 @@ YAML
 start_server() {
   rm -f "$1/port"
   "$SERVER" --listen "127.0.0.1:$2" --db "$1/c.db" --token-file "$TMP/token" --lease 2 \
-    --heartbeat 0.3 --reaper-interval 0.2 --grace 5 --max-attempts 50 --port-file "$1/port" \
+    --heartbeat 0.3 --reaper-interval 0.2 --grace 5 --max-attempts "$MAX_ATTEMPTS" --port-file "$1/port" \
     >> "$1/server.log" 2>&1 &
   SERVER_PID=$!
   for _ in $(seq 200); do [ -s "$1/port" ] && return 0; sleep 0.05; done
@@ -72,7 +76,7 @@ run() {
   "$CLI" submit "$TMP/spec.yaml" --coordinator "127.0.0.1:$port" --token-file "$TMP/token" \
     > "$dir/submit.log"
   local sup=()
-  for n in 1 2 3 4; do supervise "$dir" "$n" "$port" & sup+=($!); done
+  for n in $(seq "$WORKERS"); do supervise "$dir" "$n" "$port" & sup+=($!); done
   local start=$SECONDS
   # The kills, spread out: one coordinator kill after every WK / (CK + 1) worker kills.
   local every=$(( WK / (CK + 1) > 0 ? WK / (CK + 1) : 1 ))
@@ -86,7 +90,7 @@ run() {
         sleep "0.$((RANDOM % 9 + 1))"
         start_server "$dir" "$port"
       elif [ $wk -lt "$WK" ]; then
-        local victim; victim=$(cat "$dir"/w$((RANDOM % 4 + 1)).pid 2>/dev/null || true)
+        local victim; victim=$(cat "$dir"/w$((RANDOM % WORKERS + 1)).pid 2>/dev/null || true)
         [ -n "$victim" ] && kill -9 "$victim" 2>/dev/null && wk=$((wk + 1))
       fi
     else
@@ -95,7 +99,7 @@ run() {
     [ $((SECONDS - start)) -gt 1800 ] && { echo "campaign not done after 30 min" >&2; exit 1; }
   done
   touch "$dir/stop"
-  for n in 1 2 3 4; do kill "$(cat "$dir/w$n.pid")" 2>/dev/null || true; done
+  for n in $(seq "$WORKERS"); do kill "$(cat "$dir/w$n.pid")" 2>/dev/null || true; done
   for p in "${sup[@]}"; do wait "$p" 2>/dev/null || true; done
   "$CLI" effects 1 --format json --coordinator "127.0.0.1:$port" --token-file "$TMP/token" \
     > "$dir/effects.json"
@@ -111,8 +115,12 @@ results=$(q "SELECT COUNT(*) FROM results")
 dups=$(q "SELECT COUNT(*) - COUNT(DISTINCT job_id) FROM results")
 lost=$(q "SELECT COUNT(*) FROM jobs WHERE state <> 'done' OR id NOT IN (SELECT job_id FROM results)")
 attempts=$(q "SELECT SUM(attempt) FROM jobs")
+counted=$(q "SELECT SUM(counted) FROM jobs") most=$(q "SELECT MAX(counted) FROM jobs")
+explained=$((jobs + wk + WORKERS * ck))
 equal=no; cmp -s "$TMP/calm/effects.json" "$TMP/chaos/effects.json" && equal=yes
 echo "undisturbed: $calm_s s; chaos: $chaos_s s with $wk worker SIGKILLs and $ck coordinator SIGKILLs"
 echo "jobs $jobs, results $results, duplicates $dups, lost $lost, attempts $attempts"
+echo "attempts counted against the cap $counted (the kills explain at most $explained), at most $most of one job (cap $MAX_ATTEMPTS)"
 echo "effect tables bitwise equal to the undisturbed run: $equal"
-[ "$dups" = 0 ] && [ "$lost" = 0 ] && [ "$equal" = yes ]
+[ "$dups" = 0 ] && [ "$lost" = 0 ] && [ "$equal" = yes ] && [ "$most" -le "$MAX_ATTEMPTS" ] &&
+  [ "$counted" -le "$explained" ]
