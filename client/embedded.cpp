@@ -173,7 +173,8 @@ void EmbeddedService::refuse_if_another_spec(std::int64_t id, const SpecFile& fi
   if (google::protobuf::util::MessageDifferencer::Equals(stored.spec(), file.spec)) return;
   throw InputError("", "campaign " + std::to_string(id) + " '" + file.spec.name() + "' in " +
                            workdir_.string() + " was submitted with another spec than " +
-                           file.name + ": give another --workdir (or another name) to run it, "
+                           file.name +
+                           ": give another --workdir (or another name) to run it, "
                            "or the spec it was submitted with to resume it");
 }
 

@@ -277,7 +277,8 @@ namespace {
 /// rows run at both), and the particle-steps of each level against the all-high design.
 void print_fidelity(std::ostream& out, const v1::CalibrateReply& c) {
   if (c.fidelity_size() == 0) return;
-  out << "\n  high fidelity level from the low one (docs/doe.md, \"Multi-fidelity calibration\"):\n";
+  out << "\n  high fidelity level from the low one (docs/doe.md, \"Multi-fidelity "
+         "calibration\"):\n";
   for (const auto& f : c.fidelity()) {
     out << "    " << f.statement() << "; correction sd " << f.correction_sd() << "\n";
     for (int i = 0; i < f.rows_size(); ++i)

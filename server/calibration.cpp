@@ -133,9 +133,9 @@ void correct_design(Loaded& l) {
     const Eigen::VectorXd low = st.responses.col(Eigen::Index(m));
     l.high.col(Eigen::Index(m)) = high.col(column_of(l.plan, l.responses[m]));
     const double noise = analyse(l.plan, low, l.options.model, 0.05).noise.sd;
-    const auto& model = l.fidelity.emplace_back(l.responses[m], st.coded, low,
-                                                l.high.col(Eigen::Index(m)), noise,
-                                                calib::GpOptions{8, l.options.calibration.seed});
+    const auto& model =
+        l.fidelity.emplace_back(l.responses[m], st.coded, low, l.high.col(Eigen::Index(m)), noise,
+                                calib::GpOptions{8, l.options.calibration.seed});
     st.responses.col(Eigen::Index(m)) = model.corrected(st.coded, low, l.high.col(Eigen::Index(m)));
   }
 }
@@ -168,11 +168,11 @@ void add_targets(Loaded& l) {
       throw InputError(t.response, "only " + std::to_string(finite) +
                                        " design runs have a result; the campaign must run first");
     const doe::ResponseAnalysis a = analyse(l.plan, col, l.options.model, 0.05);
-    const double correction =
-        l.fidelity.empty() ? 0.0
-                           : l.fidelity[m].mean_correction_sd(l.state.stages.front().coded,
-                                                              l.low.col(Eigen::Index(m)),
-                                                              l.high.col(Eigen::Index(m)));
+    const double correction = l.fidelity.empty()
+                                  ? 0.0
+                                  : l.fidelity[m].mean_correction_sd(l.state.stages.front().coded,
+                                                                     l.low.col(Eigen::Index(m)),
+                                                                     l.high.col(Eigen::Index(m)));
     l.state.targets.push_back(
         {t.response, t.value, t.weight, t.uncertainty, a.noise.sd, correction});
     l.noise_df.push_back(a.noise.degrees_of_freedom);
@@ -349,9 +349,9 @@ std::vector<std::int64_t> queue_rounds(Store& store, const CampaignRow& row, con
     std::map<std::string, double> parameters;
     for (std::size_t f = 0; f < l.plan.factors.size(); ++f)
       parameters[l.plan.factors[f].path] = d.batch[b](Eigen::Index(f));
-    const auto jobs = jobs_at(at_fidelity(l.spec, l.plan, true), l.spec.material(), parameters,
-                              round, "verify",
-                              pinned ? 0 : kVerifySeedOffset + std::uint64_t(round));
+    const auto jobs =
+        jobs_at(at_fidelity(l.spec, l.plan, true), l.spec.material(), parameters, round, "verify",
+                pinned ? 0 : kVerifySeedOffset + std::uint64_t(round));
     const auto queued = store.add_calibration_round(
         row.id,
         {round, d.stage, proposal_json(d.batch[b], d.batch_predicted[b], l.responses, batch),
@@ -369,10 +369,9 @@ std::vector<std::int64_t> queue_stage(Store& store, const CampaignRow& row, cons
   const int stage = d.stage + 1;
   std::vector<PlannedFactor> box = l.plan.factors;
   for (std::size_t f = 0; f < box.size(); ++f) box[f].factor = d.next_box[f];
-  const auto jobs =
-      design_jobs(at_fidelity(l.spec, l.plan, false), l.plan, box,
-                  std::string(kStagePrefix) + std::to_string(stage),
-                  (stage - 1) * l.plan.design.runs());
+  const auto jobs = design_jobs(at_fidelity(l.spec, l.plan, false), l.plan, box,
+                                std::string(kStagePrefix) + std::to_string(stage),
+                                (stage - 1) * l.plan.design.runs());
   spdlog::info("campaign {}: calibration stage {} queued ({} jobs)", row.id, stage, jobs.size());
   return store.add_calibration_stage(row.id, {stage, box_to_json(d.next_box), now_seconds()}, jobs);
 }

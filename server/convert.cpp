@@ -368,7 +368,8 @@ void check_setting_level(const v1::CampaignSpec& spec, const std::string& name, 
     }
   }
   if (users == 0)
-    throw InputError("spec.fidelity.path", "no test of the campaign has the setting '" + name + "'");
+    throw InputError("spec.fidelity.path",
+                     "no test of the campaign has the setting '" + name + "'");
 }
 
 /// The high rows the coordinator chooses: the first centre point, and the smallest fraction
@@ -421,8 +422,8 @@ void plan_fidelity(const v1::CampaignSpec& spec, const lab::MaterialModel& model
   } else {
     lab::require_parameter(model, f.path(), "spec.fidelity.path");
     for (const auto& factor : spec.factors()) {
-      const bool tied = std::find(factor.tied().begin(), factor.tied().end(), f.path()) !=
-                        factor.tied().end();
+      const bool tied =
+          std::find(factor.tied().begin(), factor.tied().end(), f.path()) != factor.tied().end();
       if (factor.path() == f.path() || tied)
         throw InputError("spec.fidelity.path", "'" + f.path() + "' is also a factor or a tie");
     }

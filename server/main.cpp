@@ -99,8 +99,7 @@ int main(int argc, char** argv) {
       page = std::make_unique<demcal::server::HttpPage>(
           coordinator.in_process_channel(),
           demcal::server::HttpPageOptions{
-              http,
-              demcal::server::page_token({o.token, o.worker_token, o.client_token}, http),
+              http, demcal::server::page_token({o.token, o.worker_token, o.client_token}, http),
               o.tls_cert, o.tls_key, o.insecure});
       write_port_file(http_port_file, page->port());
     }

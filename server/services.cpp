@@ -91,8 +91,8 @@ grpc::Status admit(const grpc::ServerContext& ctx, const Tokens& tokens, Caller 
                  s.error_message());
     return s;
   }
-  if (const std::string e = request_size_error(request.ByteSizeLong(), max_bytes,
-                                               request.GetDescriptor()->name());
+  if (const std::string e =
+          request_size_error(request.ByteSizeLong(), max_bytes, request.GetDescriptor()->name());
       !e.empty()) {
     spdlog::warn("call from {} refused: {}", ctx.peer(), e);
     return {grpc::StatusCode::INVALID_ARGUMENT, e};
@@ -203,8 +203,7 @@ grpc::Status CampaignServiceImpl::check_job_bounds(const std::string& owner, std
 
 grpc::Status CampaignServiceImpl::Submit(grpc::ServerContext* ctx, const v1::SubmitRequest* req,
                                          v1::SubmitReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req, kMaxSpecBytes); !s.ok())
-    return s;
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req, kMaxSpecBytes); !s.ok()) return s;
   try {
     std::vector<NewJob> jobs;
     const CampaignPlan plan = plan_campaign(req->spec(), jobs);
@@ -450,8 +449,7 @@ grpc::Status CampaignServiceImpl::Export(grpc::ServerContext* ctx, const v1::Exp
 grpc::Status CampaignServiceImpl::ImportRuns(grpc::ServerContext* ctx,
                                              const v1::ImportRunsRequest* req,
                                              v1::ImportRunsReply* reply) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req, kMaxResultRequestBytes);
-      !s.ok())
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req, kMaxResultRequestBytes); !s.ok())
     return s;
   try {
     const ImportCounts counts = import_runs(store_, *req);
@@ -516,8 +514,7 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* ctx, const v1::He
 
 grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::CompleteRequest* req,
                                          v1::CompleteReply*) {
-  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker, *req, kMaxResultRequestBytes);
-      !s.ok())
+  if (auto s = admit(*ctx, config_.tokens, Caller::kWorker, *req, kMaxResultRequestBytes); !s.ok())
     return s;
   if (const std::string error = worker_text_error(req->worker()); !error.empty())
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
@@ -530,8 +527,7 @@ grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::Com
     if (const auto job = store_.job(req->job_id())) {
       v1::JobSpec spec;
       from_json(job->payload, spec);
-      if (const std::string error = metric_names_error(req->metrics(), spec.test());
-          !error.empty())
+      if (const std::string error = metric_names_error(req->metrics(), spec.test()); !error.empty())
         return {grpc::StatusCode::INVALID_ARGUMENT, error};
     }
   } catch (const std::exception& e) {

@@ -74,14 +74,12 @@ FidelityModel::FidelityModel(const std::string& response, const Eigen::MatrixXd&
     throw InputError(response, "the low and high responses need one value per design row");
   const auto rows = pair_rows(low, high);
   pairs_ = static_cast<int>(rows.size());
-  if (pairs_ == 0)
-    throw InputError(response, "no design row has finished at both fidelity levels");
+  if (pairs_ == 0) throw InputError(response, "no design row has finished at both fidelity levels");
   const Eigen::VectorXd lo = take(low, rows), hi = take(high, rows);
   mean_bias_ = (hi - lo).mean();
   const int k = static_cast<int>(coded.cols());
   fit_offset(hi - lo, std::isfinite(low_noise_sd) ? low_noise_sd : 0.0);
-  if (pairs_ >= k + kLinearPairs)
-    fit_autoregressive(take_rows(coded, rows), lo, hi, options);
+  if (pairs_ >= k + kLinearPairs) fit_autoregressive(take_rows(coded, rows), lo, hi, options);
   if (form_ == FidelityForm::kOffset && pairs_ >= kLinearPairs) fit_linear(lo, hi);
 }
 

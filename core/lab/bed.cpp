@@ -292,9 +292,8 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
   // d sqrt(rho_p / sigma_ref) (GDR MiDi 2004, with the bed's strain rate for the shear rate).
   const double creep_time = mean_diameter(p) * std::sqrt(rho / quiet_stress);
   const double t0 = w.time;
-  const long chunk =
-      creep_rule ? std::max<long>(1, std::lround(0.2 * spec.creep_window / w.dt))
-                 : std::max<long>(200, std::lround(0.002 * time_factor / w.dt));
+  const long chunk = creep_rule ? std::max<long>(1, std::lround(0.2 * spec.creep_window / w.dt))
+                                : std::max<long>(200, std::lround(0.002 * time_factor / w.dt));
   SinkWatch sinking;
   bool rest = false;
   while (!rest && w.time - t0 < t_end) {
@@ -431,8 +430,8 @@ double largest_overlap(sim::World& w) {
 /// growth: gives every lab wall material the material's wall law without friction, rolling
 /// resistance and adhesion (its slots kept, their forces zero, as the tensile test's die), and
 /// returns the laws they had.
-std::vector<std::pair<std::uint16_t, contact::ContactLaw>> smooth_walls(sim::World& w,
-                                                                       const MaterialModel& material) {
+std::vector<std::pair<std::uint16_t, contact::ContactLaw>> smooth_walls(
+    sim::World& w, const MaterialModel& material) {
   contact::ContactLawSpec smooth = material.wall_law;
   if (smooth.cohesion.model == "van_der_waals") smooth.cohesion.params["hamaker"] = 0.0;
   if (smooth.rolling.model != "none") smooth.rolling.params["mu_r"] = 0.0;
@@ -506,7 +505,8 @@ GrownBed grow_bed(sim::World& w, const MaterialModel& material, const sim::Healt
   contact::ContactLawSpec plain = material.particle_law;
   plain.cohesion = {"none", {}};
   w.set_pair_law(0, 0, simulated_law(material, plain));
-  const std::vector<std::pair<std::uint16_t, contact::ContactLaw>> wall_laws = smooth_walls(w, material);
+  const std::vector<std::pair<std::uint16_t, contact::ContactLaw>> wall_laws =
+      smooth_walls(w, material);
   GrownBed out;
   out.critical_time = particle_contact_time(w, full);
   const double t_c = out.critical_time;
@@ -544,7 +544,8 @@ GrownBed grow_bed(sim::World& w, const MaterialModel& material, const sim::Healt
   double factor = out.start_factor;  // of the radii at the last neighbour-list build
   std::size_t builds = w.list.builds();
   auto grow_and_quench = [&](sim::World& world) {
-    const double f = std::min(1.0, out.start_factor * std::exp(s.growth_rate * (world.time - t0) / t_c));
+    const double f =
+        std::min(1.0, out.start_factor * std::exp(s.growth_rate * (world.time - t0) / t_c));
     for (std::size_t i = 0; i < p.size(); ++i) p.radius[i] = start[i] / out.start_factor * f;
     const double pushed = world.walls[lid].force.z / (cap * area);
     world.walls[lid].velocity.z = pushed > 1.0 ? rise * std::min(pushed, kLidSpeedUp) : 0.0;
@@ -624,8 +625,8 @@ PreparedBed prepare_and_settle(sim::World& w, const MaterialModel& material, con
     out.settled = settle(w, spec, limits, material.factors().time);
   } else {
     out.prepared = clock.stop(w, name, growth_text(*grown), true);
-    out.settled = settle(w, growth_settle(spec, grown->critical_time), limits,
-                         material.factors().time);
+    out.settled =
+        settle(w, growth_settle(spec, grown->critical_time), limits, material.factors().time);
   }
   // The settled bed keeps its contacts' history under the full law.
   if (material.preparation.method != PreparationMethod::kClusters &&

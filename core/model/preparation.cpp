@@ -5,12 +5,13 @@
 namespace demcal::lab {
 
 PreparationMethod parse_preparation_method(const std::string& text, const std::string& where) {
-  for (auto m : {PreparationMethod::kClusters, PreparationMethod::kRandomMotion,
-                 PreparationMethod::kTerminalVelocity, PreparationMethod::kPour,
-                 PreparationMethod::kGrowth})
+  for (auto m :
+       {PreparationMethod::kClusters, PreparationMethod::kRandomMotion,
+        PreparationMethod::kTerminalVelocity, PreparationMethod::kPour, PreparationMethod::kGrowth})
     if (text == preparation_method_name(m)) return m;
-  throw InputError(where, "unknown preparation method '" + text +
-                              "' (known: clusters, random_motion, terminal_velocity, pour, growth)");
+  throw InputError(where,
+                   "unknown preparation method '" + text +
+                       "' (known: clusters, random_motion, terminal_velocity, pour, growth)");
 }
 
 std::string preparation_method_name(PreparationMethod method) {

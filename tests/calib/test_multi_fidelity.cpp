@@ -43,8 +43,8 @@ doe::Design with_centre(doe::Design d) {
 TEST(MultiFidelity, OnePairGivesTheOffsetWithTheNoiseOfTwoRuns) {
   const doe::Design d = with_centre(doe::fractional_factorial(3, "C=AB"));
   Rng rng(1);
-  const auto l = levels(d.coded, {4}, [](const Eigen::VectorXd&, double y) { return y + 0.015; },
-                        0.0, rng);
+  const auto l = levels(
+      d.coded, {4}, [](const Eigen::VectorXd&, double y) { return y + 0.015; }, 0.0, rng);
   const FidelityModel m("packing.solid_fraction", d.coded, l.low, l.high, 0.002);
   EXPECT_EQ(m.form(), FidelityForm::kOffset);
   EXPECT_EQ(m.pairs(), 1);

@@ -28,8 +28,8 @@
 namespace {
 
 constexpr int kLow = 150, kHigh = 1000;
-constexpr double kHiddenMu = 0.2;           ///< inside the factor box [0.1, 0.6]
-constexpr double kMaxCostFraction = 0.4;    ///< of the all-high design's particle-steps
+constexpr double kHiddenMu = 0.2;         ///< inside the factor box [0.1, 0.6]
+constexpr double kMaxCostFraction = 0.4;  ///< of the all-high design's particle-steps
 
 std::string material_yaml(double mu_s) {
   std::ostringstream y;
@@ -103,8 +103,8 @@ bool inside(const nlohmann::json& interval, double v) {
 }
 
 TEST(MultiFidelityHidden, TheHighLevelModelFindsTheFrictionTheSmallBedMisses) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("demcal-mf-hidden-" + std::to_string(getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("demcal-mf-hidden-" + std::to_string(getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const auto measured = measure(dir);
@@ -121,18 +121,20 @@ TEST(MultiFidelityHidden, TheHighLevelModelFindsTheFrictionTheSmallBedMisses) {
   EXPECT_TRUE(inside(multi_interval, kHiddenMu)) << multi_interval.dump();
 
   const auto& cost = multi["calibration"]["fidelity_cost"];
-  const double design = cost["low_particle_steps"].get<double>() +
-                        cost["high_particle_steps"].get<double>();
+  const double design =
+      cost["low_particle_steps"].get<double>() + cost["high_particle_steps"].get<double>();
   const double all_high = cost["all_high_particle_steps"].get<double>();
   EXPECT_LE(design, kMaxCostFraction * all_high) << cost.dump();
   ASSERT_EQ(multi["calibration"]["fidelity"].size(), 2u);
-  for (const auto& f : multi["calibration"]["fidelity"]) EXPECT_GT(f["mean_bias"].get<double>(), 0.0)
-      << "the small bed is looser and less coordinated: " << f.dump();
+  for (const auto& f : multi["calibration"]["fidelity"])
+    EXPECT_GT(f["mean_bias"].get<double>(), 0.0)
+        << "the small bed is looser and less coordinated: " << f.dump();
 
   // The report shows the high level's model and the cost of each level (rendered in Chromium).
-  const std::string report = std::string(DEMCAL_CLI_BIN) + " report " + (dir / "multi.yaml").string() +
-                             " --threads 1 --workdir " + (dir / "multi").string() + " -o " +
-                             (dir / "report").string() + " 2>/dev/null";
+  const std::string report = std::string(DEMCAL_CLI_BIN) + " report " +
+                             (dir / "multi.yaml").string() + " --threads 1 --workdir " +
+                             (dir / "multi").string() + " -o " + (dir / "report").string() +
+                             " 2>/dev/null";
   ASSERT_EQ(demcal::test::run_command(report).exit_code, 0) << report;
   const auto dom = demcal::test::run_command(
       "chromium --headless --no-sandbox --disable-gpu --user-data-dir=" +

@@ -115,16 +115,20 @@ TEST(Preparation, GrowthWithItsParametersAndItsMistakes) {
   // which is filled at full size.
   MaterialModel rods = m;
   rods.shape.kind = particles::ShapeKind::kRod;
-  EXPECT_EQ(where_of([&] { run_lab_test("packing", rods, {{"particles", 60}}, {}); }),
+  EXPECT_EQ(where_of([&] {
+              run_lab_test("packing", rods, {{"particles", 60}}, {});
+            }),
             "material.preparation.method");
-  EXPECT_EQ(where_of([&] { run_lab_test("hopper", m, {{"particles", 60}}, {}); }),
+  EXPECT_EQ(where_of([&] {
+              run_lab_test("hopper", m, {{"particles", 60}}, {});
+            }),
             "material.preparation.method");
 }
 
 /// Cohesionless Hertz spheres of 1 mm (the packing tests' glass-like spheres) grown in the die.
 MaterialModel grown_hertz(double solid_fraction) {
-  MaterialModel m = read("preparation: {method: growth, solid_fraction: " +
-                         std::to_string(solid_fraction) + "}\n");
+  MaterialModel m = read(
+      "preparation: {method: growth, solid_fraction: " + std::to_string(solid_fraction) + "}\n");
   m.wall_law = m.particle_law;
   return m;
 }
@@ -172,9 +176,9 @@ density: 1545
 scaling: {law: kottlan2018, factor: 10}
 preparation: {method: growth}
 )"));
-  const auto out = run_lab_test("confined_compression", m,
-                                {{"particles", 100}, {"cycles", 1}, {"wall_stiffness_factor", 3}},
-                                {});
+  const auto out =
+      run_lab_test("confined_compression", m,
+                   {{"particles", 100}, {"cycles", 1}, {"wall_stiffness_factor", 3}}, {});
   bool grown = false;
   for (const auto& phase : out.cost.phases) {
     EXPECT_TRUE(phase.reached) << phase.name << ": " << phase.target;

@@ -30,8 +30,8 @@ factors:
   - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.6, scale: log}
   - {path: particle_law.normal.restitution, low: 0.2, high: 0.8}
   - {path: particle_law.normal.youngs_modulus, low: 2.0e6, high: 8.0e6}
-design: )" + design +
-         "\nfidelity: " + fidelity + "\n";
+design: )" +
+         design + "\nfidelity: " + fidelity + "\n";
 }
 
 struct Planned {

@@ -802,8 +802,7 @@ TEST_F(Service, OversizedSpecsAndWorkerTextsAreRefusedNamingTheFieldAndNothingIs
       {[&](v1::CampaignSpec& s) { discrete(s, 1001); }, "spec.material.sizes.discrete.radii"},
       {[&](v1::CampaignSpec& s) { s.set_name(text); }, "spec.name"},
       {[&](v1::CampaignSpec& s) { s.set_description(text); }, "spec.description"},
-      {[&](v1::CampaignSpec& s) { s.mutable_factors(0)->set_name(text); },
-       "spec.factors[0].name"},
+      {[&](v1::CampaignSpec& s) { s.mutable_factors(0)->set_name(text); }, "spec.factors[0].name"},
       {[&](v1::CampaignSpec& s) {
          for (int i = 0; i < 1001; ++i) s.mutable_factors(0)->add_tied("density");
        },
@@ -823,9 +822,7 @@ TEST_F(Service, OversizedSpecsAndWorkerTextsAreRefusedNamingTheFieldAndNothingIs
          for (int i = 0; i < 1001; ++i) s.mutable_fidelity()->add_high_rows(1);
        },
        "spec.fidelity.high_rows"},
-      {[&](v1::CampaignSpec& s) {
-         (*s.mutable_tests(0)->mutable_settings())[text] = 1;
-       },
+      {[&](v1::CampaignSpec& s) { (*s.mutable_tests(0)->mutable_settings())[text] = 1; },
        "spec.tests[0].settings"},
       // 100 sources of 4,000 characters: each within its bound, the spec over 256 KiB.
       {[&](v1::CampaignSpec& s) {
@@ -948,7 +945,9 @@ TEST_F(Service, AResultWithAMetricItsTestDoesNotReportIsRefused) {
 TEST_F(Service, ACampaignNameWithAControlCharacterIsRefused) {
   start_server();
   // ESC, LF and the one-character CSI U+009B (as UTF-8).
-  for (const std::string name : {"tiny\x1b[2J", "a\nb", "x\xc2\x9b" "31m"}) {
+  for (const std::string name : {"tiny\x1b[2J", "a\nb",
+                                 "x\xc2\x9b"
+                                 "31m"}) {
     v1::SubmitRequest req;
     *req.mutable_spec() = cli::parse_campaign_spec(tiny_spec(30), "spec.yaml").spec;
     req.mutable_spec()->set_name(name);
@@ -968,8 +967,8 @@ TEST_F(Service, ACoordinatorWithoutATokenStartsOnlyWithNoAuth) {
   EXPECT_NE(refused.log().find("--no-auth"), std::string::npos) << refused.log();
   EXPECT_FALSE(fs::exists(path("port"))) << "it listened";
   Process unguarded({DEMCAL_SERVER_BIN, "--listen", "127.0.0.1:0", "--db", path("c.db"),
-                "--port-file", path("port"), "--no-auth"},
-               path("open.log"));
+                     "--port-file", path("port"), "--no-auth"},
+                    path("open.log"));
   ASSERT_TRUE(wait_until([&] { return fs::exists(path("port")); }, 20)) << unguarded.log();
   rpc::ChannelOptions ch;
   std::ifstream(path("port")) >> port_;
@@ -1194,25 +1193,25 @@ TEST_F(Service, CoordinatorKilledAndRestartedCampaignCompletesNothingLostOrDupli
 TEST_F(Service, RunOnAWorkDirectoryWhoseCampaignHasAnotherSpecRefuses) {
   const std::string spec = path("tiny.yaml");
   std::ofstream(spec) << tiny_spec(200);
-  Process first({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1",
-                 "--no-verify"},
-                path("first.log"));
+  Process first(
+      {DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1", "--no-verify"},
+      path("first.log"));
   ASSERT_EQ(first.wait_exit(150), 0) << first.log();
   std::string edited = tiny_spec(200);
   edited.replace(edited.find("low: 0.1, high: 0.5"), 19, "low: 0.1, high: 0.4");
   std::ofstream(spec) << edited;
-  Process second({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1",
-                  "--no-verify"},
-                 path("second.log"));
+  Process second(
+      {DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1", "--no-verify"},
+      path("second.log"));
   EXPECT_NE(second.wait_exit(150), 0) << second.log();
   EXPECT_NE(second.log().find("another spec"), std::string::npos) << second.log();
   EXPECT_NE(second.log().find(path("work")), std::string::npos) << second.log();
   EXPECT_EQ(second.log().find("resuming campaign"), std::string::npos) << second.log();
   // The unchanged spec still resumes.
   std::ofstream(spec) << tiny_spec(200);
-  Process third({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1",
-                 "--no-verify"},
-                path("third.log"));
+  Process third(
+      {DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1", "--no-verify"},
+      path("third.log"));
   EXPECT_EQ(third.wait_exit(150), 0) << third.log();
   EXPECT_NE(third.log().find("resuming campaign 1"), std::string::npos) << third.log();
 }
@@ -1508,16 +1507,15 @@ TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals)
     EXPECT_FALSE(i.at("statement").get<std::string>().empty()) << i.dump();
 }
 
-
 // A multi-fidelity campaign through the coordinator and a worker: the design's rows at the low
 // level, its centre at the high level too, the verification at the high level, and `status`
 // showing the particle-steps of each level against the all-high design.
 TEST_F(Service, AMultiFidelityCampaignVerifiesAtTheHighLevelAndStatusShowsTheCostOfEach) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
-  ASSERT_TRUE(submit(tiny_spec(200, 1) + "fidelity: {path: settings.particles, low: 100, high: 200}\n",
-                     &id)
-                  .ok());
+  ASSERT_TRUE(
+      submit(tiny_spec(200, 1) + "fidelity: {path: settings.particles, low: 100, high: 200}\n", &id)
+          .ok());
   start_worker("w");
   ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 90)) << workers_[0]->log();
   const std::string ids = std::to_string(id);
@@ -1539,9 +1537,9 @@ TEST_F(Service, AMultiFidelityCampaignVerifiesAtTheHighLevelAndStatusShowsTheCos
   EXPECT_GE(cost.at("verify_jobs").get<int>(), 1);
   EXPECT_GT(cost.at("all_high_particle_steps").get<double>(),
             cost.at("high_particle_steps").get<double>());
-  Process table({DEMCAL_CLI_BIN, "status", ids, "--coordinator", channel_.address, "--token",
-                 kToken},
-                path("status.log"));
+  Process table(
+      {DEMCAL_CLI_BIN, "status", ids, "--coordinator", channel_.address, "--token", kToken},
+      path("status.log"));
   ASSERT_EQ(table.wait_exit(30), 0) << table.log();
   EXPECT_NE(table.log().find("the design at the high level in every row"), std::string::npos)
       << table.log();
