@@ -112,6 +112,11 @@ void check_material_values(const v1::Material& m, const lab::MaterialModel& mode
     check_in_range(m.scaling().factor(), range_of(model, "scaling.factor"),
                    where + ".scaling.factor");
   check_sizes(m.sizes(), model, where + ".sizes");
+  if (m.real_median_radius() != 0.0)
+    check_in_range(
+        m.real_median_radius(),
+        {"real_median_radius", "m", lab::kRealMedianRadiusMin, lab::kRealMedianRadiusMax},
+        where + ".real_median_radius");
 }
 
 }  // namespace
@@ -146,6 +151,7 @@ lab::MaterialModel to_material_model(const v1::Material& m, const std::string& w
   model.size_scale = m.size_scale() != 0.0 ? m.size_scale() : 1.0;
   if (m.density() == 0.0) throw InputError(where + ".density", "missing");
   model.density = m.density();
+  model.real_median_radius = m.real_median_radius();
   if (m.has_scaling()) {
     const std::string law = m.scaling().law().empty() ? "none" : m.scaling().law();
     model.scaling = contact::scaling_law_from_name(law, where + ".scaling.law");

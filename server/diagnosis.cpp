@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <string_view>
@@ -31,6 +32,36 @@ double option(double v, double fallback, double lo, double hi, const std::string
   return v;
 }
 
+/// The material's one median radius as its model states it (real, times sizes.scale; m), 0 for
+/// discrete classes, which have none the size distribution states.
+double median_radius(const lab::MaterialModel& model) {
+  if (const auto* one = std::get_if<particles::Monodisperse>(&model.sizes))
+    return one->radius * model.size_scale;
+  if (const auto* ln = std::get_if<particles::LogNormal>(&model.sizes))
+    return ln->median_radius * model.size_scale;
+  return 0.0;
+}
+
+/// coarse_graining: what the material says of its particles' size against the powder's, and the
+/// cohesive parameters (the cohesion slots' in J) the Bond number holds, at the spec's fixed
+/// values: the particle law's, and the wall law's unless a test instance has a wall law of its
+/// own (whose walls then keep their adhesion: a wall path sets every instance's wall law).
+void describe_size(const v1::CampaignSpec& spec, diagnose::Problem& p) {
+  lab::MaterialModel model = rpc::to_material_model(spec.material(), "spec.material");
+  for (const auto& [path, value] : spec.fixed()) lab::set_parameter(model, path, value);
+  p.median_radius = median_radius(model);
+  p.real_median_radius = model.real_median_radius;
+  p.size_scale = model.size_scale;
+  const bool own_walls = std::any_of(spec.tests().begin(), spec.tests().end(),
+                                     [](const v1::LabTest& t) { return t.has_wall_law(); });
+  for (const auto& info : lab::parameters(model)) {
+    const bool cohesion = info.path.starts_with("particle_law.cohesion.") ||
+                          (!own_walls && info.path.starts_with("wall_law.cohesion."));
+    if (cohesion && info.unit == "J")
+      p.bond_scaled[info.path] = lab::get_parameter(model, info.path);
+  }
+}
+
 diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan& plan,
                                const std::vector<JobRow>& jobs, std::uint64_t seed) {
   diagnose::Problem p;
@@ -52,6 +83,7 @@ diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan&
   for (const auto& t : spec.tests()) p.preparable &= !lab::pours_only(t.test());
   p.agitation_time_max = lab::default_agitation_time(model);
   for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
+  describe_size(spec, p);
   p.options = diagnose_options(spec.diagnose(), "spec.diagnose");
   p.options.seed = seed ? seed : 1;
   return p;

@@ -12,7 +12,15 @@
 #include "core/doe/model_fit.hpp"
 
 namespace demcal::diagnose {
+
+double bond_number_hamaker(double hamaker, double radius_ratio) {
+  return hamaker * radius_ratio * radius_ratio;
+}
+
 namespace {
+
+/// coarse_graining's factor: it multiplies every radius of the material's size distribution.
+constexpr const char* kSizeScale = "sizes.scale";
 
 /// A value for a sentence, in six significant digits (5e-19 stays 5e-19, not 0.000000).
 std::string number(double x) {
@@ -30,7 +38,34 @@ struct Plan {
   Eigen::MatrixXd new_rows = Eigen::MatrixXd();  ///< runs to simulate
   doe::ModelKind model = doe::ModelKind::kTwoFactor;
   bool by_default = true;  ///< tested without being listed in `candidates`
+  /// coarse_graining: the cohesive parameters its runs rescale to their radius (path -> value at
+  /// the base runs' size scale `size_scale`); empty for the others.
+  std::map<std::string, double> bond_scaled;
+  double size_scale = 1.0;
 };
+
+/// The cohesive parameters a plan rescales, at a point of its factor box: each one's value at
+/// the base radius (the point's, where it is a factor) at the point's radius and the same Bond
+/// number. Empty for a plan that rescales none.
+std::map<std::string, double> rescaled_at(const Plan& plan,
+                                          const std::map<std::string, double>& point) {
+  std::map<std::string, double> out;
+  if (plan.bond_scaled.empty()) return out;
+  const double ratio = point.at(kSizeScale) / plan.size_scale;
+  for (const auto& [path, at_base] : plan.bond_scaled) {
+    const auto it = point.find(path);
+    out[path] = bond_number_hamaker(it != point.end() ? it->second : at_base, ratio);
+  }
+  return out;
+}
+
+/// The parameters a point of a plan's factor box is simulated with: the point, its rescaled
+/// cohesive parameters replaced (coarse_graining).
+std::map<std::string, double> run_parameters(const Plan& plan,
+                                             std::map<std::string, double> point) {
+  for (const auto& [path, value] : rescaled_at(plan, point)) point[path] = value;
+  return point;
+}
 
 bool is_factorial(const Eigen::MatrixXd& x, Eigen::Index r) {
   for (Eigen::Index c = 0; c < x.cols(); ++c)
@@ -124,6 +159,35 @@ Plan preparation_plan(const Problem& p) {
       {"preparation.agitation_time", doe::Factor{"preparation.agitation_time", lo, hi}}, lo);
 }
 
+/// coarse_graining applies where the material states the powder's median radius, its own median
+/// radius is larger, and no factor sets a radius.
+bool coarse_grained(const Problem& p) {
+  return p.real_median_radius > 0.0 && p.median_radius > p.real_median_radius &&
+         !has_factor(p, "sizes.radius") && !has_factor(p, "sizes.median_radius") &&
+         !has_factor(p, kSizeScale);
+}
+
+/// Particles larger than the powder's against its real median radius (seed 000 §2.3 fixed its
+/// simulated spheres and scaled them to r_real of 10-20 um, Table 8, where LH220's d50 is
+/// 11-15 um, Table 2; docs/diagnosis.md found the tensile strength to follow Rumpf's F / d^2 at a
+/// given Bond number). The factor multiplies every radius (sizes.scale, log scale) from the real
+/// median over the material's median to the material's size scale, the base runs' end; the
+/// candidate's runs are at the real median radius and the geometric middle, each with its
+/// cohesion rescaled to the same Bond number (bond_number_hamaker). A run keeps its test's
+/// particle count (every test sizes its die from the particles), so it costs what a base run
+/// costs.
+Plan coarse_graining_plan(const Problem& p) {
+  const double hi = p.size_scale, lo = hi * p.real_median_radius / p.median_radius;
+  Plan plan = new_factor_plan(
+      p, "coarse_graining",
+      "coarse graining: particles of the powder's median radius (" + number(p.real_median_radius) +
+          " m) instead of " + number(p.median_radius) + " m, at the same Bond number",
+      {}, {kSizeScale, doe::Factor{kSizeScale, lo, hi, doe::Scale::kLog}}, hi);
+  plan.bond_scaled = p.bond_scaled;
+  plan.size_scale = hi;
+  return plan;
+}
+
 std::vector<Plan> candidate_plans(const Problem& p) {
   std::vector<Plan> plans;
   const auto& o = p.options;
@@ -156,6 +220,7 @@ std::vector<Plan> candidate_plans(const Problem& p) {
   if (p.preparation == "pour" && p.cohesion_model != "none" && p.preparable &&
       p.agitation_time_max > 0.0)
     plans.push_back(preparation_plan(p));
+  if (coarse_grained(p)) plans.push_back(coarse_graining_plan(p));
   for (const auto& [path, value] : p.fixed) {
     if (has_factor(p, path) || !(value > 0.0)) continue;
     double lo = value / o.fixed_span, hi = value * o.fixed_span;
@@ -432,6 +497,7 @@ struct VerifiedPoint {
   std::map<std::string, double> proposed, simulated;
   double predicted_rms = kPending, verified_rms = kPending, holdout_rms = kPending;
   bool reaches_all = false;
+  std::map<std::string, double> rescaled;  ///< the plan's rescaled parameters at `proposed`
 };
 
 /// The candidate's outcome is its best verified round (lowest verified error on the calibrated
@@ -442,6 +508,7 @@ void keep_if_best(const VerifiedPoint& point, int round, CandidateOutcome& c) {
   if (c.best_round > 0 && !(point.verified_rms < c.verified_rms)) return;
   c.best_round = round;
   c.proposed = point.proposed;
+  c.rescaled = point.rescaled;
   c.simulated = point.simulated;
   c.predicted_rms = point.predicted_rms;
   c.verified_rms = point.verified_rms;
@@ -462,12 +529,15 @@ bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
     VerifiedPoint point{
         natural_point(plan.factors, fit.result.natural), {}, std::sqrt(fit.result.objective)};
     point.reaches_all = fit.reaches_all;
+    point.rescaled = rescaled_at(plan, point.proposed);
     const int first = (round - 1) * p.options.replicates + 1;
-    request_replicates(p, plan.id + "/verify", first, plan.switches, point.proposed, requests);
+    request_replicates(p, plan.id + "/verify", first, plan.switches,
+                       run_parameters(plan, point.proposed), requests);
     point.simulated = replicate_mean(p, find_group(groups, plan.id + "/verify"), first);
     if (point.simulated.empty()) {
       if (c.best_round == 0) {  // nothing verified yet: show what is being verified
         c.proposed = point.proposed;
+        c.rescaled = point.rescaled;
         c.predicted_rms = point.predicted_rms;
         c.reaches_all = point.reaches_all;
         c.state = "designed";
@@ -508,6 +578,7 @@ CandidateOutcome assess_candidate(const Problem& p, const Plan& plan, const Fitt
     for (std::size_t f = 0; f < plan.factors.size(); ++f)
       req.parameters[plan.factors[f].path] =
           plan.factors[f].factor.to_natural(plan.new_rows(r, Eigen::Index(f)));
+    req.parameters = run_parameters(plan, std::move(req.parameters));
     requests.push_back(std::move(req));
   }
   const auto* g = find_group(groups, plan.id);
@@ -562,6 +633,8 @@ void rank_candidates(const Problem& p, Report& rep) {
       if (!has_factor(p, f.path))
         e << "; " << f.path << " = " << c.proposed.at(f.path) << " in [" << f.factor.low << ", "
           << f.factor.high << "]";
+    for (const auto& [path, value] : c.rescaled)
+      e << "; simulated with " << path << " = " << value << " (the same Bond number)";
     e << (c.reaches_all ? "; its box reaches every target" : "; some target stays out of reach");
     c.evidence = e.str();
   }

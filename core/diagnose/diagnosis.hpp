@@ -15,6 +15,8 @@
 //                    material has one size;
 //       preparation  a cohesive bed built from clusters (seed 000 §2.7.1 method 1; its
 //                    agitation time) where the material's beds are poured;
+//       coarse_graining  particles of the powder's real median radius at the same Bond number
+//                    (its cohesion rescaled) where the material's particles are larger;
 //       fixed:<p>    a parameter held fixed, varied over [v / span, v * span];
 //       curvature    non-linearity: axial runs, main effects and squares;
 //       interaction  a two-factor interaction aliased in the design: the fold-over;
@@ -43,6 +45,17 @@ inline constexpr double kSigmaGLow = 1.01;
 /// preparation: the shortest agitation it runs, as a fraction of the longest (an agitation
 /// time of 0 is pouring; the preparation reads 0 as "the default").
 inline constexpr double kAgitationLowFraction = 1e-3;
+
+/// coarse_graining: a Hamaker constant at the same granular Bond number when every radius is
+/// multiplied by `radius_ratio`. The Bond number is the van der Waals force at contact over the
+/// weight (seed 000 eq. 12-13, two spheres of radius r: r_eff = r):
+///   Bo = (A_H r / (6 D_min^2)) / ((4/3) pi r^3 rho g) = A_H / (8 pi D_min^2 rho g r^2),
+/// so with D_min, D_max and the density kept (a molecular distance and the solid's density do
+/// not change with the particle size) it stays the same when A_H ~ r^2. docs/diagnosis.md
+/// measured it so (LH220's median radius 6.5 um against the example's 100 um: A_H 5e-18 J ->
+/// 2.1e-20 J). Seed 000's own scaling (eq. 24-30) keeps the same Bond number between the
+/// simulated and the real particle: A_H ~ SF and D_min ~ SF with r ~ SF, rho ~ SF^-3.
+double bond_number_hamaker(double hamaker, double radius_ratio);
 
 struct Factor {
   std::string path;  ///< material parameter path
@@ -98,6 +111,14 @@ struct Problem {
   /// preparation: the longest agitation time it runs (s, simulated): the preparation's own
   /// default, 3 largest diameters at the speed sqrt(g d).
   double agitation_time_max = 0.0;
+  /// coarse_graining: the material's median radius as its model states it (sizes times
+  /// sizes.scale, m; 0: no one median, as for discrete classes), the powder's measured median
+  /// radius (material.real_median_radius, m; 0: not stated), the size scale the base runs use,
+  /// and the cohesive parameters the Bond number holds (path -> value at that radius, J).
+  double median_radius = 0.0;
+  double real_median_radius = 0.0;
+  double size_scale = 1.0;
+  std::map<std::string, double> bond_scaled;
   std::map<std::string, double> fixed;  ///< parameters held fixed (path -> value)
   std::map<std::string, std::pair<double, double>> valid;  ///< valid range of each path
   Options options;
@@ -144,8 +165,11 @@ struct CandidateOutcome {
   int runs = 0;                            ///< simulations of its augmented design
   std::vector<Factor> factors;             ///< the extended factor box
   std::map<std::string, double> proposed;  ///< its calibrated set (natural)
-  bool reaches_all = false;                ///< every calibrated target inside its envelopes
-  int rounds = 0;                          ///< verification rounds done
+  /// Parameters its runs set from the proposed set rather than take from it (coarse_graining:
+  /// the cohesion at the proposed radius, bond_number_hamaker); empty for the others.
+  std::map<std::string, double> rescaled;
+  bool reaches_all = false;  ///< every calibrated target inside its envelopes
+  int rounds = 0;            ///< verification rounds done
   /// The verified round with the lowest calibrated error; proposed, predicted_rms,
   /// verified_rms, simulated, holdout_rms and reaches_all are that round's (0: none verified,
   /// proposed and predicted_rms are the round being verified).

@@ -26,13 +26,14 @@ auto read_kind_block(const io::YamlNode& s, const std::string& kind_key, const s
 
 MaterialModel read_material(const io::YamlNode& n) {
   n.expect_only({"particle_law", "wall_law", "sizes", "size_scale", "density", "scaling", "shape",
-                 "preparation"});
+                 "preparation", "real_median_radius"});
   MaterialModel m;
   m.particle_law = io::read_contact_law_spec(n["particle_law"]);
   m.wall_law = n.has("wall_law") ? io::read_contact_law_spec(n["wall_law"]) : m.particle_law;
   m.sizes = io::read_size_distribution(n["sizes"]);
   m.size_scale = n.number("size_scale", 1.0);
   m.density = n["density"].as_number();
+  m.real_median_radius = n.number("real_median_radius", 0.0);
   if (auto s = n.child("scaling")) {
     s->expect_only({"law", "factor"});
     m.scaling = contact::scaling_law_from_name((*s)["law"].as_string(), s->where() + ".law");

@@ -11,6 +11,7 @@
 //     size_scale: 1.0
 //     density: 1545
 //     scaling: {law: none | kottlan2018 | tiscar2019, factor: 1}
+//     real_median_radius: 6.5e-6           # the powder's measured median radius; default none
 #include <string>
 
 #include "core/io/yaml_node.hpp"

@@ -3,11 +3,19 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "core/common/error.hpp"
 
 namespace demcal::lab {
 namespace {
+
+/// A number for a message, in six significant digits (1e-09, 10).
+std::string short_number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
 
 contact::SlotSpec& slot_of(contact::ContactLawSpec& law, const std::string& slot,
                            const std::string& path) {
@@ -134,6 +142,11 @@ void MaterialModel::validate() const {
   particles::validate(sizes, "sizes");
   if (!(density > 0.0)) throw InputError("density", "must be > 0");
   if (!(size_scale > 0.0)) throw InputError("sizes.scale", "must be > 0");
+  if (real_median_radius != 0.0 &&
+      !(real_median_radius >= kRealMedianRadiusMin && real_median_radius <= kRealMedianRadiusMax))
+    throw InputError("real_median_radius", "must be 0 (not stated) or in [" +
+                                               short_number(kRealMedianRadiusMin) + ", " +
+                                               short_number(kRealMedianRadiusMax) + "] m");
   factors();
 }
 

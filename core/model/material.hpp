@@ -32,6 +32,11 @@ struct MaterialModel {
   double density = 1500.0;  ///< real particle density (kg/m^3)
   contact::ScalingLaw scaling = contact::ScalingLaw::kNone;
   double scale_factor = 1.0;
+  /// The powder's measured number-median radius (m; 0: not stated), when the model's particles
+  /// stand for larger ones than the powder's (seed 000 §2.3: spheres scaled to r_real of
+  /// 10-20 um for LH220's d50 of 11-15 um). Changes no simulation; the diagnosis's
+  /// coarse_graining candidate moves the radius toward it.
+  double real_median_radius = 0.0;
   /// Particle shape: spheres, or rigid multisphere clumps whose volume-equivalent radius
   /// follows `sizes` (so mass and volume do not change with the shape).
   particles::ShapeSpec shape;
@@ -51,10 +56,13 @@ struct MaterialModel {
   void validate() const;
 };
 
+/// The range of a stated real median radius (m), that of a monodisperse radius.
+inline constexpr double kRealMedianRadiusMin = 1e-9, kRealMedianRadiusMax = 10.0;
+
 /// Everything of the model that can change a simulation, as text: every slot's model and given
 /// parameters, the size distribution, density, scaling, shape and preparation (numbers to 17
-/// digits). Two models with the same identity simulate alike; the key of work that runs share
-/// (core/lab/stage_cache.hpp).
+/// digits; not the real median radius, which changes none). Two models with the same identity
+/// simulate alike; the key of work that runs share (core/lab/stage_cache.hpp).
 std::string material_identity(const MaterialModel& model);
 
 struct ParameterInfo {

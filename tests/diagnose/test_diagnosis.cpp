@@ -11,6 +11,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <string>
@@ -621,6 +622,140 @@ TEST(Diagnosis, FirstCallRequestsTheBaselineAndEveryCandidatesDesign) {
   }
   EXPECT_DOUBLE_EQ(clusters[4].parameters.at(kSpread), 0.5);
   expect_base_factors_at(clusters[4], 0.0, 0.0, 0.0);
+}
+
+// --- coarse graining: particles larger than the powder's, at the same Bond number ---------
+
+const char* const kScale = "sizes.scale";
+const char* const kHamaker = "particle_law.cohesion.hamaker";
+constexpr double kMaterialRadius = 1e-4;  ///< the material's radius (m): the example's
+constexpr double kRealRadius = 1e-5;      ///< the powder's median radius (m)
+constexpr double kHamakerAtMaterial = 5e-18;
+constexpr double kTrueScale = 0.3;  ///< the hidden radius over the material's
+
+/// A problem whose material states a median radius ten times the powder's: coarse_graining
+/// applies, with the particle law's Hamaker constant held at the Bond number.
+Problem coarse(Problem p) {
+  p.median_radius = kMaterialRadius;
+  p.real_median_radius = kRealRadius;
+  p.bond_scaled = {{kHamaker, kHamakerAtMaterial}};
+  return p;
+}
+
+/// The granular Bond number, van der Waals force at contact over weight (seed 000 eq. 12-13,
+/// r_eff = r for equal spheres; D_min 4e-10 m, solid density 1545 kg/m^3), worked out here.
+double bond_number(double hamaker, double radius) {
+  constexpr double d_min = 4e-10, rho = 1545.0, g = 9.81;
+  const double force = hamaker * radius / (6.0 * d_min * d_min);
+  const double weight = 4.0 / 3.0 * std::numbers::pi * radius * radius * radius * rho * g;
+  return force / weight;
+}
+
+TEST(Diagnosis, BondNumberHamakerKeepsTheBondNumberAtTheRealRadius) {
+  // LH220's median radius 6.5 um against the example's 100 um (docs/diagnosis.md): 5e-18 J
+  // becomes 5e-18 x 0.065^2 = 2.1125e-20 J.
+  const double ratio = 6.5e-6 / 1e-4;
+  EXPECT_NEAR(bond_number_hamaker(5e-18, ratio), 2.1125e-20, 1e-30);
+  EXPECT_NEAR(bond_number(bond_number_hamaker(5e-18, ratio), 6.5e-6) / bond_number(5e-18, 1e-4),
+              1.0, 1e-12);
+  // Without the rescaling the Bond number at the real radius would be 1 / ratio^2 = 237 x.
+  EXPECT_NEAR(bond_number(5e-18, 6.5e-6) / bond_number(5e-18, 1e-4), 1.0 / (ratio * ratio), 1e-9);
+}
+
+TEST(Diagnosis, CoarseGrainingIsACandidateOnlyForParticlesLargerThanThePowders) {
+  const Simulator sim = linear_truth;
+  const auto ms = targets_at(sim(natural_point(0.3, -0.4, 0.2), {}), {kSf, kCn});
+  const Problem base = coarse(make_problem(sim, {kSf, kCn}, ms));
+  auto groups = [](const Problem& p) {
+    std::vector<RunRequest> out;
+    for (const auto& r : diagnose::advance(p, {}).requests)
+      if (r.group == "coarse_graining") out.push_back(r);
+    return out;
+  };
+  // The factorial runs at the powder's radius (sizes.scale 0.1) and the middle run at the
+  // geometric mean (sqrt(0.1)), no model switched, each with A_H at the same Bond number.
+  const auto runs = groups(base);
+  ASSERT_EQ(runs.size(), 5u);
+  const Eigen::MatrixXd d = base_design();
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_TRUE(runs[i].switches.empty());
+    EXPECT_NEAR(runs[i].parameters.at(kScale), 0.1, 1e-12);
+    EXPECT_NEAR(runs[i].parameters.at(kHamaker), kHamakerAtMaterial * 0.01, 1e-30);
+    expect_base_factors_at(runs[i], d(i, 0), d(i, 1), d(i, 2));
+  }
+  EXPECT_NEAR(runs[4].parameters.at(kScale), std::sqrt(0.1), 1e-12);
+  EXPECT_NEAR(runs[4].parameters.at(kHamaker), kHamakerAtMaterial * 0.1, 1e-30);
+  // A Hamaker constant that is a factor is rescaled from the run's own value.
+  Problem p = base;
+  p.factors[2].path = kHamaker;
+  const auto own = groups(p);
+  ASSERT_EQ(own.size(), 5u);
+  EXPECT_NEAR(own[0].parameters.at(kHamaker), natural(2, d(0, 2)) * 0.01, 1e-15);
+  // A size scale already set: the radii are the material's times it, the factor ends there.
+  p = base;
+  p.size_scale = 2.0;
+  p.median_radius = 2.0 * kMaterialRadius;
+  EXPECT_NEAR(groups(p)[0].parameters.at(kScale), 0.1, 1e-12);
+  p = base;
+  p.real_median_radius = 0.0;  // the powder's radius not stated
+  EXPECT_TRUE(groups(p).empty());
+  p = base;
+  p.real_median_radius = kMaterialRadius;  // the particles are the powder's
+  EXPECT_TRUE(groups(p).empty());
+  p = base;
+  p.median_radius = 0.0;  // discrete classes: no one median
+  EXPECT_TRUE(groups(p).empty());
+  for (const char* radius : {"sizes.radius", "sizes.median_radius", "sizes.scale"}) {
+    p = base;
+    p.factors[0].path = radius;  // a radius the design varies
+    EXPECT_TRUE(groups(p).empty()) << radius;
+  }
+}
+
+/// As the rolling truth, but what the base factors cannot reach is the particle size: at a
+/// given Bond number Bo ~ A_H / r^2 (1 at the material's radius and A_H) a bed's cohesive
+/// strength goes as Bo r (Rumpf's F / d^2, docs/diagnosis.md), and a weaker bed packs denser
+/// with more contacts. Scale and A_H default to the material's where a run does not set them.
+Responses size_at_bond_truth(const Parameters& p, const Switches&) {
+  const auto [a, b, c] = coded_point(p);
+  const double scale = p.count(kScale) ? p.at(kScale) : 1.0;
+  const double hamaker = p.count(kHamaker) ? p.at(kHamaker) : kHamakerAtMaterial;
+  const double bond = hamaker / (kHamakerAtMaterial * scale * scale);
+  const double weakening = 1.0 - bond * scale;
+  const double l = a + 0.5 * b + 0.3 * c;
+  return {{kSf, 0.60 - 0.02 * l + 0.1 * weakening}, {kCn, 5.0 + 0.5 * l + 1.0 * weakening}};
+}
+
+TEST(Diagnosis, HiddenCoarseGrainingIsNamedAndItsRadiusRecovered) {
+  auto truth_point = natural_point(0.2, -0.3, 0.1);
+  truth_point[kScale] = kTrueScale;
+  truth_point[kHamaker] = bond_number_hamaker(kHamakerAtMaterial, kTrueScale);
+  const auto ms = targets_at(size_at_bond_truth(truth_point, {}), {kSf, kCn});
+  const Driven d =
+      drive(coarse(make_problem(size_at_bond_truth, {kSf, kCn}, ms)), size_at_bond_truth);
+  const Report& r = d.step.report;
+  EXPECT_EQ(r.state, "done");
+  EXPECT_EQ(r.named_cause, "coarse_graining") << r.conclusion;
+  const CandidateOutcome* c = candidate(r, "coarse_graining");
+  ASSERT_NE(c, nullptr);
+  ASSERT_TRUE(c->proposed.count(kScale));
+  EXPECT_NEAR(c->proposed.at(kScale), kTrueScale, 0.1 * kTrueScale);
+  ASSERT_TRUE(c->rescaled.count(kHamaker));
+  EXPECT_NEAR(c->rescaled.at(kHamaker),
+              kHamakerAtMaterial * c->proposed.at(kScale) * c->proposed.at(kScale), 1e-30);
+  EXPECT_LT(c->verified_rms, 0.7 * r.baseline_verified_rms);
+}
+
+TEST(Diagnosis, CoarseGrainingIsNotNamedForHiddenRollingResistance) {
+  auto truth_point = natural_point(0.2, -0.3, 0.1);
+  truth_point[kMuR] = kTrueMuR;
+  const auto ms =
+      targets_at(rolling_truth(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  const Driven d = drive(coarse(make_problem(rolling_truth, {kSf, kCn}, ms)), rolling_truth);
+  const Report& r = d.step.report;
+  EXPECT_EQ(r.state, "done");
+  ASSERT_NE(candidate(r, "coarse_graining"), nullptr);
+  EXPECT_EQ(r.named_cause, "rolling") << r.conclusion;
 }
 
 /// As the rolling truth, but what the base factors cannot reach is a parameter the campaign

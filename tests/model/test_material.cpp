@@ -2,6 +2,8 @@
 // campaign's fixed values and factor bounds: every value set, or the first wrong one named.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/common/error.hpp"
 #include "core/model/material.hpp"
 
@@ -51,6 +53,22 @@ TEST(MaterialParameters, TheFirstWrongValueIsNamedByItsField) {
   EXPECT_EQ(where_of(m, {{"density", 1800.0, "a"}}), "");
   // The given model is not changed, whether the call fails or not.
   EXPECT_DOUBLE_EQ(get_parameter(m, "density"), 2500.0);
+}
+
+TEST(MaterialParameters, TheRealMedianRadiusIsUnstatedOrInRange) {
+  MaterialModel m = hertz(0.3);
+  m.validate();  // 0: not stated
+  m.real_median_radius = 6.5e-6;
+  m.validate();
+  for (const double bad : {-1e-5, 1e-10, 11.0, std::nan("")}) {
+    m.real_median_radius = bad;
+    try {
+      m.validate();
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where(), "real_median_radius") << bad;
+    }
+  }
 }
 
 }  // namespace

@@ -364,6 +364,10 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
        "spec.material.size_scale"},
       {[&](v1::CampaignSpec& s) { s.mutable_material()->mutable_scaling()->set_factor(inf); },
        "spec.material.scaling.factor"},
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_real_median_radius(inf); },
+       "spec.material.real_median_radius"},
+      {[&](v1::CampaignSpec& s) { s.mutable_material()->set_real_median_radius(-1e-5); },
+       "spec.material.real_median_radius"},
       {[&](v1::CampaignSpec& s) {
          auto* l = s.mutable_material()->mutable_sizes()->mutable_lognormal();
          l->set_median_radius(5e-4);
