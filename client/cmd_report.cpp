@@ -9,8 +9,8 @@
 
 #include "client/commands.hpp"
 #include "client/embedded.hpp"
-#include "client/report/report_data.hpp"
-#include "client/report/report_html.hpp"
+#include "report/report_data.hpp"
+#include "report/report_html.hpp"
 
 namespace demcal::cli {
 namespace {

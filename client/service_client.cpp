@@ -1,6 +1,5 @@
 #include "client/service_client.hpp"
 
-#include <google/protobuf/util/json_util.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -26,20 +25,6 @@ std::string duration(double s) {
     << std::setfill('0') << t % 60;
   return o.str();
 }
-
-}  // namespace
-
-std::string message_json(const google::protobuf::Message& m) {
-  std::string out;
-  google::protobuf::util::JsonPrintOptions o;
-  o.add_whitespace = true;
-  o.preserve_proto_field_names = true;
-  o.always_print_primitive_fields = true;
-  (void)google::protobuf::util::MessageToJsonString(m, &out, o);
-  return out;
-}
-
-namespace {
 
 std::string csv_quote(const std::string& s) {
   if (s.find_first_of(",\"") == std::string::npos) return s;
@@ -75,23 +60,6 @@ void add_connection_options(CLI::App& cmd, rpc::ChannelOptions& o) {
 
 std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const rpc::ChannelOptions& o) {
   return v1::CampaignService::NewStub(rpc::make_channel(o));
-}
-
-grpc::Status read_export(v1::CampaignService::StubInterface& stub,
-                         const rpc::ChannelOptions& options, std::int64_t id,
-                         const std::string& format, std::string& content, bool series,
-                         const std::vector<std::int64_t>& jobs) {
-  v1::ExportRequest req;
-  req.set_id(id);
-  req.set_format(format);
-  req.set_series(series);
-  for (const auto job : jobs) req.add_jobs(job);
-  const auto context = rpc::make_context(options, 600);
-  auto reader = stub.Export(context.get(), req);
-  content.clear();
-  v1::ExportReply piece;
-  while (reader->Read(&piece)) content += piece.content();
-  return reader->Finish();
 }
 
 void check(const grpc::Status& s, const std::string& what) {

@@ -10,6 +10,7 @@
 
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "rpc/channel.hpp"
+#include "rpc/replies.hpp"
 
 namespace demcal::cli {
 
@@ -22,14 +23,9 @@ std::unique_ptr<v1::CampaignService::Stub> campaign_stub(const rpc::ChannelOptio
 /// std::runtime_error "<what>: <CODE>: <message>" otherwise.
 void check(const grpc::Status& status, const std::string& what);
 
-/// The campaign's Export document in `format` (json, csv or journal; with `series` the jobs'
-/// curves too; a journal of the jobs in `jobs` only when it is not empty), read whole from its
-/// stream (it may exceed one gRPC message). Returns the stream's status; `content` is complete
-/// only when it is OK.
-grpc::Status read_export(v1::CampaignService::StubInterface& stub,
-                         const rpc::ChannelOptions& options, std::int64_t id,
-                         const std::string& format, std::string& content, bool series = false,
-                         const std::vector<std::int64_t>& jobs = {});
+/// The reply printer and the Export stream reader live in rpc/ (the report reads with them too).
+using rpc::message_json;
+using rpc::read_export;
 
 void print_design_summary(std::ostream& out, const v1::DesignSummary& d);
 std::string progress_line(const v1::Progress& p, int width = 30);
@@ -49,8 +45,6 @@ void print_rounds(std::ostream& out,
 v1::CalibrateReply drive_calibration(v1::CampaignService::Stub& stub,
                                      const rpc::ChannelOptions& channel,
                                      const v1::CalibrateRequest& request, std::ostream& progress);
-/// A message as JSON with every field printed (the one document `--format json` writes).
-std::string message_json(const google::protobuf::Message& m);
 std::string state_name(v1::CampaignState s);
 
 }  // namespace demcal::cli

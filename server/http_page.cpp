@@ -5,9 +5,9 @@
 
 #include <stdexcept>
 
-#include "client/report/report_data.hpp"
-#include "client/report/report_html.hpp"
 #include "demcal/v1/campaign.grpc.pb.h"
+#include "report/report_data.hpp"
+#include "report/report_html.hpp"
 #include "rpc/channel.hpp"
 #include "server/auth.hpp"
 

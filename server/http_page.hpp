@@ -1,6 +1,6 @@
 #pragma once
 // The live report page (`demcal-server --http HOST:PORT`, `demcal run --http`): the report of
-// client/report served per campaign over HTTP with cpp-httplib, read-only. The pages are
+// report/ served per campaign over HTTP with cpp-httplib, read-only. The pages are
 // shells without data; the data come from two JSON endpoints that call the coordinator's own
 // gRPC service in process, forwarding the request's bearer token, so the page reads exactly
 // what the gRPC API serves, behind exactly its check:

@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "client/report/report_html.hpp"
+#include "report/report_html.hpp"
 
 namespace demcal::report {
 namespace {

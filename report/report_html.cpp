@@ -1,4 +1,4 @@
-#include "client/report/report_html.hpp"
+#include "report/report_html.hpp"
 
 #include <map>
 #include <stdexcept>

@@ -1,8 +1,8 @@
-#include "client/report/report_data.hpp"
+#include "report/report_data.hpp"
 
 #include <string>
 
-#include "client/service_client.hpp"
+#include "rpc/replies.hpp"
 
 namespace demcal::report {
 namespace {
@@ -12,7 +12,7 @@ using nlohmann::json;
 constexpr double kDeadlineSeconds = 300;
 
 json as_json(const google::protobuf::Message& m) {
-  return json::parse(cli::message_json(m));
+  return json::parse(rpc::message_json(m));
 }
 
 /// A reply the report cannot do without: a failure is thrown with its status.
@@ -57,7 +57,7 @@ json read_design(v1::CampaignService::StubInterface& stub, const rpc::ChannelOpt
 json read_export(v1::CampaignService::StubInterface& stub, const rpc::ChannelOptions& ch,
                  std::int64_t id) {
   std::string content;
-  required([&] { return cli::read_export(stub, ch, id, "json", content, true); }, "export");
+  required([&] { return rpc::read_export(stub, ch, id, "json", content, true); }, "export");
   return json::parse(content);
 }
 

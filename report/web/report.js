@@ -1,4 +1,4 @@
-// demcal's campaign report: turns the report document (client/report/report_data.hpp: the
+// demcal's campaign report: turns the report document (report/report_data.hpp: the
 // coordinator's own replies) into tables and Vega-Lite plots. The same script draws the static
 // report.html (data inline) and the live page (data polled from the coordinator's HTTP API).
 // docs/report.md says what every plot shows and which figure of seed 000 it follows.
