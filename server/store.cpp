@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
+#include <string_view>
 #include <tuple>
 
 namespace demcal::server {
@@ -18,199 +19,13 @@ double wall_seconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-namespace {
-
-/// Schema migrations: migration i takes user_version i to i + 1. Never edit a released one.
-const std::vector<const char*>& migrations() {
-  static const std::vector<const char*> m = {
-      R"sql(
-      CREATE TABLE campaigns (
-        id INTEGER PRIMARY KEY AUTOINCREMENT,
-        name TEXT NOT NULL,
-        state TEXT NOT NULL CHECK (state IN ('running', 'done', 'cancelled')),
-        spec_json TEXT NOT NULL,
-        design_json TEXT NOT NULL,
-        created REAL NOT NULL,
-        finished REAL NOT NULL DEFAULT 0);
-      CREATE TABLE jobs (
-        id INTEGER PRIMARY KEY AUTOINCREMENT,
-        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
-        std_order INTEGER NOT NULL,
-        run_order INTEGER NOT NULL,
-        test TEXT NOT NULL,
-        kind TEXT NOT NULL CHECK (kind IN ('design', 'verify')),
-        payload TEXT NOT NULL,
-        state TEXT NOT NULL
-          CHECK (state IN ('queued', 'leased', 'done', 'failed', 'cancelled')),
-        attempt INTEGER NOT NULL DEFAULT 0,
-        counted INTEGER NOT NULL DEFAULT 0,
-        lease_deadline REAL NOT NULL DEFAULT 0,
-        worker TEXT NOT NULL DEFAULT '',
-        error TEXT NOT NULL DEFAULT '',
-        finished REAL NOT NULL DEFAULT 0);
-      CREATE INDEX jobs_queue ON jobs (state, campaign_id, kind, run_order);
-      CREATE INDEX jobs_campaign ON jobs (campaign_id);
-      CREATE TABLE results (
-        job_id INTEGER PRIMARY KEY REFERENCES jobs(id),
-        attempt INTEGER NOT NULL,
-        worker TEXT NOT NULL,
-        metrics_json TEXT NOT NULL,
-        wall_seconds REAL NOT NULL,
-        stored REAL NOT NULL);
-      )sql",
-      // 2: jobs of the diagnosis (kind 'diagnose:<group>'). SQLite cannot change a CHECK in
-      // place: the table is rebuilt (https://www.sqlite.org/lang_altertable.html, the 12 steps;
-      // foreign keys are off while migrating).
-      R"sql(
-      CREATE TABLE jobs_v2 (
-        id INTEGER PRIMARY KEY AUTOINCREMENT,
-        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
-        std_order INTEGER NOT NULL,
-        run_order INTEGER NOT NULL,
-        test TEXT NOT NULL,
-        kind TEXT NOT NULL CHECK (kind IN ('design', 'verify') OR kind LIKE 'diagnose:%'),
-        payload TEXT NOT NULL,
-        state TEXT NOT NULL
-          CHECK (state IN ('queued', 'leased', 'done', 'failed', 'cancelled')),
-        attempt INTEGER NOT NULL DEFAULT 0,
-        counted INTEGER NOT NULL DEFAULT 0,
-        lease_deadline REAL NOT NULL DEFAULT 0,
-        worker TEXT NOT NULL DEFAULT '',
-        error TEXT NOT NULL DEFAULT '',
-        finished REAL NOT NULL DEFAULT 0);
-      INSERT INTO jobs_v2 SELECT * FROM jobs;
-      DROP TABLE jobs;
-      ALTER TABLE jobs_v2 RENAME TO jobs;
-      CREATE INDEX jobs_queue ON jobs (state, campaign_id, kind, run_order);
-      CREATE INDEX jobs_campaign ON jobs (campaign_id);
-      )sql",
-      // 3: per result, the metrics flagged as untrustworthy and the run's cost block.
-      R"sql(
-      ALTER TABLE results ADD COLUMN flags_json TEXT NOT NULL DEFAULT '{}';
-      ALTER TABLE results ADD COLUMN cost_json TEXT NOT NULL DEFAULT '{}';
-      )sql",
-      // 4: the sequential calibration: its rounds, its stage boxes, and the jobs of its stage
-      // designs (kind 'stage:<n>'), which need the jobs table rebuilt as in migration 2.
-      R"sql(
-      CREATE TABLE jobs_v4 (
-        id INTEGER PRIMARY KEY AUTOINCREMENT,
-        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
-        std_order INTEGER NOT NULL,
-        run_order INTEGER NOT NULL,
-        test TEXT NOT NULL,
-        kind TEXT NOT NULL CHECK (kind IN ('design', 'verify') OR kind LIKE 'diagnose:%'
-                                  OR kind LIKE 'stage:%'),
-        payload TEXT NOT NULL,
-        state TEXT NOT NULL
-          CHECK (state IN ('queued', 'leased', 'done', 'failed', 'cancelled')),
-        attempt INTEGER NOT NULL DEFAULT 0,
-        counted INTEGER NOT NULL DEFAULT 0,
-        lease_deadline REAL NOT NULL DEFAULT 0,
-        worker TEXT NOT NULL DEFAULT '',
-        error TEXT NOT NULL DEFAULT '',
-        finished REAL NOT NULL DEFAULT 0);
-      INSERT INTO jobs_v4 SELECT * FROM jobs;
-      DROP TABLE jobs;
-      ALTER TABLE jobs_v4 RENAME TO jobs;
-      CREATE INDEX jobs_queue ON jobs (state, campaign_id, kind, run_order);
-      CREATE INDEX jobs_campaign ON jobs (campaign_id);
-      CREATE TABLE calibration_rounds (
-        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
-        round INTEGER NOT NULL,
-        stage INTEGER NOT NULL,
-        proposal_json TEXT NOT NULL,
-        created REAL NOT NULL,
-        PRIMARY KEY (campaign_id, round));
-      CREATE TABLE calibration_stages (
-        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
-        stage INTEGER NOT NULL,
-        box_json TEXT NOT NULL,
-        created REAL NOT NULL,
-        PRIMARY KEY (campaign_id, stage));
-      )sql",
-      // 5: a campaign's jobs are inserted in batches, each in its own short transaction; the
-      // campaign is invisible (ready = 0) until the last batch is in.
-      R"sql(
-      ALTER TABLE campaigns ADD COLUMN ready INTEGER NOT NULL DEFAULT 1;
-      )sql",
-      // 6: a result's curves (stress-strain, yield points, drum surface, ...), apart from the
-      // results so that reading metrics never reads them.
-      R"sql(
-      CREATE TABLE result_series (
-        job_id INTEGER PRIMARY KEY REFERENCES results(job_id),
-        series_json TEXT NOT NULL);
-      )sql",
-      // 7: the latest checkpoint of a job's simulation, from the lease that sent it; handed out
-      // with the job's next lease, dropped when its result is stored.
-      R"sql(
-      CREATE TABLE checkpoints (
-        job_id INTEGER PRIMARY KEY REFERENCES jobs(id),
-        attempt INTEGER NOT NULL,
-        worker TEXT NOT NULL,
-        stage TEXT NOT NULL,
-        state BLOB NOT NULL,
-        stored REAL NOT NULL);
-      )sql",
-      // 8: run keys and the lab protocol version each was computed under (server/run_key.hpp;
-      // NULL until the coordinator computes those of older jobs at opening), results taken from an
-      // earlier run with the same key instead of simulated (the source job, or the journal line),
-      // and the runs read from journals.
-      R"sql(
-      ALTER TABLE jobs ADD COLUMN run_key TEXT;
-      ALTER TABLE jobs ADD COLUMN run_protocol INTEGER NOT NULL DEFAULT 0;
-      CREATE INDEX jobs_run_key ON jobs (run_key, state);
-      ALTER TABLE results ADD COLUMN reused_from INTEGER NOT NULL DEFAULT 0;
-      ALTER TABLE results ADD COLUMN reused_journal TEXT NOT NULL DEFAULT '';
-      CREATE TABLE journal_runs (
-        run_key TEXT PRIMARY KEY,
-        attempt INTEGER NOT NULL,
-        metrics_json TEXT NOT NULL,
-        wall_seconds REAL NOT NULL,
-        flags_json TEXT NOT NULL,
-        cost_json TEXT NOT NULL,
-        series_json TEXT NOT NULL,
-        source TEXT NOT NULL,
-        imported REAL NOT NULL);
-      )sql",
-      // 9: the design rows a multi-fidelity campaign runs at its high level as well (kind
-      // 'design:high'), rebuilt as in migration 2.
-      R"sql(
-      CREATE TABLE jobs_v9 (
-        id INTEGER PRIMARY KEY AUTOINCREMENT,
-        campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
-        std_order INTEGER NOT NULL,
-        run_order INTEGER NOT NULL,
-        test TEXT NOT NULL,
-        kind TEXT NOT NULL CHECK (kind IN ('design', 'design:high', 'verify')
-                                  OR kind LIKE 'diagnose:%' OR kind LIKE 'stage:%'),
-        payload TEXT NOT NULL,
-        state TEXT NOT NULL
-          CHECK (state IN ('queued', 'leased', 'done', 'failed', 'cancelled')),
-        attempt INTEGER NOT NULL DEFAULT 0,
-        counted INTEGER NOT NULL DEFAULT 0,
-        lease_deadline REAL NOT NULL DEFAULT 0,
-        worker TEXT NOT NULL DEFAULT '',
-        error TEXT NOT NULL DEFAULT '',
-        finished REAL NOT NULL DEFAULT 0,
-        run_key TEXT,
-        run_protocol INTEGER NOT NULL DEFAULT 0);
-      INSERT INTO jobs_v9 SELECT * FROM jobs;
-      DROP TABLE jobs;
-      ALTER TABLE jobs_v9 RENAME TO jobs;
-      CREATE INDEX jobs_queue ON jobs (state, campaign_id, kind, run_order);
-      CREATE INDEX jobs_campaign ON jobs (campaign_id);
-      CREATE INDEX jobs_run_key ON jobs (run_key, state);
-      )sql",
-      // 10: the token a campaign was submitted with (auth.hpp, token_name), whose unfinished
-      // jobs are bounded (limits.hpp).
-      R"sql(
-      ALTER TABLE campaigns ADD COLUMN owner TEXT NOT NULL DEFAULT '';
-      )sql",
-  };
-  return m;
-}
-
-}  // namespace
+namespace schema {
+/// The schema migrations, server/schema/NNN_name.sql in the order of their numbers (built into
+/// the binary by cmake/EmbedFiles.cmake): migration i + 1 takes user_version i to i + 1. Never
+/// edit a released one: its statements keep their text byte for byte (SQLite stores the text of
+/// each CREATE in sqlite_schema).
+const std::vector<std::string_view>& migrations();
+}  // namespace schema
 
 /// A prepared statement, taken from the store's cache of idle statements (SQLite's parsing and
 /// planning was 14 % of the coordinator's time in bench/coordinator.sh when every call prepared
@@ -453,7 +268,7 @@ void Store::exec(const char* sql) {
 }
 
 int Store::latest_schema_version() {
-  return static_cast<int>(migrations().size());
+  return static_cast<int>(schema::migrations().size());
 }
 
 int Store::schema_version() {
@@ -483,7 +298,7 @@ void Store::migrate() {
                              " is newer than this coordinator's " +
                              std::to_string(latest_schema_version()));
   for (int i = version; i < latest_schema_version(); ++i) {
-    exec(migrations()[std::size_t(i)]);
+    exec(std::string(schema::migrations()[std::size_t(i)]).c_str());
     exec(("PRAGMA user_version=" + std::to_string(i + 1)).c_str());
   }
   Statement fk(*this, "PRAGMA foreign_key_check");
