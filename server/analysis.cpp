@@ -1,27 +1,13 @@
 #include "server/analysis.hpp"
 
 #include <cmath>
-#include <nlohmann/json.hpp>
 
 #include "core/common/error.hpp"
 
 namespace demcal::server {
 
-std::string metrics_to_json(const std::map<std::string, double>& metrics) {
-  nlohmann::json j = nlohmann::json::object();
-  for (const auto& [k, v] : metrics) j[k] = std::isfinite(v) ? nlohmann::json(v) : nullptr;
-  return j.dump();
-}
-
-std::map<std::string, double> metrics_from_json(const std::string& json) {
-  std::map<std::string, double> out;
-  const auto parsed = nlohmann::json::parse(json);  // items() refers to it: keep it alive
-  for (const auto& [k, v] : parsed.items()) out[k] = v.is_number() ? v.get<double>() : std::nan("");
-  return out;
-}
-
 Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobRow>& jobs,
-                                const std::string& kind) {
+                                std::string_view kind) {
   Eigen::MatrixXd y = Eigen::MatrixXd::Constant(
       plan.design.runs(), static_cast<Eigen::Index>(plan.responses.size()), std::nan(""));
   for (const auto& job : jobs) {
@@ -39,9 +25,8 @@ Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobR
 std::map<std::string, std::vector<int>> flagged_runs(const std::vector<JobRow>& jobs) {
   std::map<std::string, std::vector<int>> out;
   for (const auto& job : jobs) {
-    if (job.kind != "design" || job.state != "done") continue;
-    const auto flags = nlohmann::json::parse(job.flags_json);  // items() refers to it
-    for (const auto& [metric, why] : flags.items())
+    if (job.kind != job_kind::kDesign || job.state != "done") continue;
+    for (const auto& [metric, why] : flags_from_json(job.flags_json))
       out[job.test + "." + metric].push_back(job.std_order);
   }
   return out;

@@ -10,11 +10,9 @@
 #include "core/doe/analysis.hpp"
 #include "server/plan.hpp"
 #include "server/store.hpp"
+#include "server/stored_columns.hpp"
 
 namespace demcal::server {
-
-std::string metrics_to_json(const std::map<std::string, double>& metrics);
-std::map<std::string, double> metrics_from_json(const std::string& json);
 
 /// One row per design row (standard order), one column per plan.responses; NaN = no result.
 /// Per response ("test.metric"), the design runs (std order) whose value is flagged: a phase it
@@ -23,7 +21,7 @@ std::map<std::string, std::vector<int>> flagged_runs(const std::vector<JobRow>& 
 /// `kind` selects the jobs: the campaign's design, or a calibration stage's ("stage:<n>"),
 /// whose rows are the same design laid over the stage's box.
 Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobRow>& jobs,
-                                const std::string& kind = "design");
+                                std::string_view kind = job_kind::kDesign);
 
 doe::ResponseAnalysis analyse(const CampaignPlan& plan, const Eigen::VectorXd& y,
                               doe::ModelKind model, double alpha);

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <nlohmann/json.hpp>
 #include <set>
 #include <string_view>
 
@@ -14,11 +13,11 @@
 #include "server/convert.hpp"
 #include "server/plan.hpp"
 #include "server/services.hpp"
+#include "server/stored_columns.hpp"
 
 namespace demcal::server {
 namespace {
 
-constexpr std::string_view kStagePrefix = "stage:";
 /// Verification seeds start here, apart from every design and stage row's seed.
 constexpr std::uint64_t kVerifySeedOffset = 1'000'000;
 
@@ -48,7 +47,7 @@ doe::ModelKind polynomial_model(const std::string& text, const std::string& wher
 }
 
 bool is_calibration_job(const JobRow& j) {
-  return (j.kind == "verify" && j.std_order > 0) || j.kind.starts_with(kStagePrefix);
+  return (j.kind == job_kind::kVerify && j.std_order > 0) || job_kind::is_stage(j.kind);
 }
 
 bool is_open(const JobRow& j) {
@@ -67,7 +66,7 @@ std::optional<Eigen::VectorXd> round_values(const Loaded& l, const std::vector<i
   Eigen::VectorXd v = Eigen::VectorXd::Constant(Eigen::Index(columns.size()), std::nan(""));
   int seen = 0;
   for (const auto& j : l.jobs) {
-    if (j.kind != "verify" || j.std_order != round) continue;
+    if (j.kind != job_kind::kVerify || j.std_order != round) continue;
     ++seen;
     if (is_open(j)) return std::nullopt;
     if (j.state != "done" || !j.metrics_json) continue;
@@ -82,38 +81,12 @@ std::optional<Eigen::VectorXd> round_values(const Loaded& l, const std::vector<i
 
 /// Particles x steps of a run's cost block (0 when it has none).
 double particle_steps(const std::string& cost_json) {
-  v1::RunCost cost;
-  from_json(cost_json, cost);
+  const v1::RunCost cost = cost_from_json(cost_json);
   return static_cast<double>(cost.particles()) * static_cast<double>(cost.steps());
 }
 
-std::string box_to_json(const std::vector<doe::Factor>& box) {
-  nlohmann::json j = nlohmann::json::array();
-  for (const auto& f : box) j.push_back({{"low", f.low}, {"high", f.high}});
-  return j.dump();
-}
-
-std::vector<doe::Factor> box_from_json(const CampaignPlan& plan, const std::string& text) {
-  const auto j = nlohmann::json::parse(text);
-  std::vector<doe::Factor> box;
-  for (std::size_t i = 0; i < plan.factors.size(); ++i) {
-    doe::Factor f = plan.factors[i].factor;
-    f.low = j.at(i).at("low").get<double>();
-    f.high = j.at(i).at("high").get<double>();
-    box.push_back(f);
-  }
-  return box;
-}
-
-Eigen::VectorXd vector_of(const nlohmann::json& j) {
-  Eigen::VectorXd v(Eigen::Index(j.size()));
-  for (std::size_t i = 0; i < j.size(); ++i)
-    v(Eigen::Index(i)) = j[i].is_number() ? j[i].get<double>() : std::nan("");
-  return v;
-}
-
 calib::StageRuns stage_runs(const Loaded& l, const std::vector<int>& columns,
-                            std::vector<doe::Factor> box, const std::string& kind) {
+                            std::vector<doe::Factor> box, std::string_view kind) {
   const Eigen::MatrixXd y = response_matrix(l.plan, l.jobs, kind);
   calib::StageRuns st{std::move(box), l.plan.design.coded,
                       Eigen::MatrixXd(y.rows(), Eigen::Index(columns.size()))};
@@ -128,7 +101,7 @@ void correct_design(Loaded& l) {
   auto& st = l.state.stages.front();
   l.low = st.responses;
   l.high = Eigen::MatrixXd(st.responses.rows(), st.responses.cols());
-  const Eigen::MatrixXd high = response_matrix(l.plan, l.jobs, kHighDesignKind);
+  const Eigen::MatrixXd high = response_matrix(l.plan, l.jobs, job_kind::kHighDesign);
   for (std::size_t m = 0; m < l.responses.size(); ++m) {
     const Eigen::VectorXd low = st.responses.col(Eigen::Index(m));
     l.high.col(Eigen::Index(m)) = high.col(column_of(l.plan, l.responses[m]));
@@ -182,7 +155,7 @@ void add_targets(Loaded& l) {
 
 Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& req) {
   Loaded l;
-  from_json(row.spec_json, l.spec);
+  l.spec = spec_from_json(row.spec_json);
   l.plan = plan_from_json(row.design_json);
   l.jobs = store.jobs(row.id);
   l.round_rows = store.calibration_rounds(row.id);
@@ -205,18 +178,18 @@ Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& re
   s.factors.clear();
   for (const auto& f : l.plan.factors) s.factors.push_back(f.factor);
   s.jobs_per_point = std::max(1, l.spec.tests_size());
-  s.stages.push_back(stage_runs(l, columns, s.factors, "design"));
+  s.stages.push_back(stage_runs(l, columns, s.factors, job_kind::kDesign));
   if (l.plan.fidelity) correct_design(l);
   add_targets(l);
   for (const auto& st : store.calibration_stages(row.id)) {
-    s.stages.push_back(stage_runs(l, columns, box_from_json(l.plan, st.box_json),
-                                  std::string(kStagePrefix) + std::to_string(st.stage)));
+    s.stages.push_back(
+        stage_runs(l, columns, box_from_json(l.plan, st.box_json), job_kind::stage(st.stage)));
     if (l.plan.fidelity) correct_stage(l, s.stages.back());
   }
   for (const auto& r : l.round_rows) {
-    const auto j = nlohmann::json::parse(r.proposal_json);
-    s.rounds.push_back({r.stage, vector_of(j.at("natural")), vector_of(j.at("predicted")),
-                        round_values(l, columns, r.round), j.value("batch", r.round)});
+    const StoredProposal p = proposal_from_json(r.proposal_json);
+    s.rounds.push_back({r.stage, p.natural, p.predicted, round_values(l, columns, r.round),
+                        p.batch.value_or(r.round)});
   }
   std::set<std::string> workers;
   for (const auto& j : l.jobs) {
@@ -229,16 +202,6 @@ Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& re
   if (l.spec.calibration().batch() == 0)
     l.options.batch = std::clamp(static_cast<int>(workers.size()), 1, 64);
   return l;
-}
-
-std::string proposal_json(const Eigen::VectorXd& natural, const Eigen::VectorXd& predicted,
-                          const std::vector<std::string>& metrics, int batch) {
-  nlohmann::json j;
-  for (Eigen::Index i = 0; i < natural.size(); ++i) j["natural"].push_back(natural(i));
-  for (Eigen::Index i = 0; i < predicted.size(); ++i) j["predicted"].push_back(predicted(i));
-  j["metrics"] = metrics;
-  j["batch"] = batch;
-  return j.dump();
 }
 
 v1::CalibrationRound round_message(const Loaded& l, std::size_t i) {
@@ -349,12 +312,12 @@ std::vector<std::int64_t> queue_rounds(Store& store, const CampaignRow& row, con
     std::map<std::string, double> parameters;
     for (std::size_t f = 0; f < l.plan.factors.size(); ++f)
       parameters[l.plan.factors[f].path] = d.batch[b](Eigen::Index(f));
-    const auto jobs =
-        jobs_at(at_fidelity(l.spec, l.plan, true), l.spec.material(), parameters, round, "verify",
-                pinned ? 0 : kVerifySeedOffset + std::uint64_t(round));
+    const auto jobs = jobs_at(at_fidelity(l.spec, l.plan, true), l.spec.material(), parameters,
+                              round, std::string(job_kind::kVerify),
+                              pinned ? 0 : kVerifySeedOffset + std::uint64_t(round));
     const auto queued = store.add_calibration_round(
         row.id,
-        {round, d.stage, proposal_json(d.batch[b], d.batch_predicted[b], l.responses, batch),
+        {round, d.stage, proposal_to_json(d.batch[b], d.batch_predicted[b], l.responses, batch),
          now_seconds()},
         jobs);
     ids.insert(ids.end(), queued.begin(), queued.end());
@@ -370,8 +333,7 @@ std::vector<std::int64_t> queue_stage(Store& store, const CampaignRow& row, cons
   std::vector<PlannedFactor> box = l.plan.factors;
   for (std::size_t f = 0; f < box.size(); ++f) box[f].factor = d.next_box[f];
   const auto jobs = design_jobs(at_fidelity(l.spec, l.plan, false), l.plan, box,
-                                std::string(kStagePrefix) + std::to_string(stage),
-                                (stage - 1) * l.plan.design.runs());
+                                job_kind::stage(stage), (stage - 1) * l.plan.design.runs());
   spdlog::info("campaign {}: calibration stage {} queued ({} jobs)", row.id, stage, jobs.size());
   return store.add_calibration_stage(row.id, {stage, box_to_json(d.next_box), now_seconds()}, jobs);
 }
@@ -412,10 +374,10 @@ v1::FidelityCost fidelity_cost(const CampaignPlan& plan, const std::vector<JobRo
   for (const auto& j : jobs) {
     if (j.state != "done") continue;
     const double ps = particle_steps(j.cost_json);
-    if (j.kind == "design" || j.kind.starts_with(kStagePrefix)) {
+    if (j.kind == job_kind::kDesign || job_kind::is_stage(j.kind)) {
       c.set_low_particle_steps(c.low_particle_steps() + ps);
       c.set_low_jobs(c.low_jobs() + 1);
-    } else if (j.kind == kHighDesignKind) {
+    } else if (j.kind == job_kind::kHighDesign) {
       c.set_high_particle_steps(c.high_particle_steps() + ps);
       c.set_high_jobs(c.high_jobs() + 1);
     } else if (is_calibration_job(j)) {

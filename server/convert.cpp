@@ -22,6 +22,7 @@
 #include "server/diagnosis.hpp"
 #include "server/limits.hpp"
 #include "server/run_key.hpp"
+#include "server/stored_columns.hpp"
 
 namespace demcal::server {
 
@@ -495,10 +496,11 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
   // anything runs.
   (void)calibration_options(spec.calibration(), "spec.calibration");
   (void)diagnose_options(spec.diagnose(), "spec.diagnose");
-  jobs = design_jobs(at_fidelity(spec, plan, false), plan, plan.factors, "design", 0);
+  jobs = design_jobs(at_fidelity(spec, plan, false), plan, plan.factors,
+                     std::string(job_kind::kDesign), 0);
   if (plan.fidelity) {
     const auto high = design_jobs(at_fidelity(spec, plan, true), plan, plan.factors,
-                                  kHighDesignKind, 0, &plan.fidelity->high_rows);
+                                  std::string(job_kind::kHighDesign), 0, &plan.fidelity->high_rows);
     jobs.insert(jobs.end(), high.begin(), high.end());
   }
   return plan;
@@ -619,7 +621,7 @@ v1::Campaign campaign_message(const CampaignRow& row, const Counts& counts, doub
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
   c.set_created_at(buf);
-  if (with_spec) from_json(row.spec_json, *c.mutable_spec());
+  if (with_spec) *c.mutable_spec() = spec_from_json(row.spec_json);
   return c;
 }
 
@@ -636,45 +638,13 @@ v1::JobResult job_message(const JobRow& job) {
   r.set_error(job.error);
   r.set_worker(job.worker);
   r.set_wall_seconds(job.wall_seconds);
-  const auto flags = nlohmann::json::parse(job.flags_json);  // items() refers to it
-  for (const auto& [k, v] : flags.items()) (*r.mutable_flags())[k] = v.get<std::string>();
-  from_json(job.cost_json, *r.mutable_cost());
+  for (const auto& [k, v] : flags_from_json(job.flags_json)) (*r.mutable_flags())[k] = v;
+  *r.mutable_cost() = cost_from_json(job.cost_json);
   r.set_run_key(job.run_key.key);
   r.set_run_protocol(job.run_key.protocol);
   r.set_reused_from(job.reused_from);
   r.set_reused_journal(job.reused_journal);
   return r;
-}
-
-std::string series_json(const google::protobuf::RepeatedPtrField<v1::Series>& series) {
-  if (series.empty()) return {};
-  nlohmann::json out = nlohmann::json::object();
-  for (const auto& s : series) {
-    const std::size_t width = static_cast<std::size_t>(s.columns_size());
-    nlohmann::json rows = nlohmann::json::array();
-    for (std::size_t at = 0; width > 0 && at < static_cast<std::size_t>(s.values_size());
-         at += width)
-      rows.push_back(std::vector<double>(s.values().begin() + static_cast<int>(at),
-                                         s.values().begin() + static_cast<int>(at + width)));
-    out[s.name()] = {{"columns", std::vector<std::string>(s.columns().begin(), s.columns().end())},
-                     {"rows", std::move(rows)}};
-  }
-  return out.dump();
-}
-
-google::protobuf::RepeatedPtrField<v1::Series> series_from_json(const std::string& json) {
-  google::protobuf::RepeatedPtrField<v1::Series> out;
-  if (json.empty()) return out;
-  const auto curves = nlohmann::json::parse(json);
-  for (auto it = curves.begin(); it != curves.end(); ++it) {
-    const auto& curve = it.value();
-    auto* s = out.Add();
-    s->set_name(it.key());
-    for (const auto& column : curve.at("columns")) s->add_columns(column.get<std::string>());
-    for (const auto& row : curve.at("rows"))
-      for (const auto& value : row) s->add_values(value.get<double>());
-  }
-  return out;
 }
 
 std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,

@@ -66,9 +66,4 @@ std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
                             const std::string& format,
                             const std::map<std::int64_t, std::string>* series = nullptr);
 
-/// A result's curves as stored: {name: {"columns": [...], "rows": [[...], ...]}}; "" for none.
-std::string series_json(const google::protobuf::RepeatedPtrField<v1::Series>& series);
-/// The curves stored by series_json() as messages again.
-google::protobuf::RepeatedPtrField<v1::Series> series_from_json(const std::string& json);
-
 }  // namespace demcal::server

@@ -1,7 +1,5 @@
 #include "server/journal.hpp"
 
-#include <nlohmann/json.hpp>
-
 #include "core/common/error.hpp"
 #include "core/lab/protocol.hpp"
 #include "rpc/journal_line.hpp"
@@ -9,14 +7,13 @@
 #include "server/build_info.hpp"
 #include "server/convert.hpp"
 #include "server/run_key.hpp"
+#include "server/stored_columns.hpp"
 
 namespace demcal::server {
 namespace {
 
 v1::JournalHeader journal_header(const CampaignRow& row) {
-  // The spec in canonical JSON (keys sorted; the stored text has protobuf's map order, which
-  // differs between processes), so that one spec has one text and one hash.
-  const std::string spec = nlohmann::json::parse(row.spec_json).dump();
+  const std::string spec = canonical_spec_json(row.spec_json);
   v1::JournalHeader h;
   h.set_journal(rpc::kJournalMarker);
   h.set_version(rpc::kJournalFormat);
@@ -31,8 +28,7 @@ v1::JournalHeader journal_header(const CampaignRow& row) {
 
 /// A finished job as its journal line: what determines it (from its payload) and its result.
 v1::JournalRun journal_run(const JobRow& job, const std::string* series) {
-  v1::JobSpec spec;
-  from_json(job.payload, spec);
+  const v1::JobSpec spec = job_from_payload(job.payload);
   v1::JournalRun run;
   run.set_run_key(job.run_key.key);
   run.set_protocol(job.run_key.protocol);
@@ -44,11 +40,10 @@ v1::JournalRun journal_run(const JobRow& job, const std::string* series) {
   run.set_seed(spec.seed());
   for (const auto& [name, value] : metrics_from_json(*job.metrics_json))
     (*run.mutable_metrics())[name] = value;
-  const auto flags = nlohmann::json::parse(job.flags_json);
-  for (const auto& [name, why] : flags.items())
-    (*run.mutable_flags())[name] = why.get<std::string>();
+  for (const auto& [name, why] : flags_from_json(job.flags_json))
+    (*run.mutable_flags())[name] = why;
   if (series) *run.mutable_series() = series_from_json(*series);
-  from_json(job.cost_json, *run.mutable_cost());
+  *run.mutable_cost() = cost_from_json(job.cost_json);
   run.set_wall_seconds(job.wall_seconds);
   run.set_attempt(job.result_attempt);
   return run;
@@ -56,10 +51,14 @@ v1::JournalRun journal_run(const JobRow& job, const std::string* series) {
 
 FinishedRun finished_run(const v1::JournalRun& run) {
   const std::map<std::string, double> metrics(run.metrics().begin(), run.metrics().end());
-  const nlohmann::json flags(
-      std::map<std::string, std::string>(run.flags().begin(), run.flags().end()));
-  return {run.run_key(), run.attempt(),       metrics_to_json(metrics),  run.wall_seconds(),
-          flags.dump(),  to_json(run.cost()), series_json(run.series()), run.source()};
+  return {run.run_key(),
+          run.attempt(),
+          metrics_to_json(metrics),
+          run.wall_seconds(),
+          flags_to_json(run.flags()),
+          to_json(run.cost()),
+          series_to_json(run.series()),
+          run.source()};
 }
 
 }  // namespace

@@ -33,9 +33,6 @@ struct FidelityPlan {
   std::vector<int> high_rows;
 };
 
-/// Job kind of the design rows run at the high fidelity level (the design's own: "design").
-inline constexpr const char* kHighDesignKind = "design:high";
-
 struct CampaignPlan {
   std::vector<PlannedFactor> factors;
   doe::Design design;

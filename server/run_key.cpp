@@ -10,6 +10,7 @@
 #include "core/model/material.hpp"
 #include "rpc/material_convert.hpp"
 #include "server/convert.hpp"
+#include "server/stored_columns.hpp"
 
 namespace demcal::server {
 namespace {
@@ -100,9 +101,7 @@ RunKey run_key(const v1::JobSpec& job) {
 
 RunKey payload_run_key(const std::string& payload) {
   try {
-    v1::JobSpec job;
-    from_json(payload, job);
-    return run_key(job);
+    return run_key(job_from_payload(payload));
   } catch (const std::exception&) {
     return {};
   }

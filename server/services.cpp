@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "core/common/error.hpp"
@@ -481,7 +480,7 @@ grpc::Status WorkerServiceImpl::Lease(grpc::ServerContext* ctx, const v1::LeaseR
   if (!job) return grpc::Status::OK;
   v1::JobSpec spec;
   try {
-    from_json(job->payload, spec);
+    spec = job_from_payload(job->payload);
   } catch (const std::exception& e) {
     return internal(e);
   }
@@ -525,8 +524,7 @@ grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::Com
   try {
     // A job not in the store is answered by the lease check below.
     if (const auto job = store_.job(req->job_id())) {
-      v1::JobSpec spec;
-      from_json(job->payload, spec);
+      const v1::JobSpec spec = job_from_payload(job->payload);
       if (const std::string error = metric_names_error(req->metrics(), spec.test()); !error.empty())
         return {grpc::StatusCode::INVALID_ARGUMENT, error};
     }
@@ -534,12 +532,10 @@ grpc::Status WorkerServiceImpl::Complete(grpc::ServerContext* ctx, const v1::Com
     return internal(e);
   }
   std::map<std::string, double> metrics(req->metrics().begin(), req->metrics().end());
-  const nlohmann::json flags(
-      std::map<std::string, std::string>(req->flags().begin(), req->flags().end()));
   if (const auto answer =
           store_.complete(req->job_id(), req->attempt(), req->worker(), metrics_to_json(metrics),
-                          req->wall_seconds(), steady_seconds(), flags.dump(), to_json(req->cost()),
-                          series_json(req->series()));
+                          req->wall_seconds(), steady_seconds(), flags_to_json(req->flags()),
+                          to_json(req->cost()), series_to_json(req->series()));
       answer != LeaseAnswer::kOk) {
     spdlog::warn("job {}: result of attempt {} from {} rejected", req->job_id(), req->attempt(),
                  req->worker());

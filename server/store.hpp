@@ -97,7 +97,7 @@ struct FinishedRun {
   std::string source;       ///< where it was read: FILE:LINE
 };
 
-/// One round of the sequential calibration: its proposal as JSON (server/calibration.cpp).
+/// One round of the sequential calibration: its proposal as JSON (server/stored_columns.hpp).
 struct CalibrationRoundRow {
   int round = 0;  ///< 1-based; its verification jobs have kind 'verify' and std_order = round
   int stage = 1;
