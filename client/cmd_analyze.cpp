@@ -162,76 +162,56 @@ std::vector<std::string> factor_legend(const std::vector<doe::Factor>& factors) 
 }
 
 /// A value, or null where there is none.
-nlohmann::json or_null(std::optional<double> v) {
-  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+nlohmann::ordered_json or_null(std::optional<double> v) {
+  return v ? nlohmann::ordered_json(*v) : nlohmann::ordered_json(nullptr);
 }
 
-/// The effects largest first (in the order `demcal effects` prints them), Lenth's test, the
-/// half-normal plot and the seed's constants.
-nlohmann::json effects_json(const std::string& response, const doe::ResponseAnalysis& res) {
-  nlohmann::json j;
-  const v1::MetricEffects effects = rpc::effects_message(response, res);
-  for (const auto& e : effects.effects())
-    j["effects"].push_back({{"chain", e.chain()},
-                            {"effect", e.effect()},
-                            {"in_model", e.in_model()},
-                            {"active_me", e.active_me()},
-                            {"active_sme", e.active_sme()}});
-  if (res.lenth)
-    j["lenth"] = {{"m", res.lenth->contrasts},
-                  {"df", res.lenth->degrees_of_freedom},
-                  {"alpha", res.lenth->alpha},
-                  {"pse", res.lenth->pse},
-                  {"t_me", res.lenth->t_me},
-                  {"t_sme", res.lenth->t_sme},
-                  {"me", res.lenth->me},
-                  {"sme", res.lenth->sme},
-                  {"critical_values", "Student t with m/3 df, computed by demcal"}};
+/// The analysis as `demcal effects` has it: the factor legend and the response's effects.
+v1::EffectsReply effects_reply(const AnalyzeOptions& opt, const Design& d,
+                               const doe::ResponseAnalysis& res) {
+  v1::EffectsReply effects;
+  for (const auto& l : factor_legend(d.factors)) effects.add_factor_letters(l);
+  *effects.add_metrics() = rpc::effects_message(opt.response, res);
+  return effects;
+}
+
+/// What only the offline analysis has, added to the response's analysis_json: the failed rows,
+/// Lenth's alpha and t quantiles, the half-normal plot, the seed's constants, the rest of the
+/// fit, the curvature's means, ANOVA and the seed's Table 9 prediction errors.
+void add_offline_json(const doe::ResponseAnalysis& res, nlohmann::ordered_json& j) {
+  j["missing_rows"] = res.balance.missing_rows;
+  j["balanced"] = res.balance.balanced();
+  j["max_abs_correlation"] = res.balance.max_abs_correlation;
+  j["lost_terms"] = res.balance.lost_terms;
+  if (res.lenth) {
+    j["lenth_alpha"] = res.lenth->alpha;
+    j["lenth_t_me"] = res.lenth->t_me;
+    j["lenth_t_sme"] = res.lenth->t_sme;
+  }
+  j["half_normal"] = nlohmann::ordered_json::array();
   for (const auto& h : res.half_normal)
     j["half_normal"].push_back(
         {{"chain", h.name}, {"abs_effect", h.abs_effect}, {"quantile", h.quantile}});
   if (res.seed) {
     j["seed_equation"]["y_mean"] = res.seed->y_mean;
     for (const auto& c : res.seed->coefficients) {
-      nlohmann::json members;
+      nlohmann::ordered_json members;
       for (std::size_t m = 0; m < c.term.chain.size(); ++m)
         members.push_back({{"member", doe::word_name(c.term.chain[m])}, {"b", c.b[m]}});
       j["seed_equation"]["terms"].push_back(
           {{"chain", c.term.name()}, {"E", c.effect}, {"b", members}});
     }
   }
-  return j;
-}
-
-nlohmann::json fit_json(const doe::ModelFit& fit) {
-  nlohmann::json j = {{"model", doe::to_string(fit.kind)},  {"intercept", fit.intercept},
-                      {"r_squared", fit.r_squared},         {"adj_r_squared", fit.adj_r_squared},
-                      {"residual_df", fit.residual_df},     {"loo_rmse", fit.loo_rmse},
-                      {"loo_undefined", fit.loo_undefined}, {"not_estimable", fit.not_estimable}};
-  for (std::size_t i = 0; i < fit.terms.size(); ++i)
-    j["terms"].push_back(
-        {{"chain", fit.terms[i].name()},
-         {"coefficient", fit.coefficients(Eigen::Index(i))},
-         {"standard_error",
-          or_null(fit.standard_errors.size() ? std::optional(fit.standard_errors(Eigen::Index(i)))
-                                             : std::nullopt)}});
-  return j;
-}
-
-/// Noise, curvature, ANOVA and the seed's Table 9 prediction errors.
-void add_checks_json(const doe::ResponseAnalysis& res, nlohmann::json& j) {
-  const auto& c = res.curvature;
-  j["noise"] = {
-      {"sd", res.noise.sd}, {"df", res.noise.degrees_of_freedom}, {"source", res.noise.source}};
-  j["curvature"] = {{"available", c.available},
-                    {"factorial_mean", c.factorial_mean},
-                    {"centre_mean", c.centre_mean},
-                    {"difference", c.difference},
-                    {"t", c.t},
-                    {"df", c.degrees_of_freedom},
-                    {"p", c.p_value},
-                    {"error", c.error_source},
-                    {"significant", c.significant}};
+  const auto& fit = res.fit;
+  j["model"] = doe::to_string(fit.kind);
+  j["adj_r_squared"] = fit.adj_r_squared;
+  j["residual_df"] = fit.residual_df;
+  j["loo_rmse"] = fit.loo_rmse;
+  j["loo_undefined"] = fit.loo_undefined;
+  j["not_estimable"] = fit.not_estimable;
+  j["curvature_factorial_mean"] = res.curvature.factorial_mean;
+  j["curvature_centre_mean"] = res.curvature.centre_mean;
+  j["anova"] = nlohmann::ordered_json::array();
   for (const auto& a : res.anova)
     j["anova"].push_back({{"source", a.source},
                           {"df", a.df},
@@ -239,6 +219,7 @@ void add_checks_json(const doe::ResponseAnalysis& res, nlohmann::json& j) {
                           {"ms", a.ms},
                           {"F", or_null(a.f)},
                           {"p", or_null(a.p)}});
+  j["prediction_errors"] = nlohmann::ordered_json::array();
   for (const auto& p : res.prediction_errors)
     j["prediction_errors"].push_back(
         {{"model", p.model},
@@ -250,21 +231,13 @@ void add_checks_json(const doe::ResponseAnalysis& res, nlohmann::json& j) {
                                                         : std::nullopt)}});
 }
 
-nlohmann::json analysis_json(const AnalyzeOptions& opt, const Design& d,
-                             const doe::ResponseAnalysis& res) {
-  nlohmann::json j = effects_json(opt.response, res);
-  j["response"] = opt.response;
-  j["factors"] = factor_legend(d.factors);
+/// The document of `demcal effects --format json` for the one response (effects_json), its
+/// analysis with what only the offline analysis has, and the CSV columns that were ignored.
+nlohmann::ordered_json analyze_json(const AnalyzeOptions& opt, const Design& d,
+                                    const doe::ResponseAnalysis& res) {
+  nlohmann::ordered_json j = effects_json(effects_reply(opt, d, res));
+  add_offline_json(res, j["metrics"][0]);
   j["ignored_columns"] = d.ignored;
-  j["runs"] = {{"total", res.balance.runs_total},
-               {"used", res.balance.runs_used},
-               {"missing_rows", res.balance.missing_rows},
-               {"balanced", res.balance.balanced()},
-               {"max_abs_correlation", res.balance.max_abs_correlation},
-               {"lost_terms", res.balance.lost_terms}};
-  j["fit"] = fit_json(res.fit);
-  add_checks_json(res, j);
-  j["notes"] = res.notes;
   return j;
 }
 
@@ -351,10 +324,7 @@ void print_analysis(std::ostream& out, const AnalyzeOptions& opt, const Design& 
                     const doe::ResponseAnalysis& res) {
   out << "response: " << opt.response << " (" << opt.design << ")\n";
   print_balance(out, d, res.balance);
-  v1::EffectsReply effects;
-  for (const auto& l : factor_legend(d.factors)) effects.add_factor_letters(l);
-  *effects.add_metrics() = rpc::effects_message(opt.response, res);
-  print_effects(out, effects, "table");
+  print_effects(out, effects_reply(opt, d, res), "table");
   print_seed_constants(out, res);
   print_fit(out, res.fit);
   print_anova_and_errors(out, res);
@@ -371,7 +341,7 @@ void run_analyze(const AnalyzeOptions& opt) {
   ao.factors = d.factors;
   const doe::ResponseAnalysis res = doe::analyse_response(d.coded, d.y, ao);
   if (opt.format == "json")
-    std::cout << analysis_json(opt, d, res).dump(2) << "\n";
+    std::cout << analyze_json(opt, d, res).dump(2) << "\n";
   else
     print_analysis(std::cout, opt, d, res);
 }

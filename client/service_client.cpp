@@ -166,9 +166,22 @@ v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const rpc::ChannelO
   return last;
 }
 
+nlohmann::ordered_json analysis_json(const v1::MetricEffects& m) {
+  return nlohmann::ordered_json::parse(message_json(m));
+}
+
+nlohmann::ordered_json effects_json(const v1::EffectsReply& e) {
+  nlohmann::ordered_json j = {
+      {"factor_letters",
+       std::vector<std::string>(e.factor_letters().begin(), e.factor_letters().end())},
+      {"metrics", nlohmann::ordered_json::array()}};
+  for (const auto& m : e.metrics()) j["metrics"].push_back(analysis_json(m));
+  return j;
+}
+
 void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::string& format) {
   if (format == "json") {
-    out << message_json(e) << "\n";
+    out << effects_json(e).dump(2) << "\n";
     return;
   }
   if (format == "csv") {

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -32,6 +33,13 @@ std::string progress_line(const v1::Progress& p, int width = 30);
 /// Streams Watch and draws a progress bar on `out` until the campaign is no longer running.
 v1::Progress watch_campaign(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& o,
                             std::int64_t id, std::ostream& out);
+/// A response's analysis as JSON: its MetricEffects with every field printed, in the message's
+/// field order. The one JSON form of a response analysis: `demcal effects` prints one per
+/// metric, `demcal analyze` one for its response (with what only the offline analysis has).
+nlohmann::ordered_json analysis_json(const v1::MetricEffects& m);
+/// The document of `demcal effects --format json`: the factor letters and each metric's
+/// analysis_json.
+nlohmann::ordered_json effects_json(const v1::EffectsReply& e);
 /// table | csv | json
 void print_effects(std::ostream& out, const v1::EffectsReply& e, const std::string& format);
 void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std::string& format);

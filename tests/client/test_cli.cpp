@@ -100,8 +100,14 @@ TEST(Cli, AnalyzeFindsTheActiveEffectsOfACsv) {
                           " --response y --model 2fi --format json");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
+  // The form of `demcal effects --format json`: the factor letters and one analysis per response.
+  ASSERT_EQ(j["metrics"].size(), 1u) << r.out;
+  EXPECT_EQ(j["factor_letters"].size(), 5u) << r.out;
+  const auto& y = j["metrics"][0];
+  EXPECT_EQ(y["metric"], "y");
+  EXPECT_EQ(y["runs_used"], 16);
   std::set<std::string> active;
-  for (const auto& e : j["effects"])
+  for (const auto& e : y["effects"])
     if (e["active_me"]) active.insert(e["chain"]);
   EXPECT_TRUE(active.count("A") && active.count("B")) << r.out;
   bool interaction_found = false;
