@@ -680,7 +680,7 @@ std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
   j["id"] = row.id;
   j["name"] = row.name;
   j["state"] = row.state;
-  j["spec"] = nlohmann::json::parse(row.spec_json);
+  j["spec"] = column_document(row.spec_json);
   j["design"] = nlohmann::json::parse(plan_to_json(plan));
   j["reused"] =
       std::count_if(jobs.begin(), jobs.end(), [](const JobRow& job) { return job.reused(); });
@@ -698,14 +698,13 @@ std::string export_campaign(const CampaignRow& row, const CampaignPlan& plan,
                         {"reused_from", job.reused_from},
                         {"reused_journal", job.reused_journal}};
     if (job.metrics_json) {
-      o["metrics"] = nlohmann::json::parse(*job.metrics_json);
-      o["flags"] = nlohmann::json::parse(job.flags_json);
-      o["cost"] = nlohmann::json::parse(job.cost_json);
+      o["metrics"] = column_document(*job.metrics_json);
+      o["flags"] = column_document(job.flags_json);
+      o["cost"] = column_document(job.cost_json);
     }
     if (series) {
       const auto it = series->find(job.id);
-      o["series"] =
-          it == series->end() ? nlohmann::json::object() : nlohmann::json::parse(it->second);
+      o["series"] = it == series->end() ? nlohmann::json::object() : column_document(it->second);
     }
     j["jobs"].push_back(o);
   }

@@ -1,7 +1,6 @@
 #include "server/stored_columns.hpp"
 
 #include <cmath>
-#include <nlohmann/json.hpp>
 
 #include "server/convert.hpp"
 
@@ -34,6 +33,10 @@ Eigen::VectorXd vector_of(const nlohmann::json& j) {
 
 }  // namespace
 
+nlohmann::json column_document(const std::string& column) {
+  return nlohmann::json::parse(column);
+}
+
 v1::CampaignSpec spec_from_json(const std::string& spec_json) {
   v1::CampaignSpec spec;
   from_json(spec_json, spec);
@@ -41,7 +44,7 @@ v1::CampaignSpec spec_from_json(const std::string& spec_json) {
 }
 
 std::string canonical_spec_json(const std::string& spec_json) {
-  return nlohmann::json::parse(spec_json).dump();
+  return column_document(spec_json).dump();
 }
 
 v1::JobSpec job_from_payload(const std::string& payload) {

@@ -4,6 +4,7 @@
 // stage's box and a calibration round's proposal; and the job kinds of jobs.kind.
 #include <Eigen/Dense>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -29,6 +30,9 @@ inline constexpr std::string_view kVerify = "verify";
 std::string stage(int n);
 bool is_stage(std::string_view kind);
 }  // namespace job_kind
+
+/// A JSON column as the document it holds, its values as stored (the export embeds them so).
+nlohmann::json column_document(const std::string& column);
 
 /// campaigns.spec_json: the campaign's spec as JSON.
 v1::CampaignSpec spec_from_json(const std::string& spec_json);
