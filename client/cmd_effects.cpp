@@ -1,18 +1,26 @@
 // `demcal effects ID [--format table|csv|json]`, `demcal calibrate ID [--verify [--wait]]`,
-// `demcal export ID|SPEC [--format csv|json|journal|liggghts] [-o FILE]`: analysis on the
-// coordinator, on demand. The journal format writes the finished jobs as a campaign journal
-// (docs/journal.md), the liggghts format the calibrated material as a LIGGGHTS input fragment.
+// `demcal export ID|SPEC [--format csv|json|journal|liggghts|yaml] [-o FILE] [--lab-specs DIR]`:
+// analysis on the coordinator, on demand. The journal format writes the finished jobs as a
+// campaign journal (docs/journal.md), the liggghts format the calibrated material as a LIGGGHTS
+// input fragment, the yaml format the calibrated material as the `material:` block of a spec and,
+// with --lab-specs, one `demcal lab run` spec per test instance (docs/report.md).
+#include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <thread>
+#include <variant>
 
 #include "client/commands.hpp"
 #include "client/embedded.hpp"
 #include "client/jsonl_file.hpp"
 #include "client/liggghts_fragment.hpp"
 #include "client/service_client.hpp"
+#include "core/common/error.hpp"
+#include "core/lab/lab_spec.hpp"
+#include "rpc/journal_line.hpp"
 #include "rpc/material_convert.hpp"
 
 namespace demcal::cli {
@@ -42,13 +50,132 @@ std::string liggghts_export(v1::CampaignService::Stub& stub, const rpc::ChannelO
   return f.text;
 }
 
+/// The campaign's calibration; an InputError naming the campaign when none has been verified
+/// (the calibrated set of the yaml export is one a simulation has checked).
+v1::CalibrateReply verified_calibration(v1::CampaignService::Stub& stub,
+                                        const rpc::ChannelOptions& channel, std::int64_t id) {
+  v1::CalibrateRequest req;
+  req.set_id(id);
+  v1::CalibrateReply cal;
+  check(stub.Calibrate(rpc::make_context(channel, 300).get(), req, &cal), "calibrate");
+  if (cal.rounds_size() == 0)
+    throw InputError("campaign " + std::to_string(id),
+                     "has no calibration yet (no verified round): `demcal calibrate " +
+                         std::to_string(id) + " --verify --wait` or `demcal run` calibrates it");
+  return cal;
+}
+
+/// A test instance's name in the campaign: its `name`, else its test.
+std::string instance_name(const v1::LabTest& t) {
+  return t.name().empty() ? t.test() : t.name();
+}
+
+/// The material a job of the campaign runs: the spec's material (with the instance's own wall law,
+/// if it has one) and `parameters` (fixed values, factors and tied paths) set on it.
+lab::MaterialModel job_material(const v1::CampaignSpec& spec, const v1::LabTest* instance,
+                                const std::map<std::string, double>& parameters) {
+  v1::JobSpec job;
+  *job.mutable_material() = spec.material();
+  if (instance && instance->has_wall_law())
+    *job.mutable_material()->mutable_wall_law() = instance->wall_law();
+  job.mutable_parameters()->insert(parameters.begin(), parameters.end());
+  return rpc::job_material(job);
+}
+
+/// Whether a run was simulated at the calibrated set: every factor at its calibrated value.
+bool at_calibrated_set(const v1::JournalRun& run, const v1::CalibrateReply& cal) {
+  for (int i = 0; i < cal.factor_paths_size(); ++i) {
+    const auto it = run.parameters().find(cal.factor_paths(i));
+    const double v = cal.proposed_values(i);
+    if (it == run.parameters().end() || std::abs(it->second - v) > 1e-12 * std::abs(v))
+      return false;
+  }
+  return true;
+}
+
+/// The latest finished run of each test instance at the calibrated set (instance -> run): the
+/// verification that simulated the calibrated numbers.
+std::map<std::string, v1::JournalRun> verification_runs(v1::CampaignService::Stub& stub,
+                                                        const rpc::ChannelOptions& channel,
+                                                        std::int64_t id,
+                                                        const v1::CalibrateReply& cal) {
+  std::string journal;
+  check(read_export(stub, channel, id, "journal", journal, false), "export");
+  std::map<std::string, v1::JournalRun> out;
+  for (const auto& line : split_lines(journal)) {
+    const auto parsed = rpc::parse_journal_line(line);
+    const auto* run = std::get_if<v1::JournalRun>(&parsed);
+    if (!run || !at_calibrated_set(*run, cal)) continue;
+    auto& kept = out[run->instance()];
+    if (run->job_id() > kept.job_id()) kept = *run;
+  }
+  return out;
+}
+
+/// One `demcal lab run` spec per test instance, `DIR/<instance>.yaml`: the calibrated material
+/// and the settings and seed of the instance's verification run (the instance's own when no
+/// finished run is at the calibrated set), one thread.
+void write_lab_specs(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                     std::int64_t id, const v1::CampaignSpec& spec, const v1::CalibrateReply& cal,
+                     const std::map<std::string, double>& parameters, const std::string& dir) {
+  const auto verified = verification_runs(stub, channel, id, cal);
+  std::filesystem::create_directories(dir);
+  for (const auto& t : spec.tests()) {
+    const std::string name = instance_name(t);
+    lab::LabRunSpec run;
+    run.test = t.test();
+    run.options.threads = 1;
+    const auto it = verified.find(name);
+    const bool found = it != verified.end();
+    const auto& source = found ? it->second.settings() : t.settings();
+    run.settings = lab::Settings(source.begin(), source.end());
+    run.options.seed = found ? it->second.seed() : (t.seed() ? t.seed() : 1);
+    run.material =
+        found ? job_material(spec, &t,
+                             {it->second.parameters().begin(), it->second.parameters().end()})
+              : job_material(spec, &t, parameters);
+    const auto file = std::filesystem::path(dir) / (name + ".yaml");
+    std::ofstream(file) << "# demcal campaign " << id << ", test " << name
+                        << (found ? ": the verification run (job " +
+                                        std::to_string(it->second.job_id()) + ")"
+                                  : ": no finished run at the calibrated set; the test's own "
+                                    "settings and seed")
+                        << "\n"
+                        << lab::lab_run_yaml(run);
+    std::cerr << "wrote " << file.string() << "\n";
+  }
+}
+
+/// The calibrated material as the `material:` block of a spec: the spec's material, its fixed
+/// values, the calibrated set and the tied paths. With `lab_specs`, one lab run spec per test
+/// instance there as well.
+std::string yaml_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                        std::int64_t id, const std::string& lab_specs) {
+  v1::GetRequest get;
+  get.set_id(id);
+  v1::Campaign campaign;
+  check(stub.Get(rpc::make_context(channel, 60).get(), get, &campaign), "campaign");
+  const v1::CalibrateReply cal = verified_calibration(stub, channel, id);
+  std::map<std::string, double> proposed;
+  for (int i = 0; i < cal.factor_paths_size(); ++i)
+    proposed[cal.factor_paths(i)] = cal.proposed_values(i);
+  const auto parameters = rpc::run_parameters(campaign.spec(), proposed);
+  if (!lab_specs.empty())
+    write_lab_specs(stub, channel, id, campaign.spec(), cal, parameters, lab_specs);
+  return "# demcal campaign " + std::to_string(id) + " '" + campaign.name() +
+         "': the calibrated material (" +
+         (cal.conclusion().empty() ? cal.verification_state() : cal.conclusion()) + ")\n" +
+         lab::material_yaml(job_material(campaign.spec(), nullptr, parameters));
+}
+
 struct ExportOptions {
   rpc::ChannelOptions channel;
   std::string campaign;  ///< a campaign id, or a spec on the embedded default
   std::string format = "json";
   std::string out;
-  bool series = false;  ///< json: each finished job's curves too
-  std::string workdir;  ///< of a spec: its work directory
+  std::string lab_specs;  ///< yaml: the directory of one lab run spec per test instance
+  bool series = false;    ///< json: each finished job's curves too
+  std::string workdir;    ///< of a spec: its work directory
   LocalWorkers local;
   bool verbose = false;
 };
@@ -61,6 +188,8 @@ void write_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& ch
   std::string content;
   if (o.format == "liggghts")
     content = liggghts_export(stub, channel, id);
+  else if (o.format == "yaml")
+    content = yaml_export(stub, channel, id, o.lab_specs);
   else
     check(read_export(stub, channel, id, o.format, content, o.series), "export");
   if (o.out.empty()) {
@@ -141,21 +270,27 @@ void add_analysis_commands(CLI::App& app) {
   auto* exp = app.add_subcommand(
       "export",
       "The campaign's design and results (csv or json), its finished jobs as a campaign journal "
-      "(journal), or its calibrated material as a LIGGGHTS input fragment (liggghts)");
+      "(journal), or its calibrated material as a LIGGGHTS input fragment (liggghts) or a spec's "
+      "material block (yaml)");
   add_connection_options(*exp, e->channel);
   exp->add_option("campaign", e->campaign, "campaign id, or a spec YAML (embedded default)")
       ->required();
-  exp->add_option("--format", e->format, "csv, json, journal or liggghts")
-      ->check(CLI::IsMember({"csv", "json", "journal", "liggghts"}));
+  exp->add_option("--format", e->format, "csv, json, journal, liggghts or yaml")
+      ->check(CLI::IsMember({"csv", "json", "journal", "liggghts", "yaml"}));
   exp->add_option("-o,--output", e->out,
                   "file (default: standard output); a journal to FILE.gz is written as gzip");
   exp->add_flag("--series", e->series,
                 "json: each finished job's curves (stress-strain, yield points, drum surface, "
                 "mass-time; docs/lab-tests.md) under jobs[].series");
+  exp->add_option("--lab-specs", e->lab_specs,
+                  "yaml: also write one `demcal lab run` spec per test instance into this "
+                  "directory (the calibrated material, the verification run's settings and seed)");
   exp->add_option("--workdir", e->workdir, "embedded: directory of the SQLite file");
   add_local_worker_options(*exp, e->local);
   exp->add_flag("-v,--verbose", e->verbose, "embedded: coordinator and worker logs");
   exp->callback([e] {
+    if (!e->lab_specs.empty() && e->format != "yaml")
+      throw InputError("--lab-specs", "only with --format yaml");
     with_campaign(e->campaign, e->workdir, e->local, e->verbose, e->channel,
                   [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                       std::int64_t id) { write_export(stub, channel, id, *e); });

@@ -1,5 +1,8 @@
 #include "core/lab/lab_spec.hpp"
 
+#include <cstdio>
+#include <sstream>
+
 #include "core/io/contact_law_yaml.hpp"
 #include "core/io/scene_yaml.hpp"
 
@@ -22,7 +25,107 @@ auto read_kind_block(const io::YamlNode& s, const std::string& kind_key, const s
   }
 }
 
+/// A number that reads back to the same double.
+std::string exact(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+/// `{key: model, name: value, ...}` of a slot, a shape or a preparation.
+std::string flow_block(const std::string& key, const std::string& kind,
+                       const std::map<std::string, double>& params) {
+  std::string out = "{" + key + ": " + kind;
+  for (const auto& [name, value] : params) out += ", " + name + ": " + exact(value);
+  return out + "}";
+}
+
+void write_law(std::ostream& y, const std::string& name, const contact::ContactLawSpec& law) {
+  y << "  " << name << ":\n";
+  const std::pair<const char*, const contact::SlotSpec*> slots[] = {{"normal", &law.normal},
+                                                                    {"cohesion", &law.cohesion},
+                                                                    {"tangential", &law.tangential},
+                                                                    {"rolling", &law.rolling}};
+  for (const auto& [slot, spec] : slots)
+    if (!spec->model.empty() && spec->model != "none")
+      y << "    " << slot << ": " << flow_block("model", spec->model, spec->params) << "\n";
+}
+
+std::string sizes_yaml(const particles::SizeDistribution& sizes) {
+  if (const auto* m = std::get_if<particles::Monodisperse>(&sizes))
+    return "{monodisperse: {radius: " + exact(m->radius) + "}}";
+  if (const auto* l = std::get_if<particles::LogNormal>(&sizes))
+    return "{lognormal: {median_radius: " + exact(l->median_radius) +
+           ", sigma_g: " + exact(l->sigma_g) + ", truncate_k: " + exact(l->truncate_k) + "}}";
+  const auto& d = std::get<particles::DiscreteClasses>(sizes);
+  std::string radii, fractions;
+  for (std::size_t k = 0; k < d.radii.size(); ++k) {
+    radii += (k ? ", " : "") + exact(d.radii[k]);
+    fractions += (k ? ", " : "") + exact(d.mass_fractions[k]);
+  }
+  return "{discrete: {radii: [" + radii + "], mass_fractions: [" + fractions + "]}}";
+}
+
+std::string scaling_law_name(contact::ScalingLaw law) {
+  switch (law) {
+    case contact::ScalingLaw::kKottlan2018:
+      return "kottlan2018";
+    case contact::ScalingLaw::kTiscar2019:
+      return "tiscar2019";
+    case contact::ScalingLaw::kNone:
+      break;
+  }
+  return "none";
+}
+
+/// The parameters of the preparation's method with their values.
+std::map<std::string, double> preparation_values(const PreparationSpec& prep) {
+  std::map<std::string, double> out;
+  for (const auto& name : preparation_params(prep.method))
+    for (const auto& info : PreparationSpec::table())
+      if (name == info.name) out[name] = prep.*(info.field);
+  return out;
+}
+
 }  // namespace
+
+std::string material_yaml(const MaterialModel& m) {
+  std::ostringstream y;
+  y << "material:\n";
+  write_law(y, "particle_law", m.particle_law);
+  write_law(y, "wall_law", m.wall_law);
+  y << "  sizes: " << sizes_yaml(m.sizes) << "\n"
+    << "  size_scale: " << exact(m.size_scale) << "\n"
+    << "  density: " << exact(m.density) << "\n"
+    << "  scaling: {law: " << scaling_law_name(m.scaling) << ", factor: " << exact(m.scale_factor)
+    << "}\n";
+  if (m.shape.kind != particles::ShapeKind::kSphere)
+    y << "  shape: "
+      << flow_block("kind", particles::shape_kind_name(m.shape.kind),
+                    particles::shape_values(m.shape))
+      << "\n";
+  if (m.preparation.method != PreparationMethod::kPour)
+    y << "  preparation: "
+      << flow_block("method", preparation_method_name(m.preparation.method),
+                    preparation_values(m.preparation))
+      << "\n";
+  if (m.real_median_radius != 0.0)
+    y << "  real_median_radius: " << exact(m.real_median_radius) << "\n";
+  return y.str();
+}
+
+std::string lab_run_yaml(const LabRunSpec& spec) {
+  std::ostringstream y;
+  y << "test: " << spec.test << "\nsettings: {";
+  bool first = true;
+  for (const auto& [name, value] : spec.settings) {
+    y << (first ? "" : ", ") << name << ": " << exact(value);
+    first = false;
+  }
+  y << "}\nseed: " << spec.options.seed << "\nthreads: " << spec.options.threads << "\n"
+    << material_yaml(spec.material);
+  return y.str();
+}
 
 MaterialModel read_material(const io::YamlNode& n) {
   n.expect_only({"particle_law", "wall_law", "sizes", "size_scale", "density", "scaling", "shape",

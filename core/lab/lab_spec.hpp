@@ -29,4 +29,12 @@ struct LabRunSpec {
 MaterialModel read_material(const io::YamlNode& node);
 LabRunSpec read_lab_run(const io::YamlNode& root);
 
+/// The YAML that read_material() reads back to the same model, as a `material:` block: both laws
+/// (slots without a model left out), the size distribution, size scale, density, scaling, shape
+/// and preparation (when not the defaults) and the real median radius (when stated). Numbers to
+/// 17 significant digits, so every value reads back to the same double.
+std::string material_yaml(const MaterialModel& model);
+/// The YAML that read_lab_run() reads back to the same run (`demcal lab run FILE`).
+std::string lab_run_yaml(const LabRunSpec& spec);
+
 }  // namespace demcal::lab

@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "core/common/rng.hpp"
+#include "core/io/yaml_node.hpp"
+#include "core/lab/lab_spec.hpp"
 #include "tests/common/command.hpp"
 
 namespace {
@@ -365,6 +367,68 @@ phases:
   EXPECT_EQ(values[3], 2.0);
   EXPECT_NEAR(values[6], -0.05 * 3000 * 1e-5, 1e-12);
   EXPECT_GT(values[9], 0.0) << "the bed pushes the piston up";
+  fs::remove_all(dir);
+}
+
+/// The embedded default's `demcal export --format yaml`: a tiny packing campaign (2^2 runs of
+/// 30 spheres, one verification round) is run and calibrated; the exported material block read
+/// back by the lab-run spec reader holds the calibrated values and the fixed one, and the lab run
+/// spec written for the packing test simulates the verified number again, to the bit.
+TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
+  const fs::path dir = scratch_dir("yaml");
+  std::ofstream(dir / "tiny.yaml") << R"(name: tiny
+material:
+  particle_law:
+    normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 0.0005}}
+  density: 2500
+tests:
+  - test: packing
+    settings: {particles: 30}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
+  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
+fixed:
+  wall_law.tangential.mu_s: 0.25
+design: {type: full_factorial}
+measurements:
+  - {metric: solid_fraction, value: 0.6, uncertainty: 0.02}
+calibration: {rounds: 1, stages: 1}
+)";
+  const std::string spec = (dir / "tiny.yaml").string();
+  const std::string work = " --workdir " + (dir / "work").string();
+  const Result none = demcal("export " + spec + work + " --format yaml");
+  EXPECT_NE(none.exit_code, 0);
+  EXPECT_NE(none.out.find("campaign 1: has no calibration yet"), std::string::npos) << none.out;
+
+  const auto run =
+      demcal::test::run_command(std::string(DEMCAL_BINARY_DIR) + "/client/demcal run " + spec +
+                                work + " --threads 1 --format json 2>/dev/null");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const auto calibration = nlohmann::json::parse(run.out)["calibration"];
+  const Result exported =
+      demcal("export " + spec + work + " --format yaml -o " + (dir / "material.yaml").string() +
+             " --lab-specs " + (dir / "specs").string());
+  ASSERT_EQ(exported.exit_code, 0) << exported.out;
+
+  const auto material = demcal::lab::read_material(
+      demcal::io::YamlNode::load_file((dir / "material.yaml").string())["material"]);
+  ASSERT_FALSE(calibration["proposed"].empty());
+  for (const auto& [path, value] : calibration["proposed"].items())
+    EXPECT_EQ(demcal::lab::get_parameter(material, path), value.get<double>()) << path;
+  EXPECT_EQ(demcal::lab::get_parameter(material, "wall_law.tangential.mu_s"), 0.25);
+
+  const fs::path lab_spec = dir / "specs" / "packing.yaml";
+  const auto lab = demcal::lab::read_lab_run(demcal::io::YamlNode::load_file(lab_spec.string()));
+  EXPECT_EQ(demcal::lab::material_identity(lab.material), demcal::lab::material_identity(material));
+  const auto rerun = demcal::test::run_command(
+      std::string(DEMCAL_BINARY_DIR) + "/client/demcal lab run " + lab_spec.string() + " --out " +
+      (dir / "rerun").string() + " 2>/dev/null");
+  ASSERT_EQ(rerun.exit_code, 0) << rerun.out;
+  const auto& round = calibration["rounds"].back();
+  EXPECT_EQ(nlohmann::json::parse(rerun.out)["metrics"]["solid_fraction"].get<double>(),
+            round["simulated"][0].get<double>());
   fs::remove_all(dir);
 }
 
