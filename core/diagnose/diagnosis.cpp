@@ -177,7 +177,10 @@ bool coarse_grained(const Problem& p) {
 /// particle count (every test sizes its die from the particles), so it costs what a base run
 /// costs.
 Plan coarse_graining_plan(const Problem& p) {
-  const double hi = p.size_scale, lo = hi * p.real_median_radius / p.median_radius;
+  const double hi = p.size_scale;
+  double lo = hi * p.real_median_radius / p.median_radius;
+  // No smaller than a size scale the material takes (its parameter's valid range).
+  if (auto it = p.valid.find(kSizeScale); it != p.valid.end()) lo = std::max(lo, it->second.first);
   Plan plan = new_factor_plan(
       p, "coarse_graining",
       "coarse graining: particles of the powder's median radius (" + number(p.real_median_radius) +

@@ -697,6 +697,9 @@ TEST(Diagnosis, CoarseGrainingIsACandidateOnlyForParticlesLargerThanThePowders) 
   p.median_radius = 2.0 * kMaterialRadius;
   EXPECT_NEAR(groups(p)[0].parameters.at(kScale), 0.1, 1e-12);
   p = base;
+  p.valid[kScale] = {0.2, 1e6};  // a size scale below 0.2 not taken: the factor ends there
+  EXPECT_NEAR(groups(p)[0].parameters.at(kScale), 0.2, 1e-12);
+  p = base;
   p.real_median_radius = 0.0;  // the powder's radius not stated
   EXPECT_TRUE(groups(p).empty());
   p = base;
