@@ -94,6 +94,17 @@ v1::JobSpec instance_job(const v1::CampaignSpec& spec, const v1::LabTest& t,
   return job;
 }
 
+/// Every rule a worker checks before it simulates the job, at the job's own material: a factor
+/// can change what a test asks for (the drum's particle count with the particle radius).
+void admit_job(const v1::JobSpec& job, const std::string& where, int row) {
+  try {
+    lab::admit_lab_test(job.test(), rpc::job_material(job), rpc::to_settings(job.settings()),
+                        {where + ".settings", "spec.material"});
+  } catch (const InputError& e) {
+    throw InputError(e.where(), "design run " + std::to_string(row) + ": " + e.message());
+  }
+}
+
 /// A job to store: the planned job's payload with its run key.
 NewJob new_job(int std_order, int run_order, const std::string& instance, const std::string& kind,
                const v1::JobSpec& job) {
@@ -168,13 +179,12 @@ Instances plan_tests(const v1::CampaignSpec& spec, CampaignPlan& plan) {
     if (!seen.insert(name).second)
       throw InputError(where + (t.name().empty() ? ".test" : ".name"),
                        "test '" + name + "' appears twice (give each instance its own `name`)");
-    const lab::Settings settings = rpc::to_settings(t.settings());
-    lab::validate_settings(*info, settings, where + ".settings");
     if (t.threads() < 0 || t.threads() > kMaxThreads)
       throw InputError(where + ".threads", "must be in [0, " + std::to_string(kMaxThreads) +
                                                "] (a worker runs at most its own --threads)");
     lab::MaterialModel instance = instance_model(spec, t, where);
-    lab::check_size(t.test(), instance, settings, where + ".settings");
+    lab::admit_lab_test(t.test(), instance, rpc::to_settings(t.settings()),
+                        {where + ".settings", "spec.material"});
     instances.emplace_back(name, std::move(instance));
     plan.tests.push_back(name);
     for (const auto& m : info->metrics) plan.responses.push_back(name + "." + m.name);
@@ -362,8 +372,7 @@ void check_setting_level(const v1::CampaignSpec& spec, const std::string& name, 
     lab::Settings settings = rpc::to_settings(t.settings());
     settings[name] = value;
     try {
-      lab::validate_settings(lab::find_lab_info(t.test()), settings, "settings");
-      lab::check_size(t.test(), instance_model(spec, t, where), settings, "settings");
+      lab::admit_lab_test(t.test(), instance_model(spec, t, where), settings);
     } catch (const InputError& e) {
       throw InputError(where, "test '" + instance_name(t) + "': " + e.where() + ": " + e.message());
     }
@@ -517,11 +526,13 @@ std::vector<NewJob> design_jobs(const v1::CampaignSpec& spec, const CampaignPlan
     std::map<std::string, double> parameters;
     for (std::size_t f = 0; f < box.size(); ++f)
       parameters[box[f].path] = box[f].factor.to_natural(design.coded(r, Eigen::Index(f)));
-    for (const auto& t : spec.tests()) {
+    for (int i = 0; i < spec.tests_size(); ++i) {
+      const auto& t = spec.tests(i);
       const std::uint64_t seed = design_seed(t, spec.design(), design, r) +
                                  (pinned ? 0 : static_cast<std::uint64_t>(stage_offset));
-      jobs.push_back(new_job(r + 1, design.run_order[std::size_t(r)], instance_name(t), kind,
-                             instance_job(spec, t, spec.material(), parameters, seed)));
+      const v1::JobSpec job = instance_job(spec, t, spec.material(), parameters, seed);
+      admit_job(job, "spec." + idx("tests", i), r + 1);
+      jobs.push_back(new_job(r + 1, design.run_order[std::size_t(r)], instance_name(t), kind, job));
     }
   }
   return jobs;

@@ -80,7 +80,8 @@ diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan&
   const auto model = rpc::to_material_model(m, "spec.material");
   p.cohesion_model = model.particle_law.cohesion.model;
   p.preparation = lab::preparation_method_name(model.preparation.method);
-  for (const auto& t : spec.tests()) p.preparable &= !lab::pours_only(t.test());
+  for (const auto& t : spec.tests())
+    p.preparable &= lab::accepts_preparation(t.test(), lab::PreparationMethod::kClusters);
   p.agitation_time_max = lab::default_agitation_time(model);
   for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
   describe_size(spec, p);

@@ -65,11 +65,19 @@ struct JobStop {
 };
 
 /// A job this worker refuses before running it (empty: none): more particles than its
-/// --max-particles.
+/// --max-particles, counted as the test sizes its bed (the drum's from its geometry). A job
+/// its test does not admit is not refused here: running it fails at once, as not retryable.
 std::string refusal(const v1::JobSpec& job, double max_particles) {
-  const auto it = job.settings().find("particles");
-  if (max_particles <= 0 || it == job.settings().end() || !(it->second > max_particles)) return {};
-  return "job asks for " + std::to_string(std::llround(it->second)) +
+  if (max_particles <= 0) return {};
+  std::size_t particles = 0;
+  try {
+    particles =
+        lab::admit_lab_test(job.test(), rpc::job_material(job), rpc::to_settings(job.settings()));
+  } catch (const InputError&) {
+    return {};
+  }
+  if (static_cast<double>(particles) <= max_particles) return {};
+  return "job asks for " + std::to_string(particles) +
          " particles, more than this worker's --max-particles " +
          std::to_string(std::llround(max_particles));
 }

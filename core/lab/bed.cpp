@@ -153,10 +153,8 @@ sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
   particles::InsertRequest req = material_insert_request(material, {}, spec.particles);
   const PreparationSpec& prep = material.preparation;
   const bool grown = prep.method == PreparationMethod::kGrowth;
-  if (grown && req.shape)
-    throw InputError("material.preparation.method",
-                     "growth grows spheres only (a clump's members would have to move apart as "
-                     "they grow); use pour, clusters, random_motion or terminal_velocity");
+  if (grown && req.shape)  // refused at admission (core/model/catalog.cpp)
+    throw std::logic_error("growth of a clump bed");
   const double bound = req.shape ? req.shape->bounding_radius : 1.0;
   const double r_max = particles::max_radius(sizes) * bound;
   // growth: the die up to the bed's height at the target solid fraction.
@@ -492,10 +490,8 @@ GrownBed grow_bed(sim::World& w, const MaterialModel& material, const sim::Healt
     full[i] = full_radius(p.mass[i], material.simulated_density());
     shrunk_bed = shrunk_bed && full[i] > p.radius[i];
   }
-  if (!shrunk_bed)
-    throw InputError("material.preparation.method",
-                     "growth grows the sphere beds the die tests insert at reduced radii "
-                     "(packing, confined_compression, tensile, wall_friction); use pour here");
+  if (!shrunk_bed)  // only the die tests accept growth (core/model/catalog.cpp)
+    throw std::logic_error("growth of a bed not inserted at reduced radii");
   const PreparationSpec& s = material.preparation;
   // Without cohesion while the radii grow, as the seed's free motion (§2.7.1 step 1): a contact
   // that stuck as it formed would lock in a network the growth then has to push apart (with
@@ -586,14 +582,6 @@ GrownBed grow_bed(sim::World& w, const MaterialModel& material, const sim::Healt
   cohesion_in_contact(w, material);
   w.gravity = g;
   return out;
-}
-
-void require_pour(const MaterialModel& material, const std::string& test) {
-  if (pours_only(test) && material.preparation.method != PreparationMethod::kPour)
-    throw InputError("material.preparation.method",
-                     "the " + test +
-                         " test builds its bed by pouring only: use 'pour' or leave "
-                         "preparation out");
 }
 
 PreparedBed prepare_and_settle(sim::World& w, const MaterialModel& material, const BedSpec& spec,

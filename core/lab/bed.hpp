@@ -105,14 +105,10 @@ struct GrownBed {
 /// Method growth (material.preparation): the particles, inserted by make_die_world at reduced
 /// radii with their full masses, grow at `growth_rate` per critical time without gravity under
 /// a lid at the height of the die volume at `solid_fraction`, their motion quenched, cohesion only
-/// in contact; then the lid goes and gravity comes back. Throws InputError naming
-/// material.preparation.method for a bed not inserted so (clumps, the hopper's bin).
+/// in contact; then the lid goes and gravity comes back. Only the die tests' sphere
+/// beds are inserted so (their admission refuses growth elsewhere: core/model/catalog.hpp).
 GrownBed grow_bed(sim::World& world, const MaterialModel& material,
                   const sim::HealthLimits& limits);
-
-/// Refuses a preparation other than pouring for a test that builds its bed only so
-/// (pours_only), naming the field: material.preparation.method.
-void require_pour(const MaterialModel& material, const std::string& test);
 
 /// The phases that built a bed from its inserted particles.
 struct PreparedBed {

@@ -83,7 +83,7 @@ void LabOutput::add_phase(const PhaseCost& phase, const std::vector<std::string>
 LabOutput run_lab_test(const std::string& name, const MaterialModel& material,
                        const Settings& settings, const RunOptions& options) {
   const LabTestInfo& info = find_lab_info(name);
-  validate_settings(info, settings, "settings");
+  admit_lab_test(name, material, settings);
   const auto started = std::chrono::steady_clock::now();
   RunOptions run = options;
   if (options.progress)

@@ -132,7 +132,6 @@ LabOutput RotatingDrumTest::run(const MaterialModel& material, const Settings& v
   const auto s = read_settings<RotatingDrumSettings>(values, "settings");
   const auto sizes = material.simulated_sizes();
   const double r_max = particles::max_radius(sizes);
-  require_pour(material, "rotating_drum");
   const DrumBed bed = drum_bed(s, sizes, "settings");
   const double radius = bed.radius, depth = bed.length;
 

@@ -349,7 +349,6 @@ YieldStep shear_step(ShearCell& c, const std::string& name, double step_kpa,
 
 LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& values,
                              const RunOptions& options) {
-  require_pour(material, "shear_cell");
   const auto s = read_settings<ShearCellSettings>(values, "settings");
   LabOutput out;
   ShearCell c;

@@ -1,14 +1,76 @@
 #include "core/model/catalog.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/common/error.hpp"
 #include "core/model/lab_tests.hpp"
 #include "core/model/material.hpp"
 
 namespace demcal::lab {
 
+namespace {
+
+/// The catalogue entry of test type T with what the registry reads from its types: the
+/// cross-setting rules of its settings and the preparations it runs.
+template <class T>
+LabTestInfo registered_info() {
+  using S = typename T::SettingsType;
+  LabTestInfo info = T::info();
+  if constexpr (requires { S::rules(); })
+    for (const auto& r : S::rules()) info.rules.push_back({r.field, r.requirement, r.breaking});
+  info.preparations = T::preparations();
+  return info;
+}
+
+/// The particles (bodies) a run of T asks for: its `particles` setting, or what a test that
+/// sizes its bed from the material says (T::admit, which also checks that bed: the drum's from
+/// its geometry and fill, the packing's sampling volume).
+template <class T>
+std::size_t sized_bed(const MaterialModel& material, const typename T::SettingsType& s,
+                      const std::string& where) {
+  if constexpr (requires { T::admit(material, s, where); })
+    return T::admit(material, s, where);
+  else
+    return static_cast<std::size_t>(std::llround(s.particles));
+}
+
+/// The material's bed preparation against what test T runs and what the method can grow.
+void check_preparation(const LabTestInfo& info, const MaterialModel& material,
+                       const std::string& where) {
+  const PreparationMethod method = material.preparation.method;
+  const auto& ok = info.preparations;
+  if (std::find(ok.begin(), ok.end(), method) == ok.end()) {
+    std::string names;
+    for (auto m : ok) names += (names.empty() ? "" : ", ") + preparation_method_name(m);
+    throw InputError(where + ".preparation.method",
+                     "the " + info.name + " test cannot build its bed by '" +
+                         preparation_method_name(method) + "' (it runs: " + names + ")");
+  }
+  if (method == PreparationMethod::kGrowth && material.clump_template())
+    throw InputError(where + ".preparation.method",
+                     "growth grows spheres only (a clump's members would have to move apart as "
+                     "they grow); use pour, clusters, random_motion or terminal_velocity");
+}
+
+template <class T>
+std::size_t admit_as(const MaterialModel& material, const Settings& settings,
+                     const FieldPaths& where) {
+  static const LabTestInfo info = registered_info<T>();
+  validate_settings(info, settings, where.settings);
+  const auto typed = read_settings<typename T::SettingsType>(settings, where.settings);
+  check_preparation(info, material, where.material);
+  return sized_bed<T>(material, typed, where.settings);
+}
+
+using Admission = std::size_t (*)(const MaterialModel&, const Settings&, const FieldPaths&);
+
+}  // namespace
+
 const std::vector<LabTestInfo>& lab_catalog() {
   static const std::vector<LabTestInfo> tests = std::apply(
-      [](auto... test) { return std::vector<LabTestInfo>{decltype(test)::info()...}; }, LabTests{});
+      [](auto... test) { return std::vector<LabTestInfo>{registered_info<decltype(test)>()...}; },
+      LabTests{});
   return tests;
 }
 
@@ -35,10 +97,21 @@ void validate_settings(const LabTestInfo& info, const Settings& settings,
   }
 }
 
-void check_size(const std::string& test, const MaterialModel& material, const Settings& settings,
-                const std::string& where) {
-  if (test != "rotating_drum") return;  // the other tests are sized by their particle count
-  drum_bed(read_settings<RotatingDrumSettings>(settings, where), material.simulated_sizes(), where);
+std::size_t admit_lab_test(const std::string& test, const MaterialModel& material,
+                           const Settings& settings, const FieldPaths& where) {
+  static const std::map<std::string, Admission> admissions = std::apply(
+      [](auto... t) {
+        return std::map<std::string, Admission>{
+            {decltype(t)::info().name, &admit_as<decltype(t)>}...};
+      },
+      LabTests{});
+  find_lab_info(test);  // an unknown name: the error listing the known ones
+  return admissions.at(test)(material, settings, where);
+}
+
+bool accepts_preparation(const std::string& test, PreparationMethod method) {
+  const auto& ok = find_lab_info(test).preparations;
+  return std::find(ok.begin(), ok.end(), method) != ok.end();
 }
 
 }  // namespace demcal::lab

@@ -7,8 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "core/common/error.hpp"
 #include "core/contact/contact_law.hpp"
 #include "core/contact/param_table.hpp"
+#include "core/model/preparation.hpp"
 
 namespace demcal::lab {
 
@@ -22,6 +24,24 @@ struct MetricInfo {
 
 using Settings = std::map<std::string, double>;
 
+/// A rule across a test's settings (each setting's own range is in its table), checked by the
+/// settings' finalize() wherever they are read: at Submit, in `demcal lab run` and on the worker.
+/// `breaking` is a settings map inside every range that breaks the rule, so that every rule has
+/// a test refusing it.
+template <class S>
+struct SettingsRule {
+  const char* field;        ///< the setting an error names
+  const char* requirement;  ///< e.g. "must be < max_stress"
+  bool (*holds)(const S&);
+  Settings breaking;
+};
+
+/// A settings rule as the catalogue lists it.
+struct RuleDoc {
+  std::string field, requirement;
+  Settings breaking;
+};
+
 struct LabTestInfo {
   std::string name;
   std::string description;
@@ -31,6 +51,9 @@ struct LabTestInfo {
   /// What the runner reports beside its metrics, as context and never as a response (a drum's
   /// particle count, its centrifuging at every speed): a result may carry these names too.
   std::vector<std::string> also_reported = {};
+  /// Filled in by the registry from the test's type (lab_catalog()):
+  std::vector<RuleDoc> rules = {};                   ///< cross-setting rules
+  std::vector<PreparationMethod> preparations = {};  ///< the bed preparations it can run
 };
 
 /// All lab tests, in a fixed order.
@@ -40,10 +63,29 @@ const LabTestInfo& find_lab_info(const std::string& name);
 /// Checks every setting name and value against the test's table; errors name `where`.<setting>.
 void validate_settings(const LabTestInfo& info, const Settings& settings, const std::string& where);
 
-/// Checks what a test's settings ask of the machine for this material before anything runs (the
-/// rotating drum's particle count against its max_particles); InputError names `where`.<setting>.
-void check_size(const std::string& test, const MaterialModel& material, const Settings& settings,
-                const std::string& where);
+/// Where the fields a lab test is admitted on live in the caller's input.
+struct FieldPaths {
+  std::string settings = "settings";  ///< e.g. "spec.tests[2].settings"
+  std::string material = "material";  ///< e.g. "spec.material"
+};
+
+/// Every rule a lab test's runner would refuse its input with, checked before anything runs:
+/// the settings' names, ranges and cross-setting rules, the material's bed preparation against
+/// the ones the test can run, and the geometry a test sizes from the material (the rotating
+/// drum's bed). Submit, `demcal lab run` and the worker call it alike. Returns the number of
+/// particles (bodies) the run asks for; InputError naming the field otherwise.
+std::size_t admit_lab_test(const std::string& test, const MaterialModel& material,
+                           const Settings& settings, const FieldPaths& where = {});
+
+/// Whether lab test `test` can build its beds by `method`.
+bool accepts_preparation(const std::string& test, PreparationMethod method);
+
+/// Checks a settings struct's cross-setting rules (S::rules()); errors name `where`.<field>.
+template <class S>
+void check_rules(const S& s, const std::string& where) {
+  for (const auto& rule : S::rules())
+    if (!rule.holds(s)) throw InputError(where + "." + rule.field, rule.requirement);
+}
 
 /// Reads a settings struct S (with S::table()) from a map, checking names and ranges.
 template <class S>

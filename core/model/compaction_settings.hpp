@@ -47,16 +47,23 @@ struct CompactionSettings {
              {"time_step_safety", "-", 0.01, 1.0, 0.2,
               "time step as a fraction of the critical one", &S::time_step_safety}}};
   }
-  void finalize(const std::string& where) {
-    if (!(phi_max > phi_start)) throw InputError(where + ".phi_max", "must exceed phi_start");
-    if (yield_probes != 0.0 && yield_probes != 1.0)
-      throw InputError(where + ".yield_probes", "must be 0 or 1");
+  static std::vector<SettingsRule<CompactionSettings>> rules() {
+    using S = CompactionSettings;
+    // phi_max > phi_start holds by their ranges.
+    return {{"yield_probes",
+             "must be 0 or 1",
+             [](const S& s) { return s.yield_probes == 0.0 || s.yield_probes == 1.0; },
+             {{"yield_probes", 0.5}}}};
   }
+  void finalize(const std::string& where) { check_rules(*this, where); }
 };
 
 /// The compaction lab test (seed 004 §2.3-2.4, §3.1): its catalogue entry here, its runner in
 /// core/lab/compaction.cpp.
 struct CompactionTest {
+  using SettingsType = CompactionSettings;
+  /// Its periodic cell is filled at random and compacted: it has no bed to prepare.
+  static std::vector<PreparationMethod> preparations() { return {PreparationMethod::kPour}; }
   static LabTestInfo info() {
     return {
         "compaction",

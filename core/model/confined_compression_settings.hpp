@@ -33,14 +33,23 @@ struct ConfinedCompressionSettings : PistonServoSettings {
           "piston and bottom stiffness over the particle stiffness (seed 000: 30)",
           &S::wall_stiffness_factor}}});
   }
-  void finalize(const std::string& where) {
-    if (min_stress >= max_stress) throw InputError(where + ".min_stress", "must be < max_stress");
+  static std::vector<SettingsRule<ConfinedCompressionSettings>> rules() {
+    return {{"min_stress",
+             "must be < max_stress",
+             [](const ConfinedCompressionSettings& s) { return s.min_stress < s.max_stress; },
+             {{"min_stress", 10.0}, {"max_stress", 5.0}}}};
   }
+  void finalize(const std::string& where) { check_rules(*this, where); }
 };
 
 /// The confined_compression lab test (seed 000 §2.7.2, eq. 31-33; seed 001 §3.2.1, eq. 19): its
 /// catalogue entry here, its runner in core/lab/confined_compression.cpp.
 struct ConfinedCompressionTest {
+  using SettingsType = ConfinedCompressionSettings;
+  /// Its die beds are built by any preparation (core/lab/bed.hpp).
+  static std::vector<PreparationMethod> preparations() {
+    return {kPreparationMethods.begin(), kPreparationMethods.end()};
+  }
   static LabTestInfo info() {
     return {
         "confined_compression",

@@ -5,25 +5,11 @@
 #include <sstream>
 
 #include "core/common/error.hpp"
-#include "core/common/rng.hpp"
+#include "core/model/material.hpp"
 #include "core/model/rotating_drum_settings.hpp"
 
 namespace demcal::lab {
 namespace {
-
-/// Number-mean particle volume and diameter of a distribution (2,000 samples of a fixed seed, so
-/// the count depends on the geometry and the sizes, not on the run's seed).
-std::pair<double, double> mean_volume_and_diameter(const particles::SizeDistribution& sizes) {
-  constexpr int kSamples = 2000;
-  Rng rng(0x5eed);
-  double volume = 0.0, diameter = 0.0;
-  for (int k = 0; k < kSamples; ++k) {
-    const double r = particles::sample_radius(sizes, rng);
-    volume += 4.0 / 3.0 * M_PI * r * r * r;
-    diameter += 2.0 * r;
-  }
-  return {volume / kSamples, diameter / kSamples};
-}
 
 std::string number(double v) {
   std::ostringstream o;
@@ -57,7 +43,7 @@ DrumBed drum_bed(const RotatingDrumSettings& s, const particles::SizeDistributio
   DrumBed bed;
   bed.radius = 0.5e-3 * s.diameter;
   bed.length = 1e-3 * s.length;
-  const auto [volume, diameter] = mean_volume_and_diameter(simulated);
+  const auto [volume, diameter] = particles::number_means(simulated);
   bed.mean_diameter = diameter;
   bed.diameter_ratio = 2.0 * bed.radius / diameter;
   check_room(s, 2.0 * particles::max_radius(simulated), where);
@@ -75,6 +61,11 @@ DrumBed drum_bed(const RotatingDrumSettings& s, const particles::SizeDistributio
                                               " particles of the simulated sizes: at least 20");
   bed.particles = static_cast<std::size_t>(count);
   return bed;
+}
+
+std::size_t RotatingDrumTest::admit(const MaterialModel& material, const RotatingDrumSettings& s,
+                                    const std::string& where) {
+  return drum_bed(s, material.simulated_sizes(), where).particles;
 }
 
 }  // namespace demcal::lab

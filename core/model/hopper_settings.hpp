@@ -41,6 +41,12 @@ struct HopperSettings {
 /// The hopper lab test (seed 000 §2.7.6): its catalogue entry here, its runner in
 /// core/lab/hopper.cpp.
 struct HopperTest {
+  using SettingsType = HopperSettings;
+  /// Its bin is filled by any preparation but growth, which grows the die beds only.
+  static std::vector<PreparationMethod> preparations() {
+    return {PreparationMethod::kClusters, PreparationMethod::kRandomMotion,
+            PreparationMethod::kTerminalVelocity, PreparationMethod::kPour};
+  }
   static LabTestInfo info() {
     return {
         "hopper",

@@ -35,6 +35,11 @@ struct PackingSettings {
 /// The packing lab test (seed 000 §2.7.1, §3.1): its catalogue entry here, its runner in
 /// core/lab/packing.cpp.
 struct PackingTest {
+  using SettingsType = PackingSettings;
+  /// Its die beds are built by any preparation (core/lab/bed.hpp).
+  static std::vector<PreparationMethod> preparations() {
+    return {kPreparationMethods.begin(), kPreparationMethods.end()};
+  }
   static LabTestInfo info() {
     return {
         "packing",
@@ -47,6 +52,10 @@ struct PackingTest {
           "volume"}},
         settings_docs<PackingSettings>()};
   }
+  /// Checks that the bed its particles make leaves a sampling volume `wall_margin` largest
+  /// diameters from die, floor and top (packing_bed.cpp); returns the particle count.
+  static std::size_t admit(const MaterialModel& material, const PackingSettings& s,
+                           const std::string& where);
   static LabOutput run(const MaterialModel& material, const Settings& settings,
                        const RunOptions& options);
 };

@@ -5,9 +5,7 @@
 namespace demcal::lab {
 
 PreparationMethod parse_preparation_method(const std::string& text, const std::string& where) {
-  for (auto m :
-       {PreparationMethod::kClusters, PreparationMethod::kRandomMotion,
-        PreparationMethod::kTerminalVelocity, PreparationMethod::kPour, PreparationMethod::kGrowth})
+  for (auto m : kPreparationMethods)
     if (text == preparation_method_name(m)) return m;
   throw InputError(where,
                    "unknown preparation method '" + text +
@@ -43,10 +41,6 @@ std::vector<std::string> preparation_params(PreparationMethod method) {
       return {};
   }
   return {};
-}
-
-bool pours_only(const std::string& test) {
-  return test == "rotating_drum" || test == "shear_cell";
 }
 
 PreparationSpec make_preparation(const std::string& method,

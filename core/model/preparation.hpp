@@ -34,6 +34,10 @@ enum class PreparationMethod {
   kPour = 4,
   kGrowth = 5
 };
+/// Every method, in the order of the enumeration.
+inline constexpr std::array<PreparationMethod, 5> kPreparationMethods = {
+    PreparationMethod::kClusters, PreparationMethod::kRandomMotion,
+    PreparationMethod::kTerminalVelocity, PreparationMethod::kPour, PreparationMethod::kGrowth};
 
 struct PreparationSpec {
   static constexpr const char* kName = "preparation";
@@ -78,8 +82,6 @@ PreparationMethod parse_preparation_method(const std::string& text, const std::s
 std::string preparation_method_name(PreparationMethod method);
 /// The parameters that act in the given method (the others are refused for it).
 std::vector<std::string> preparation_params(PreparationMethod method);
-/// Whether lab test `test` builds its bed by pouring only (it refuses another preparation).
-bool pours_only(const std::string& test);
 
 /// A preparation from its method and parameters; errors name `where.<param>` for an unknown,
 /// out-of-range or foreign parameter.

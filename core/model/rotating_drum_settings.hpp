@@ -82,6 +82,9 @@ std::string drum_rpm_label(double rpm);
 /// The rotating_drum lab test (seed 001 §3.2.2-3.2.3, eq. 20): its catalogue entry here, its runner
 /// in core/lab/rotating_drum.cpp.
 struct RotatingDrumTest {
+  using SettingsType = RotatingDrumSettings;
+  /// Its bed is poured into the drum (seed 001 §3.2.2).
+  static std::vector<PreparationMethod> preparations() { return {PreparationMethod::kPour}; }
   static LabTestInfo info() {
     return {
         "rotating_drum",
@@ -102,6 +105,9 @@ struct RotatingDrumTest {
         {"centrifuging_4", "centrifuging_40", "centrifuging_80", "centrifuging_105",
          "drum_diameter", "drum_diameter_ratio", "particles"}};
   }
+  /// Its particle count follows from the drum, the fill and the simulated sizes (drum_bed).
+  static std::size_t admit(const MaterialModel& material, const RotatingDrumSettings& s,
+                           const std::string& where);
   static LabOutput run(const MaterialModel& material, const Settings& settings,
                        const RunOptions& options);
 };

@@ -66,6 +66,9 @@ struct ShearCellSettings {
 /// The shear_cell lab test (seed 000 §2.7.4, Table 3, Fig. 12 and 23): its catalogue entry here,
 /// its runner in core/lab/shear_cell.cpp.
 struct ShearCellTest {
+  using SettingsType = ShearCellSettings;
+  /// Its bed is poured into the cell.
+  static std::vector<PreparationMethod> preparations() { return {PreparationMethod::kPour}; }
   static LabTestInfo info() {
     return {
         "shear_cell",

@@ -51,10 +51,13 @@ struct TensileSettings : PistonServoSettings {
           "k2,wall / k2 of piston and bottom; 0 = seed 000 eq. 35 with r_real in [5, 50] um",
           &S::wall_k2_factor}}});
   }
-  void finalize(const std::string& where) {
-    if (min_stress >= consolidation_stress)
-      throw InputError(where + ".min_stress", "must be < consolidation_stress");
+  static std::vector<SettingsRule<TensileSettings>> rules() {
+    return {{"min_stress",
+             "must be < consolidation_stress",
+             [](const TensileSettings& s) { return s.min_stress < s.consolidation_stress; },
+             {{"min_stress", 10.0}, {"consolidation_stress", 5.0}}}};
   }
+  void finalize(const std::string& where) { check_rules(*this, where); }
 };
 
 /// Seed 000 eq. 34: A_H,wall / A_H = 10 + 90 (r_real - 5) / 45, r_real in um (clamped to the
@@ -66,6 +69,11 @@ double wall_k2_ratio_eq35(double r_real_um);
 /// The tensile lab test (seed 000 §2.7.3, eq. 34-35): its catalogue entry here, its runner in
 /// core/lab/tensile.cpp.
 struct TensileTest {
+  using SettingsType = TensileSettings;
+  /// Its die beds are built by any preparation (core/lab/bed.hpp).
+  static std::vector<PreparationMethod> preparations() {
+    return {kPreparationMethods.begin(), kPreparationMethods.end()};
+  }
   static LabTestInfo info() {
     return {"tensile",
             "bed conditioned in the die by the confined compression protocol, then held by an "

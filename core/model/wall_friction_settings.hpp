@@ -59,6 +59,11 @@ double two_point_calibration(double mu_a, double phi_a, double mu_b, double phi_
 /// The wall_friction lab test (seed 000 §2.7.5, §3.3.4): its catalogue entry here, its runner in
 /// core/lab/wall_friction.cpp.
 struct WallFrictionTest {
+  using SettingsType = WallFrictionSettings;
+  /// Its die beds are built by any preparation (core/lab/bed.hpp).
+  static std::vector<PreparationMethod> preparations() {
+    return {kPreparationMethods.begin(), kPreparationMethods.end()};
+  }
   static LabTestInfo info() {
     return {"wall_friction",
             "bed pressed by the container against a piston that turns at constant normal stress "

@@ -102,4 +102,18 @@ double min_radius(const SizeDistribution& dist) {
   return radius_bounds(dist).first;
 }
 
+NumberMeans number_means(const SizeDistribution& d) {
+  constexpr int kSamples = 2000;
+  Rng rng(0x5eed);
+  NumberMeans m;
+  for (int k = 0; k < kSamples; ++k) {
+    const double r = sample_radius(d, rng);
+    m.volume += 4.0 / 3.0 * M_PI * r * r * r;
+    m.diameter += 2.0 * r;
+  }
+  m.volume /= kSamples;
+  m.diameter /= kSamples;
+  return m;
+}
+
 }  // namespace demcal::particles

@@ -34,6 +34,13 @@ using SizeDistribution = std::variant<Monodisperse, DiscreteClasses, LogNormal>;
 void validate(const SizeDistribution& d, const std::string& where);
 double sample_radius(const SizeDistribution& d, Rng& rng);
 double max_radius(const SizeDistribution& d);
+/// Number-mean particle volume and diameter, from 2,000 samples of a fixed seed: what a bed's
+/// size follows from before any run (depends on the sizes only, not on a run's seed).
+struct NumberMeans {
+  double volume = 0.0;
+  double diameter = 0.0;
+};
+NumberMeans number_means(const SizeDistribution& d);
 double min_radius(const SizeDistribution& d);
 /// Number fraction of each discrete class (exposed for tests and reports).
 std::vector<double> number_fractions(const DiscreteClasses& d);

@@ -1,0 +1,34 @@
+// The packing test's die bed as its particles size it, checked before anything runs: metadata
+// without physics, so the coordinator refuses a bed too small for its sampling volume.
+#include <cmath>
+#include <string>
+
+#include "core/common/error.hpp"
+#include "core/model/material.hpp"
+#include "core/model/packing_settings.hpp"
+
+namespace demcal::lab {
+
+std::size_t PackingTest::admit(const MaterialModel& material, const PackingSettings& s,
+                               const std::string& where) {
+  // The die is as wide as a bed of solid fraction 0.6 is high (core/lab/bed.cpp: pi R^2 2R 0.6
+  // = solid volume); the settled bed is at least 2R 0.6 / 0.74 high (no packing of spheres is
+  // denser than 0.74) before the cut. 0.95 covers the sampled solid volume's scatter.
+  const double solid = s.particles * particles::number_means(material.simulated_sizes()).volume;
+  const double radius = 0.95 * std::cbrt(solid / (0.6 * 2.0 * M_PI));
+  const double top = s.cut_fraction * 2.0 * radius * 0.6 / 0.74;
+  const auto shape = material.clump_template();
+  const double d_max = 2.0 * particles::max_radius(material.simulated_sizes()) *
+                       (shape ? shape->bounding_radius : 1.0);
+  const double margin = s.wall_margin * d_max;
+  if (radius <= margin || top <= 2.0 * margin)
+    throw InputError(where + ".particles",
+                     "the bed of " + std::to_string(std::llround(s.particles)) +
+                         " particles is too small for a sampling volume " +
+                         std::to_string(s.wall_margin) +
+                         " largest diameters from its walls, floor and top: use more particles, a "
+                         "smaller wall_margin or a larger cut_fraction");
+  return static_cast<std::size_t>(std::llround(s.particles));
+}
+
+}  // namespace demcal::lab
