@@ -12,6 +12,7 @@
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "server/auth.hpp"
+#include "server/limits.hpp"
 #include "server/store.hpp"
 
 namespace demcal::server {
@@ -23,8 +24,8 @@ struct ServiceConfig {
   int max_starts = 256;              ///< Calibrate `starts`, at most
   double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
   double max_checkpoint_mb = 64.0;   ///< a checkpoint's state, at most (MiB)
-  long max_jobs_per_client = 0;      ///< unfinished jobs of one token's campaigns, at most
-  long max_jobs = 0;                 ///< unfinished jobs of the store, at most
+  long max_jobs_per_client = kDefaultMaxJobsPerClient;  ///< unfinished jobs of a token's campaigns
+  long max_jobs = kDefaultMaxJobs;                      ///< unfinished jobs of the store, at most
 };
 
 /// The shortest Watch interval.

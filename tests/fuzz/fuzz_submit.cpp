@@ -1,28 +1,29 @@
-// Fuzzes what the coordinator's Submit does with a request before anything is stored
-// (CampaignServiceImpl::Submit in server/services.cpp): the bytes of a SubmitRequest as gRPC
-// would hand them over, parsed, validated and planned (plan_campaign: factor paths, bounds,
-// tests, settings, design, limits, jobs), then turned into what the store and the reply get
-// (the spec and plan as JSON, the design summary). In process, no network, no store. Every
-// input that parses must end in a plan or an InputError (INVALID_ARGUMENT naming the field);
-// any other exception would reach the client as INTERNAL and is a finding.
+// Fuzzes the coordinator's Submit (CampaignServiceImpl::Submit, in process, no network) on a
+// store, with the store-backed oracle of submit_oracle.hpp: the bytes of a SubmitRequest as gRPC
+// would hand them over; a refused request leaves the store as it was, an accepted one is stored
+// as sent with jobs every worker would run, and no answer is INTERNAL. A broken expectation
+// aborts with its description (a finding).
+#include <spdlog/spdlog.h>
+
 #include <cstddef>
 #include <cstdint>
-#include <vector>
+#include <cstdio>
+#include <cstdlib>
 
-#include "core/common/error.hpp"
 #include "demcal/v1/campaign.pb.h"
-#include "server/convert.hpp"
+#include "tests/fuzz/submit_oracle.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  static demcal::test::SubmitOracle* oracle = [] {
+    spdlog::set_level(spdlog::level::off);
+    return new demcal::test::SubmitOracle();
+  }();
   demcal::v1::SubmitRequest request;
   if (!request.ParseFromArray(data, static_cast<int>(size))) return 0;  // gRPC would refuse it
-  try {
-    std::vector<demcal::server::NewJob> jobs;
-    const auto plan = demcal::server::plan_campaign(request.spec(), jobs);
-    (void)demcal::server::to_json(request.spec());
-    (void)demcal::server::plan_to_json(plan);
-    (void)demcal::server::design_summary(plan, static_cast<int>(jobs.size()));
-  } catch (const demcal::InputError&) {
+  const auto outcome = oracle->submit(request);
+  if (!outcome.broken.empty()) {
+    std::fprintf(stderr, "submit oracle: %s\n", outcome.broken.c_str());
+    std::abort();
   }
   return 0;
 }
