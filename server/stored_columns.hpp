@@ -1,7 +1,8 @@
 #pragma once
 // What the store's text columns hold (server/store.hpp), written and read in one place: the
 // campaign's spec, a job's payload, a result's metrics, flags, cost and curves, a calibration
-// stage's box and a calibration round's proposal; and the job kinds of jobs.kind.
+// stage's box and a calibration round's proposal; and the job kinds of jobs.kind. The campaign's
+// design (campaigns.design_json) is the plan's own JSON (plan.hpp: plan_to_json, plan_from_json).
 #include <Eigen/Dense>
 #include <map>
 #include <nlohmann/json.hpp>
