@@ -153,7 +153,8 @@ void add_targets(Loaded& l) {
   }
 }
 
-Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& req) {
+Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& req,
+            std::function<void()> interrupt = {}) {
   Loaded l;
   l.spec = spec_from_json(row.spec_json);
   l.plan = plan_from_json(row.design_json);
@@ -164,6 +165,7 @@ Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& re
   if (req.starts() < 0 || req.starts() > 1000) throw InputError("starts", "must lie in [0, 1000]");
   l.options.calibration.starts = req.starts() > 0 ? req.starts() : 16;
   l.options.calibration.seed = req.seed() ? req.seed() : 1;
+  l.options.calibration.interrupt = std::move(interrupt);
   if (l.plan.targets.empty())
     throw InputError("spec.measurements", "the campaign has no measurements to calibrate against");
   std::vector<int> columns;
@@ -421,8 +423,9 @@ std::vector<v1::CalibrationRound> calibration_rounds(Store& store, const Campaig
 }
 
 v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
-                                      const v1::CalibrateRequest& request) {
-  const Loaded l = load(store, row, request);
+                                      const v1::CalibrateRequest& request,
+                                      std::function<void()> interrupt) {
+  const Loaded l = load(store, row, request, std::move(interrupt));
   v1::CalibrateReply reply;
   reply.set_surrogate(l.options.surrogate == calib::Surrogate::kGaussianProcess ? "gp"
                                                                                 : "polynomial");

@@ -3,6 +3,7 @@
 // the state from the store (design results, stage designs, verification rounds), asks for the
 // next step, and queues its jobs. Verification jobs have kind 'verify' and std_order = round;
 // a stage design's jobs have kind 'stage:<n>' and the design rows' std_order.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,8 +21,11 @@ calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
 /// One Calibrate call: the current proposal, every round so far, and the conclusion. With
 /// `verify` it advances the loop (queues a round or a stage design) when nothing is running.
 /// InputError when there is nothing to calibrate yet (no measurements, design unfinished).
+/// `interrupt` is called before every start of every minimisation (calib::CalibrationOptions)
+/// and throws calib::Interrupted when nobody waits for the answer any more.
 v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
-                                      const v1::CalibrateRequest& request);
+                                      const v1::CalibrateRequest& request,
+                                      std::function<void()> interrupt = {});
 
 /// Particle-steps of a multi-fidelity campaign's finished jobs by level (design and stages at
 /// the low level, the design's high rows, the calibration's verifications at the high level),

@@ -385,8 +385,16 @@ grpc::Status CampaignServiceImpl::Calibrate(grpc::ServerContext* ctx,
   try {
     // One calibration step at a time: two concurrent calls must not queue the same round twice.
     std::lock_guard lock(calibrate_mutex_);
-    *reply = calibrate_campaign(store_, *row, *req);
+    // A call whose client has gone (deadline, Ctrl-C) or that shutdown waits for stops at the
+    // next start of its minimisations instead of holding the lock for the next caller.
+    *reply = calibrate_campaign(store_, *row, *req, [ctx, this] {
+      if (ctx->IsCancelled()) throw calib::Interrupted("its client went away");
+      if (stopping_) throw calib::Interrupted("the coordinator is stopping");
+    });
     return grpc::Status::OK;
+  } catch (const calib::Interrupted& e) {
+    spdlog::info("calibrate of campaign {} abandoned: {}", req->id(), e.what());
+    return {grpc::StatusCode::CANCELLED, std::string("calibration abandoned: ") + e.what()};
   } catch (const InputError& e) {
     // A bad request field is invalid; a campaign not ready to calibrate is a precondition.
     const std::string where = e.where();

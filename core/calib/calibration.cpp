@@ -90,6 +90,7 @@ Eigen::VectorXd minimise_in_box(const Objective& f, int k, const CalibrationOpti
   Eigen::VectorXd best;
   double best_value = std::numeric_limits<double>::infinity();
   for (const auto& s : starts) {
+    if (options.interrupt) options.interrupt();
     const Eigen::VectorXd x = nelder_mead(f, s, options.max_iterations);
     if (const double v = f(x); v < best_value) {
       best_value = v;

@@ -13,6 +13,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,16 @@ struct CalibrationOptions {
   /// sets, and this picks the one nearest the design centre, where the fitted models rest on
   /// the most runs. 0 = none.
   double centre_weight = 0.0;
+  /// Called before every start of every minimisation: a caller whose answer nobody waits for
+  /// any more (the client went away, the coordinator stops) throws from it (e.g. Interrupted),
+  /// and the calibration unwinds within one Nelder-Mead run. None: never interrupted.
+  std::function<void()> interrupt;
+};
+
+/// A calibration stopped by its caller through CalibrationOptions::interrupt.
+class Interrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 /// The smallest and largest value a model reaches over the box [-1, 1]^k.

@@ -72,6 +72,28 @@ TEST(Calibration, RecoversTheGeneratingParameters) {
   EXPECT_EQ(res.coded, again.coded);
 }
 
+// A caller nobody waits for any more stops a calibration between two starts of a minimisation:
+// the hook runs before every start, and what it throws ends the call there.
+TEST(Calibration, AnInterruptStopsTheCalibrationBeforeTheNextStart) {
+  CalibrationProblem problem{kBox, {}};
+  const auto fs = metrics();
+  problem.metrics.push_back(
+      {"beta", fit_on_box(fs[0], kBox, doe::ModelKind::kQuadratic), 31.0, 1.0, std::nullopt});
+  CalibrationOptions opt;
+  opt.starts = 16;
+  int calls = 0;
+  opt.interrupt = [&calls] { ++calls; };
+  (void)calibrate(problem, opt);
+  const int uninterrupted = calls;
+  EXPECT_GE(uninterrupted, opt.starts) << "once per start at least";
+  calls = 0;
+  opt.interrupt = [&calls] {
+    if (++calls == 5) throw Interrupted("client gone");
+  };
+  EXPECT_THROW((void)calibrate(problem, opt), Interrupted);
+  EXPECT_EQ(calls, 5) << "nothing runs after the interrupt";
+}
+
 TEST(Calibration, TargetOutsideTheEnvelopeIsReportedUnreachable) {
   // y = 5 + 2 a - b + 0.5 a c: multilinear, extremes on vertices: max 8.5, min 1.5.
   const doe::Design d = doe::full_factorial(3);

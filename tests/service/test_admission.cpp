@@ -1,11 +1,13 @@
 // Admission at Submit, generated from the lab-test registry (core/model/catalog.hpp), so that a
 // rule added to a test later is covered: every cross-setting rule and every preparation a test
 // cannot run is refused with INVALID_ARGUMENT naming the field; a drum above a worker's particle
-// limit is refused by that worker before it simulates. And the property behind it, over
+// limit is refused by that worker before it simulates; an abandoned Calibrate stops and frees
+// the next call. And the property behind admission, over
 // generated specs: whatever Submit accepts, a worker can run (never an accepted spec that fails
 // on every worker as invalid input).
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <random>
@@ -79,9 +81,9 @@ TEST_F(Service, ADrumAboveTheWorkersLimitIsRefusedBeforeItIsSimulated) {
   const lab::Settings settings = {{"diameter", 60}, {"length", 15}};
   const std::size_t particles = lab::admit_lab_test(
       "rotating_drum",
-      rpc::to_material_model(cli::parse_campaign_spec(one_test_spec(drum, settings), "d.yaml")
-                                 .spec.material(),
-                             "spec.material"),
+      rpc::to_material_model(
+          cli::parse_campaign_spec(one_test_spec(drum, settings), "d.yaml").spec.material(),
+          "spec.material"),
       settings);
   ASSERT_GT(particles, 100u);  // no `particles` setting: the count follows from the geometry
   std::int64_t id = 0;
@@ -98,6 +100,40 @@ TEST_F(Service, ADrumAboveTheWorkersLimitIsRefusedBeforeItIsSimulated) {
         << j.error();
   }
   EXPECT_EQ(small.log().find("simulation"), std::string::npos) << small.log();
+}
+
+// A Calibrate whose client has gone stops at the next start of its minimisations instead of
+// computing to the end with the lock the next call waits for.
+TEST_F(Service, AnAbandonedCalibrateStopsAndTheNextCallIsAnswered) {
+  start_server(/*lease=*/30, /*heartbeat=*/5, 0, {"--max-starts", "1000"});
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  for (int i = 0; i < 4; ++i)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec&, v1::CompleteRequest& c) {
+      (*c.mutable_metrics())["solid_fraction"] = 0.55 + 0.01 * i + 0.004 * i * i;
+      (*c.mutable_metrics())["coordination_number"] = 4.0 + 0.1 * i;
+      c.set_wall_seconds(1.0);
+    }));
+  v1::CalibrateRequest req;
+  req.set_id(id);
+  req.set_starts(300);
+  v1::CalibrateReply reply;
+  const auto started = std::chrono::steady_clock::now();
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), req, &reply).ok());
+  const double whole =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  ASSERT_GT(whole, 0.3) << "300 starts take long enough to be walked away from";
+  EXPECT_EQ(campaigns_->Calibrate(ctx(0.1).get(), req, &reply).error_code(),
+            grpc::StatusCode::DEADLINE_EXCEEDED);
+  EXPECT_TRUE(wait_until(
+      [&] {
+        return server_->log().find("calibrate of campaign " + std::to_string(id) +
+                                   " abandoned: its client went away") != std::string::npos;
+      },
+      30))
+      << server_->log();
+  req.set_starts(4);
+  EXPECT_TRUE(campaigns_->Calibrate(ctx().get(), req, &reply).ok());
 }
 
 /// A value of a setting drawn over its range: log-uniform over ranges of more than a decade.
