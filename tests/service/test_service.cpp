@@ -760,6 +760,77 @@ TEST_F(Service, DiagnoseOrVerifyOnACancelledCampaignIsRefusedAndQueuesNothing) {
   for (const auto& j : r.jobs()) EXPECT_EQ(j.state(), "cancelled");
 }
 
+// The coordinator's coarse_graining runs (docs/diagnosis.md): a cohesive material of radius
+// 0.5 mm stating the powder's median radius 0.25 mm. Its four design runs finished (fake
+// metrics), one Diagnose call queues the candidate's runs: the factorial rows at half the
+// radius and the middle row at 1 / sqrt(2) of it, each with the Hamaker constant of the
+// particle law and of the wall law (a copy of it) at the same Bond number, A_H (r / 0.5 mm)^2.
+// A test instance with a wall law of its own keeps its walls' adhesion.
+TEST_F(Service, CoarseGrainingRunsHoldTheBondNumberInBothLaws) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  const std::string spec = R"(
+material:
+  particle_law:
+    normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
+    cohesion: {model: van_der_waals, hamaker: 1.0e-16, d_max: 4.4e-10}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 0.0005}}
+  density: 2500
+  real_median_radius: 0.00025
+tests:
+  - test: packing
+    settings: {particles: 30})";
+  const std::string rest = R"(
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
+  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
+design: {type: full_factorial}
+measurements:
+  - {metric: solid_fraction, value: 0.6}
+diagnose: {candidates: [coarse_graining]}
+)";
+  const std::string own_wall_law = R"(
+    wall_law:
+      normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
+      cohesion: {model: van_der_waals, hamaker: 3.0e-17, d_max: 4.4e-10}
+      tangential: {model: history, mu_s: 0.3})";
+  for (const bool own_walls : {false, true}) {
+    std::int64_t id = 0;
+    ASSERT_TRUE(submit("name: coarse" + std::to_string(own_walls) + spec +
+                           (own_walls ? own_wall_law : "") + rest,
+                       &id)
+                    .ok());
+    for (int k = 0; k < 4; ++k)
+      ASSERT_NO_FATAL_FAILURE(
+          complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+            (*c.mutable_metrics())["solid_fraction"] =
+                0.5 + 0.1 * job.parameters().at("particle_law.tangential.mu_s");
+            (*c.mutable_metrics())["coordination_number"] = 4.0 + 0.1 * k;
+          }));
+    v1::DiagnoseRequest diagnose;
+    diagnose.set_id(id);
+    v1::DiagnoseReply reply;
+    ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), diagnose, &reply).ok());
+    ASSERT_EQ(reply.jobs_queued(), 1 + 5);  // the baseline and the candidate's runs
+    std::multiset<double> scales;
+    for (int k = 0; k < reply.jobs_queued(); ++k) {
+      v1::LeaseReply lease;
+      ASSERT_NO_FATAL_FAILURE(lease_as("fake", lease));
+      ASSERT_TRUE(lease.has_job());
+      const auto& p = lease.job().parameters();
+      if (!p.count("sizes.scale")) continue;  // the baseline
+      const double s = p.at("sizes.scale");
+      scales.insert(std::round(s * 1e6) / 1e6);
+      EXPECT_NEAR(p.at("particle_law.cohesion.hamaker"), 1e-16 * s * s, 1e-30);
+      if (own_walls)
+        EXPECT_FALSE(p.count("wall_law.cohesion.hamaker"));
+      else
+        EXPECT_NEAR(p.at("wall_law.cohesion.hamaker"), 1e-16 * s * s, 1e-30);
+    }
+    EXPECT_EQ(scales, (std::multiset<double>{0.5, 0.5, 0.5, 0.5, 0.707107})) << own_walls;
+  }
+}
+
 TEST_F(Service, OutOfRangeNumbersInRequestsAreInvalidArgumentNamingTheField) {
   start_server(/*lease=*/30, /*heartbeat=*/5, 0, {"--max-starts", "64"});
   std::int64_t id = 0;
