@@ -117,21 +117,13 @@ std::string metrics_error(const google::protobuf::Map<std::string, double>& metr
   return {};
 }
 
-/// Whether a run of the test `info` describes reports a metric of that name: one of its metrics
-/// or of what it also reports.
-bool reports_metric(const lab::LabTestInfo& info, const std::string& metric) {
-  return std::ranges::any_of(info.metrics,
-                             [&metric](const lab::MetricInfo& m) { return m.name == metric; }) ||
-         std::ranges::find(info.also_reported, metric) != info.also_reported.end();
-}
-
 /// The names of a result's metrics against the lab test `test` of its job; "" when the test
 /// reports each.
 std::string metric_names_error(const google::protobuf::Map<std::string, double>& metrics,
                                const std::string& test) {
   const lab::LabTestInfo& info = lab::find_lab_info(test);
   for (const auto& [name, value] : metrics)
-    if (!reports_metric(info, name))
+    if (!lab::reports_metric(info, name))
       return fmt::format("metrics.{}: not a metric the {} test reports", echo(name), test);
   return {};
 }

@@ -101,6 +101,10 @@ LabOutput run_lab_test(const std::string& name, const MaterialModel& material,
   for (const auto& m : info.metrics)
     if (!out.metrics.count(m.name))
       throw std::logic_error("lab test '" + name + "' did not produce its metric '" + m.name + "'");
+  for (const auto& [metric, value] : out.metrics)
+    if (!reports_metric(info, metric))
+      throw std::logic_error("lab test '" + name + "' reported '" + metric +
+                             "', which its catalogue entry neither lists nor also reports");
   return out;
 }
 

@@ -67,8 +67,9 @@ struct RunOptions {
   std::shared_ptr<const StageCache> stage_cache;
 };
 
-/// Runs a test by name: validates the settings, runs, and checks that every catalogued metric
-/// was produced.
+/// Runs a test by name: admits its input (admit_lab_test), runs, and checks that every
+/// catalogued metric was produced and that every metric it reports is one the catalogue names
+/// (the coordinator refuses a result with another).
 LabOutput run_lab_test(const std::string& name, const MaterialModel& material,
                        const Settings& settings, const RunOptions& options);
 

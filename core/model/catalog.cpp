@@ -109,6 +109,12 @@ std::size_t admit_lab_test(const std::string& test, const MaterialModel& materia
   return admissions.at(test)(material, settings, where);
 }
 
+bool reports_metric(const LabTestInfo& info, const std::string& metric) {
+  return std::ranges::any_of(info.metrics,
+                             [&metric](const MetricInfo& m) { return m.name == metric; }) ||
+         std::ranges::find(info.also_reported, metric) != info.also_reported.end();
+}
+
 bool accepts_preparation(const std::string& test, PreparationMethod method) {
   const auto& ok = find_lab_info(test).preparations;
   return std::find(ok.begin(), ok.end(), method) != ok.end();

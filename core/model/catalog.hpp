@@ -56,6 +56,10 @@ struct LabTestInfo {
   std::vector<PreparationMethod> preparations = {};  ///< the bed preparations it can run
 };
 
+/// Whether a run of the test `info` describes reports a metric of that name: one of its metrics
+/// or of what it also reports (a result naming anything else is refused by the coordinator).
+bool reports_metric(const LabTestInfo& info, const std::string& metric);
+
 /// All lab tests, in a fixed order.
 const std::vector<LabTestInfo>& lab_catalog();
 /// The test of that name; InputError listing the known names otherwise.

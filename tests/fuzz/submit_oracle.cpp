@@ -44,13 +44,15 @@ struct SubmitOracle::State {
   void fresh() {
     service.reset();
     store = std::make_unique<server::Store>(":memory:");
-    service = std::make_unique<server::CampaignServiceImpl>(*store, server::ServiceConfig{},
-                                                            stopping);
+    service =
+        std::make_unique<server::CampaignServiceImpl>(*store, server::ServiceConfig{}, stopping);
     campaigns = 0;
   }
 };
 
-SubmitOracle::SubmitOracle() : state_(std::make_unique<State>()) { state_->fresh(); }
+SubmitOracle::SubmitOracle() : state_(std::make_unique<State>()) {
+  state_->fresh();
+}
 SubmitOracle::~SubmitOracle() = default;
 
 SubmitOracle::Outcome SubmitOracle::submit(const v1::SubmitRequest& request) {
@@ -90,7 +92,8 @@ SubmitOracle::Outcome SubmitOracle::submit(const v1::SubmitRequest& request) {
   for (const auto& job : jobs) {
     if (job.state != "queued") return {true, "job " + std::to_string(job.id) + " is " + job.state};
     if (const std::string why = refusal_of(job); !why.empty())
-      return {true, "job " + std::to_string(job.id) + " stored, its worker would refuse it: " + why};
+      return {true,
+              "job " + std::to_string(job.id) + " stored, its worker would refuse it: " + why};
   }
   return out;
 }

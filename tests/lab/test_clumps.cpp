@@ -41,8 +41,11 @@ TEST_P(EveryTest, RunsWithRods) {
   const std::string name = GetParam();
   const auto out = run_lab_test(name, rods(1.5), short_settings(name), {});
   ASSERT_FALSE(out.metrics.empty());
-  for (const auto& [metric, value] : out.metrics)
+  for (const auto& [metric, value] : out.metrics) {
     EXPECT_FALSE(std::isnan(value)) << name << "." << metric;
+    // Every name a run reports is one the coordinator takes from a worker.
+    EXPECT_TRUE(reports_metric(find_lab_info(name), metric)) << name << "." << metric;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Lab, EveryTest,

@@ -62,7 +62,9 @@ TEST(Admission, APreparationATestCannotRunIsRefusedNamingTheMethod) {
       MaterialModel m = spheres();
       m.preparation.method = method;
       const bool accepted = accepts_preparation(t.name, method);
-      EXPECT_EQ(where_of([&] { admit_lab_test(t.name, m, {}, {"s", "spec.material"}); }),
+      EXPECT_EQ(where_of([&] {
+                  admit_lab_test(t.name, m, {}, {"s", "spec.material"});
+                }),
                 accepted ? "" : "spec.material.preparation.method")
           << t.name << " " << preparation_method_name(method);
     }
@@ -86,8 +88,8 @@ TEST(Admission, TheParticleCountIsTheSettingOrWhatTheDrumHolds) {
   EXPECT_EQ(admit_lab_test("confined_compression", spheres(), {{"particles", 450}}), 450u);
   EXPECT_EQ(admit_lab_test("hopper", spheres(), {}), 400u);  // the setting's default
   const Settings drum = {{"diameter", 60}, {"length", 20}};
-  const DrumBed bed = drum_bed(read_settings<RotatingDrumSettings>(drum, "s"),
-                               spheres().simulated_sizes(), "s");
+  const DrumBed bed =
+      drum_bed(read_settings<RotatingDrumSettings>(drum, "s"), spheres().simulated_sizes(), "s");
   EXPECT_GT(bed.particles, 20u);
   EXPECT_EQ(admit_lab_test("rotating_drum", spheres(), drum), bed.particles);
   // A drum above its own limit is refused here, before any worker sees it.

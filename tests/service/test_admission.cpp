@@ -2,7 +2,7 @@
 // rule added to a test later is covered: every cross-setting rule and every preparation a test
 // cannot run is refused with INVALID_ARGUMENT naming the field; a drum above a worker's particle
 // limit is refused by that worker before it simulates; an abandoned Calibrate stops and frees
-// the next call. And the property behind admission, over
+// the next call; a Complete above its byte bound stores nothing. And the property behind admission, over
 // generated specs: whatever Submit accepts, a worker can run (never an accepted spec that fails
 // on every worker as invalid input).
 #include <gtest/gtest.h>
@@ -18,6 +18,7 @@
 #include "core/lab/run_cancelled.hpp"
 #include "rpc/material_convert.hpp"
 #include "server/convert.hpp"
+#include "server/limits.hpp"
 #include "tests/service/service_fixture.hpp"
 
 namespace demcal::test {
@@ -134,6 +135,37 @@ TEST_F(Service, AnAbandonedCalibrateStopsAndTheNextCallIsAnswered) {
       << server_->log();
   req.set_starts(4);
   EXPECT_TRUE(campaigns_->Calibrate(ctx().get(), req, &reply).ok());
+}
+
+// A result's request is bounded (server/limits.hpp, kMaxResultRequestBytes = 16 MiB): a larger
+// Complete is refused naming its size and the bound, nothing of it is stored, and the job's
+// lease holds for a result of a sane size.
+TEST_F(Service, ACompleteAboveSixteenMebibytesIsRefusedAndNothingIsStored) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  v1::JobSpec job;
+  v1::CompleteRequest c;
+  ASSERT_NO_FATAL_FAILURE(lease_request("w", job, c));
+  (*c.mutable_metrics())["solid_fraction"] = 0.6;
+  (*c.mutable_metrics())["coordination_number"] = 4.0;
+  v1::CompleteRequest big = c;
+  auto* series = big.add_series();
+  series->set_name("settled_bed");
+  series->add_columns("h0_m");
+  series->mutable_values()->Resize(static_cast<int>(server::kMaxResultRequestBytes / 8) + 1, 0.5);
+  ASSERT_GT(big.ByteSizeLong(), server::kMaxResultRequestBytes);
+  v1::CompleteReply reply;
+  const auto refused = workers_stub_->Complete(ctx().get(), big, &reply);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(refused.error_message().find("at most " +
+                                         std::to_string(server::kMaxResultRequestBytes) +
+                                         " for CompleteRequest"),
+            std::string::npos)
+      << refused.error_message();
+  EXPECT_EQ(stored_results().size(), 0u);
+  EXPECT_TRUE(workers_stub_->Complete(ctx().get(), c, &reply).ok());
+  EXPECT_EQ(stored_results().size(), 1u);
 }
 
 /// A value of a setting drawn over its range: log-uniform over ranges of more than a decade.

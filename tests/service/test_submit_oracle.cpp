@@ -27,8 +27,7 @@ std::vector<v1::SubmitRequest> example_requests() {
   std::vector<v1::SubmitRequest> out;
   for (const auto& entry : fs::directory_iterator(fs::path(DEMCAL_SOURCE_DIR) / "examples")) {
     const auto name = entry.path().filename().string();
-    if (entry.path().extension() != ".yaml" || name.find("campaign") == std::string::npos)
-      continue;
+    if (entry.path().extension() != ".yaml" || name.find("campaign") == std::string::npos) continue;
     v1::SubmitRequest r;
     *r.mutable_spec() = cli::read_campaign_spec(entry.path().string()).spec;
     out.push_back(r);
@@ -46,8 +45,8 @@ void mutate_scalar(pb::Message& m, const pb::FieldDescriptor* f, std::mt19937_64
   const double inf = std::numeric_limits<double>::infinity();
   const std::vector<double> reals = {std::nan(""), inf, -inf, 0.0, -1.0, 1e308, 1e-300, 3.5};
   const std::vector<std::int64_t> ints = {0, -1, 1, 7, 100000, std::numeric_limits<int>::max()};
-  const std::vector<std::string> texts = {"", std::string(5000, 'a'), "\x1b[31mred", "x.y",
-                                          "particle_law.normal.k1", "rotating_drum"};
+  const std::vector<std::string> texts = {"",    std::string(5000, 'a'),   "\x1b[31mred",
+                                          "x.y", "particle_law.normal.k1", "rotating_drum"};
   switch (f->cpp_type()) {
     case pb::FieldDescriptor::CPPTYPE_DOUBLE:
       return r->SetDouble(&m, f, pick(reals, rng));
