@@ -2,7 +2,7 @@
 # libFuzzer with AddressSanitizer and UndefinedBehaviorSanitizer on the readers of untrusted input:
 # the STL reader (io::read_stl), the CSV table reader of `analyze` (io::read_csv), the YAML scene
 # parser (io::read_scene), the CLI's campaign spec parser (cli::parse_campaign_spec) and the
-# coordinator's Submit validation and planning (fuzz_submit); HARNESSES="..." picks some. Builds
+# coordinator's Submit on a store with its oracle (fuzz_submit); HARNESSES="..." picks some. Builds
 # the harnesses of tests/fuzz with clang in BUILD_DIR (-DDEMCAL_FUZZ=ON: the harnesses and what
 # they link only), replays the regression inputs, runs each harness for RUNS executions from its
 # seed corpus (tests/fuzz/corpus; the campaign harnesses start from examples/*campaign*.yaml, as
