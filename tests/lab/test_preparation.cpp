@@ -13,9 +13,12 @@
 #include "core/lab/lab_spec.hpp"
 #include "core/lab/lab_test.hpp"
 #include "core/metrics/bulk.hpp"
+#include "tests/common/input_error.hpp"
 
 namespace demcal::lab {
 namespace {
+
+using test::where_of;
 
 const char* kMaterial = R"(
 particle_law:
@@ -87,15 +90,6 @@ TEST(Preparation, TestsThatOnlyPourRefuseAnotherMethod) {
       EXPECT_EQ(e.where(), "material.preparation.method") << test;
     }
   }
-}
-
-std::string where_of(const std::function<void()>& run) {
-  try {
-    run();
-  } catch (const InputError& e) {
-    return e.where();
-  }
-  return "";
 }
 
 TEST(Preparation, GrowthWithItsParametersAndItsMistakes) {

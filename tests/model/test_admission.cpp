@@ -10,9 +10,12 @@
 #include "core/model/catalog.hpp"
 #include "core/model/material.hpp"
 #include "core/model/rotating_drum_settings.hpp"
+#include "tests/common/input_error.hpp"
 
 namespace demcal::lab {
 namespace {
+
+using test::where_of;
 
 /// Hertz spheres of radius `radius` (m).
 MaterialModel spheres(double radius = 2e-3) {
@@ -24,15 +27,6 @@ MaterialModel spheres(double radius = 2e-3) {
   m.density = 2500.0;
   m.sizes = particles::Monodisperse{radius};
   return m;
-}
-
-std::string where_of(const std::function<void()>& run) {
-  try {
-    run();
-  } catch (const InputError& e) {
-    return e.where();
-  }
-  return "";
 }
 
 TEST(Admission, EveryTestAdmitsItsDefaults) {
