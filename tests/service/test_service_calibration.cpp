@@ -1,0 +1,321 @@
+// Service tests with real processes, real gRPC on loopback and real SQLite files (the fixture:
+// service_fixture.hpp). Calibrate and Diagnose over gRPC: refused on a cancelled campaign, the
+// coarse_graining runs, centre points and curvature, what the data fix only in combination,
+// Gaussian-process batches, and a multi-fidelity campaign. Leases and heartbeats are short (flags);
+// every wait is bounded.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <thread>
+
+#include "client/service_client.hpp"
+#include "client/spec_yaml.hpp"
+#include "core/common/error.hpp"
+#include "core/lab/lab_test.hpp"
+#include "demcal/v1/campaign.grpc.pb.h"
+#include "demcal/v1/worker.grpc.pb.h"
+#include "rpc/channel.hpp"
+#include "rpc/material_convert.hpp"
+#include "server/limits.hpp"
+#include "tests/service/service_fixture.hpp"
+
+namespace demcal::test {
+namespace {
+
+TEST_F(Service, DiagnoseOrVerifyOnACancelledCampaignIsRefusedAndQueuesNothing) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  v1::CancelRequest cancel;
+  cancel.set_id(id);
+  v1::Campaign c;
+  ASSERT_TRUE(campaigns_->Cancel(ctx().get(), cancel, &c).ok());
+  // Cancelling again is refused: only a running campaign can be cancelled.
+  EXPECT_EQ(campaigns_->Cancel(ctx().get(), cancel, &c).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  v1::DiagnoseRequest diagnose;
+  diagnose.set_id(id);
+  v1::DiagnoseReply dr;
+  const auto ds = campaigns_->Diagnose(ctx().get(), diagnose, &dr);
+  EXPECT_EQ(ds.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_NE(ds.error_message().find("cancelled"), std::string::npos) << ds.error_message();
+  v1::CalibrateRequest verify;
+  verify.set_id(id);
+  verify.set_verify(true);
+  v1::CalibrateReply cr;
+  EXPECT_EQ(campaigns_->Calibrate(ctx().get(), verify, &cr).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  const auto r = results(id);
+  EXPECT_EQ(r.jobs_size(), 4);
+  for (const auto& j : r.jobs()) EXPECT_EQ(j.state(), "cancelled");
+}
+
+// The coordinator's coarse_graining runs (docs/diagnosis.md): a cohesive material of radius
+// 0.5 mm stating the powder's median radius 0.25 mm. Its four design runs finished (fake
+// metrics), one Diagnose call queues the candidate's runs: the factorial rows at half the
+// radius and the middle row at 1 / sqrt(2) of it, each with the Hamaker constant of the
+// particle law and of the wall law (a copy of it) at the same Bond number, A_H (r / 0.5 mm)^2.
+// A test instance with a wall law of its own keeps its walls' adhesion.
+TEST_F(Service, CoarseGrainingRunsHoldTheBondNumberInBothLaws) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  const std::string spec = R"(
+material:
+  particle_law:
+    normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
+    cohesion: {model: van_der_waals, hamaker: 1.0e-16, d_max: 4.4e-10}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 0.0005}}
+  density: 2500
+  real_median_radius: 0.00025
+tests:
+  - test: packing
+    settings: {particles: 30})";
+  const std::string rest = R"(
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
+  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
+design: {type: full_factorial}
+measurements:
+  - {metric: solid_fraction, value: 0.6}
+diagnose: {candidates: [coarse_graining]}
+)";
+  const std::string own_wall_law = R"(
+    wall_law:
+      normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
+      cohesion: {model: van_der_waals, hamaker: 3.0e-17, d_max: 4.4e-10}
+      tangential: {model: history, mu_s: 0.3})";
+  for (const bool own_walls : {false, true}) {
+    std::int64_t id = 0;
+    ASSERT_TRUE(submit("name: coarse" + std::to_string(own_walls) + spec +
+                           (own_walls ? own_wall_law : "") + rest,
+                       &id)
+                    .ok());
+    for (int k = 0; k < 4; ++k)
+      ASSERT_NO_FATAL_FAILURE(
+          complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+            (*c.mutable_metrics())["solid_fraction"] =
+                0.5 + 0.1 * job.parameters().at("particle_law.tangential.mu_s");
+            (*c.mutable_metrics())["coordination_number"] = 4.0 + 0.1 * k;
+          }));
+    v1::DiagnoseRequest diagnose;
+    diagnose.set_id(id);
+    v1::DiagnoseReply reply;
+    ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), diagnose, &reply).ok());
+    ASSERT_EQ(reply.jobs_queued(), 1 + 5);  // the baseline and the candidate's runs
+    std::multiset<double> scales;
+    for (int k = 0; k < reply.jobs_queued(); ++k) {
+      v1::LeaseReply lease;
+      ASSERT_NO_FATAL_FAILURE(lease_as("fake", lease));
+      ASSERT_TRUE(lease.has_job());
+      const auto& p = lease.job().parameters();
+      if (!p.count("sizes.scale")) continue;  // the baseline
+      const double s = p.at("sizes.scale");
+      scales.insert(std::round(s * 1e6) / 1e6);
+      EXPECT_NEAR(p.at("particle_law.cohesion.hamaker"), 1e-16 * s * s, 1e-30);
+      if (own_walls)
+        EXPECT_FALSE(p.count("wall_law.cohesion.hamaker"));
+      else
+        EXPECT_NEAR(p.at("wall_law.cohesion.hamaker"), 1e-16 * s * s, 1e-30);
+    }
+    EXPECT_EQ(scales, (std::multiset<double>{0.5, 0.5, 0.5, 0.5, 0.707107})) << own_walls;
+  }
+}
+
+TEST_F(Service, CentrePointsDifferCurvatureIsTestedAndTheCalibrationRoundsAreShownAsJson) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(
+      submit(tiny_spec(200, 2, "", "calibration: {rounds: 2, stages: 2, max_jobs: 16}\n"), &id)
+          .ok());
+  start_worker("w");
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 90)) << workers_[0]->log();
+  // The two centre points (design rows 5 and 6) ran with their own seeds and differ.
+  std::map<int, double> centre;
+  std::set<std::uint64_t> seeds;
+  const auto design_results = results(id);
+  for (const auto& j : design_results.jobs()) {
+    if (j.kind() != "design" || j.std_order() < 5) continue;
+    centre[j.std_order()] = j.metrics().at("solid_fraction");
+  }
+  each_row(path("c.db"), "SELECT payload FROM jobs WHERE kind = 'design' AND std_order >= 5",
+           [&](sqlite3_stmt* st) {
+             const auto job =
+                 nlohmann::json::parse(reinterpret_cast<const char*>(sqlite3_column_text(st, 0)));
+             seeds.insert(std::stoull(job.at("seed").get<std::string>()));
+           });
+  ASSERT_EQ(centre.size(), 2u);
+  EXPECT_NE(centre[5], centre[6]);
+  EXPECT_EQ(seeds.size(), 2u);
+
+  const std::string ids = std::to_string(id);
+  const auto effects = cli_json(dir_, "effects", {"effects", ids, "--format", "json"}, channel_);
+  bool found = false;
+  for (const auto& m : effects.at("metrics")) {
+    if (m.at("metric") != "packing.solid_fraction") continue;
+    found = true;
+    EXPECT_TRUE(m.at("curvature_available")) << m.dump();
+    EXPECT_EQ(m.at("noise_df"), 1.0);
+    EXPECT_GT(m.at("noise_sd").get<double>(), 0.0);
+    EXPECT_NE(m.at("noise_source").get<std::string>().find("pure error"), std::string::npos);
+    EXPECT_NE(m.at("curvature_error").get<std::string>().find("pure error"), std::string::npos);
+  }
+  EXPECT_TRUE(found);
+
+  const auto cal = cli_json(dir_, "calibrate",
+                            {"calibrate", ids, "--verify", "--wait", "--format", "json"}, channel_);
+  const auto& rounds = cal.at("rounds");
+  ASSERT_GE(rounds.size(), 1u) << cal.dump();
+  EXPECT_LE(cal.at("simulations").get<int>(), 16);
+  const std::string conclusion = cal.at("conclusion");
+  EXPECT_TRUE(conclusion.rfind("within uncertainty after ", 0) == 0 ||
+              conclusion.rfind("not within uncertainty after ", 0) == 0)
+      << conclusion;
+  EXPECT_EQ(cal.at("verification_state"), "done");
+  if (conclusion.rfind("within", 0) == 0) {
+    // The calibrated set is the verified round that matched, not a newer proposal.
+    EXPECT_EQ(cal.at("proposed_values"), rounds.back().at("proposed_values")) << cal.dump();
+  }
+  EXPECT_GT(cal.at("metrics").at(0).at("tolerance").get<double>(), 0.02);
+
+  const auto status =
+      cli_json(dir_, "status", {"status", ids, "--jobs", "--format", "json"}, channel_);
+  EXPECT_EQ(status.at("calibration_rounds").size(), rounds.size());
+  EXPECT_GE(status.at("jobs").size(), 6u + rounds.size());
+  const auto exported = cli_json(dir_, "export", {"export", ids, "--format", "json"}, channel_);
+  EXPECT_EQ(exported.at("calibration_rounds").size(), rounds.size());
+  // A read-only diagnosis (what the report pages ask) reports and queues nothing.
+  const int jobs_before = results(id).jobs_size();
+  v1::DiagnoseRequest read_only;
+  read_only.set_id(id);
+  read_only.set_read_only(true);
+  v1::DiagnoseReply peek;
+  ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), read_only, &peek).ok());
+  EXPECT_EQ(peek.jobs_queued(), 0);
+  EXPECT_EQ(results(id).jobs_size(), jobs_before);
+  // The report is a typed message: the measured metric against its target, the baseline's
+  // calibrated set, and candidates whose runs have not run: their errors are absent, not 0.
+  ASSERT_TRUE(peek.has_report());
+  const v1::DiagnosisReport& report = peek.report();
+  EXPECT_EQ(report.state(), peek.state());
+  ASSERT_GE(report.metrics_size(), 1);
+  EXPECT_FALSE(report.metrics(0).response().empty());
+  EXPECT_FALSE(report.baseline().proposed().empty());
+  EXPECT_GE(report.candidates_size(), 1);
+  for (const auto& c : report.candidates()) {
+    EXPECT_FALSE(c.has_verified_rms()) << c.id();
+    EXPECT_TRUE(c.simulated().empty()) << c.id();
+  }
+  const auto diagnosis =
+      cli_json(dir_, "diagnose", {"diagnose", ids, "--no-wait", "--format", "json"}, channel_);
+  EXPECT_TRUE(diagnosis.is_object() && !diagnosis.empty()) << diagnosis.dump();
+  // --format json prints the report with the proto's field names.
+  EXPECT_TRUE(diagnosis.contains("metrics") && diagnosis.contains("candidates"))
+      << diagnosis.dump();
+  EXPECT_GT(results(id).jobs_size(), jobs_before) << "the diagnosis proper queues its runs";
+}
+
+TEST_F(Service, ACalibrationStatesTheFactorsTheDataFixOnlyInCombination) {
+  // Results through the real worker protocol, no physics: a solid fraction that both factors
+  // raise equally, so every set on the box's anti-diagonal matches 0.6 +- 0.02. The two centre
+  // runs differ by 0.002: the noise is their pure error, not Lenth's estimate from the effects.
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  // 2^2 + 2 centre runs, factors mu_s [0.1, 0.5] and e [0.2, 0.6]
+  ASSERT_TRUE(submit(tiny_spec(30, 2), &id).ok());
+  int centre_runs = 0;
+  for (int k = 0; k < 6; ++k)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+      const auto& p = job.parameters();
+      const double a = (p.at("particle_law.tangential.mu_s") - 0.3) / 0.2;
+      const double b = (p.at("particle_law.normal.restitution") - 0.4) / 0.2;
+      const bool centre = std::abs(a) < 1e-9 && std::abs(b) < 1e-9;
+      (*c.mutable_metrics())["solid_fraction"] =
+          0.6 + 0.1 * a + 0.1 * b + (centre ? 0.002 * centre_runs++ : 0.0);
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+    }));
+  ASSERT_TRUE(campaign_done(id));
+  const auto cal =
+      cli_json(dir_, "calibrate", {"calibrate", std::to_string(id), "--format", "json"}, channel_);
+  ASSERT_EQ(cal.at("trade_offs").size(), 1u) << cal.dump();
+  const auto& t = cal.at("trade_offs").at(0);
+  EXPECT_EQ(t.at("factor_a"), "particle_law.tangential.mu_s");
+  EXPECT_EQ(t.at("factor_b"), "particle_law.normal.restitution");
+  EXPECT_LT(t.at("correlation").get<double>(), -0.9);
+  EXPECT_LT(t.at("a_from").get<double>(), t.at("a_to").get<double>());
+  EXPECT_GT(t.at("b_from").get<double>(), t.at("b_to").get<double>());
+  EXPECT_NE(t.at("statement").get<std::string>().find("trade off"), std::string::npos);
+}
+
+TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(200, 2, "",
+                               "calibration: {surrogate: gp, batch: 2, rounds: 2, max_jobs: 4}\n"),
+                     &id)
+                  .ok());
+  start_worker("w");
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 90)) << workers_[0]->log();
+  const auto cal = cli_json(
+      dir_, "calibrate",
+      {"calibrate", std::to_string(id), "--verify", "--wait", "--format", "json"}, channel_);
+  EXPECT_EQ(cal.at("surrogate"), "gp");
+  const auto& rounds = cal.at("rounds");
+  ASSERT_FALSE(rounds.empty()) << cal.dump();
+  EXPECT_EQ(rounds.size() % 2, 0u) << "whole batches of two";
+  EXPECT_EQ(rounds.at(0).at("batch"), 1);
+  EXPECT_EQ(rounds.at(1).at("batch"), 1);
+  EXPECT_LE(cal.at("simulations").get<int>(), 4);
+  ASSERT_EQ(cal.at("intervals").size(), 2u);
+  for (const auto& i : cal.at("intervals"))
+    EXPECT_FALSE(i.at("statement").get<std::string>().empty()) << i.dump();
+}
+
+// A multi-fidelity campaign through the coordinator and a worker: the design's rows at the low
+// level, its centre at the high level too, the verification at the high level, and `status`
+// showing the particle-steps of each level against the all-high design.
+TEST_F(Service, AMultiFidelityCampaignVerifiesAtTheHighLevelAndStatusShowsTheCostOfEach) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(
+      submit(tiny_spec(200, 1) + "fidelity: {path: settings.particles, low: 100, high: 200}\n", &id)
+          .ok());
+  start_worker("w");
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 90)) << workers_[0]->log();
+  const std::string ids = std::to_string(id);
+  const auto cal = cli_json(dir_, "calibrate",
+                            {"calibrate", ids, "--verify", "--wait", "--format", "json"}, channel_);
+  ASSERT_EQ(cal.at("fidelity").size(), 1u) << cal.dump();
+  EXPECT_EQ(cal.at("fidelity").at(0).at("rows"), nlohmann::json::array({5}));
+  std::map<std::string, std::set<double>> particles;
+  const auto finished = results(id);
+  for (const auto& j : finished.jobs())
+    particles[j.kind()].insert(static_cast<double>(j.cost().particles()));
+  EXPECT_EQ(particles.at("design"), (std::set<double>{100}));
+  EXPECT_EQ(particles.at("design:high"), (std::set<double>{200}));
+  EXPECT_EQ(particles.at("verify"), (std::set<double>{200}));
+
+  const auto status = cli_json(dir_, "status", {"status", ids, "--format", "json"}, channel_);
+  const auto& cost = status.at("fidelity_cost");
+  EXPECT_EQ(cost.at("low_jobs"), 5);
+  EXPECT_EQ(cost.at("high_jobs"), 1);
+  EXPECT_GE(cost.at("verify_jobs").get<int>(), 1);
+  EXPECT_GT(cost.at("all_high_particle_steps").get<double>(),
+            cost.at("high_particle_steps").get<double>());
+  Process table(
+      {DEMCAL_CLI_BIN, "status", ids, "--coordinator", channel_.address, "--token", kToken},
+      path("status.log"));
+  ASSERT_EQ(table.wait_exit(30), 0) << table.log();
+  EXPECT_NE(table.log().find("the design at the high level in every row"), std::string::npos)
+      << table.log();
+}
+
+}  // namespace
+}  // namespace demcal::test

@@ -1,0 +1,203 @@
+// Service tests with real processes, real gRPC on loopback and real SQLite files (the fixture:
+// service_fixture.hpp). The CLI against a coordinator and the embedded default: a campaign end to
+// end, a work directory of another spec, the embedded run interrupted, an export larger than a
+// message. Leases and heartbeats are short (flags); every wait is bounded.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <thread>
+
+#include "client/service_client.hpp"
+#include "client/spec_yaml.hpp"
+#include "core/common/error.hpp"
+#include "core/lab/lab_test.hpp"
+#include "demcal/v1/campaign.grpc.pb.h"
+#include "demcal/v1/worker.grpc.pb.h"
+#include "rpc/channel.hpp"
+#include "rpc/material_convert.hpp"
+#include "server/limits.hpp"
+#include "tests/service/service_fixture.hpp"
+
+namespace demcal::test {
+namespace {
+
+// `demcal run` on a work directory whose campaign of that name was submitted with another spec
+// refuses, naming the directory, instead of resuming the old campaign as if it were this one.
+TEST_F(Service, RunOnAWorkDirectoryWhoseCampaignHasAnotherSpecRefuses) {
+  const std::string spec = path("tiny.yaml");
+  std::ofstream(spec) << tiny_spec(200);
+  Process first(
+      {DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1", "--no-verify"},
+      path("first.log"));
+  ASSERT_EQ(first.wait_exit(150), 0) << first.log();
+  std::string edited = tiny_spec(200);
+  edited.replace(edited.find("low: 0.1, high: 0.5"), 19, "low: 0.1, high: 0.4");
+  std::ofstream(spec) << edited;
+  Process second(
+      {DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1", "--no-verify"},
+      path("second.log"));
+  EXPECT_NE(second.wait_exit(150), 0) << second.log();
+  EXPECT_NE(second.log().find("another spec"), std::string::npos) << second.log();
+  EXPECT_NE(second.log().find(path("work")), std::string::npos) << second.log();
+  EXPECT_EQ(second.log().find("resuming campaign"), std::string::npos) << second.log();
+  // The unchanged spec still resumes.
+  std::ofstream(spec) << tiny_spec(200);
+  Process third(
+      {DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--threads", "1", "--no-verify"},
+      path("third.log"));
+  EXPECT_EQ(third.wait_exit(150), 0) << third.log();
+  EXPECT_NE(third.log().find("resuming campaign 1"), std::string::npos) << third.log();
+}
+
+TEST_F(Service, CliRunsACampaignEndToEnd) {
+  const std::string spec = path("tiny.yaml");
+  std::ofstream(spec) << tiny_spec(200, 1);  // (60 particles: packing could not insert them all)
+  Process run(
+      {DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--workers", "2", "--threads", "1"},
+      path("run.log"));
+  ASSERT_EQ(run.wait_exit(150), 0) << run.log();
+  // The new work directory (it holds the database) is its owner's alone.
+  EXPECT_EQ(fs::status(path("work")).permissions() & (fs::perms::group_all | fs::perms::others_all),
+            fs::perms::none);
+  const std::string out = run.log();
+  EXPECT_NE(out.find("resolution full factorial"), std::string::npos) << out;
+  EXPECT_NE(out.find("== packing.solid_fraction (5 of 5 runs) =="), std::string::npos) << out;
+  EXPECT_NE(out.find("alias chain"), std::string::npos);
+  EXPECT_NE(out.find("proposed parameter set"), std::string::npos);
+  EXPECT_NE(out.find("verification: done, 1 simulation(s) added by the calibration"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("round 1 (stage 1, batch 1): done"), std::string::npos) << out;
+  // Both local workers ran jobs side by side (--workers 2), by the jobs table of the file.
+  std::map<std::string, int> jobs_by_worker;
+  each_row(path("work/campaign.db"), "SELECT worker, COUNT(*) FROM jobs GROUP BY worker",
+           [&](sqlite3_stmt* st) {
+             jobs_by_worker[reinterpret_cast<const char*>(sqlite3_column_text(st, 0))] =
+                 sqlite3_column_int(st, 1);
+           });
+  EXPECT_GE(jobs_by_worker["embedded-1"], 1) << out;
+  EXPECT_GE(jobs_by_worker["embedded-2"], 1) << out;
+  EXPECT_EQ(jobs_by_worker["embedded-1"] + jobs_by_worker["embedded-2"], 6);  // 5 runs + verify
+  // Every stored result carries the worker's cost block, with its phases and steps.
+  int with_cost = 0;
+  each_row(path("work/campaign.db"), "SELECT cost_json FROM results", [&](sqlite3_stmt* st) {
+    const auto cost =
+        nlohmann::json::parse(reinterpret_cast<const char*>(sqlite3_column_text(st, 0)));
+    EXPECT_GT(std::stoll(cost.at("steps").get<std::string>()), 0) << cost.dump();
+    EXPECT_EQ(cost.at("phases").at(1).at("name"), "settle") << cost.dump();
+    ++with_cost;
+  });
+  EXPECT_EQ(with_cost, 6);
+  // Run again with --format json: the campaign resumes, and standard output is one JSON
+  // document (design, effects, calibration); progress went to standard error.
+  Process again({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--format", "json"},
+                path("again.json"), path("again.err"));
+  ASSERT_EQ(again.wait_exit(120), 0) << again.log();
+  const auto doc = nlohmann::json::parse(again.log());
+  EXPECT_EQ(doc.at("design").at("runs"), 5);
+  EXPECT_EQ(doc.at("effects").at("metrics").size(), 2u);
+  EXPECT_EQ(doc.at("calibration").at("rounds").size(), 1u);
+  EXPECT_EQ(doc.at("calibration").at("simulations"), 1);
+  // A bad spec is refused before anything runs, naming the file, line and field.
+  std::string bad = tiny_spec(60);
+  bad.replace(bad.find("density: 2500"), 13, "densty: 2500");
+  std::ofstream(path("bad.yaml")) << bad;
+  Process refused({DEMCAL_CLI_BIN, "run", path("bad.yaml"), "--workdir", path("work2")},
+                  path("bad.log"));
+  EXPECT_EQ(refused.wait_exit(30), 2);
+  EXPECT_NE(refused.log().find("bad.yaml:8: material.densty"), std::string::npos) << refused.log();
+}
+
+// The embedded default stopped mid-job, by a signal or killed outright, counts no attempt
+// against the job it was running: on SIGINT its workers give their leases back and it exits
+// 130; after a SIGKILL the next run finds the lease in the file and gives it back at start-up.
+// Interrupted as often as a long campaign spread over sessions is, no job fails for it.
+TEST_F(Service, TheEmbeddedDefaultInterruptedCountsNoAttemptAgainstItsJobs) {
+  const std::string spec = path("interrupted.yaml");
+  std::ofstream(spec) << wall_friction_spec("interrupted", "");
+  const std::string db = path("work/campaign.db");
+  const std::vector<std::string> argv{DEMCAL_CLI_BIN, "run", spec,        "--workdir", path("work"),
+                                      "--workers",    "1",   "--threads", "1"};
+  // Polled while the run creates the file: a file without its tables yet counts as none leased.
+  auto leased = [&] {
+    int n = 0;
+    sqlite3* file = nullptr;
+    sqlite3_stmt* st = nullptr;
+    if (fs::exists(db) &&
+        sqlite3_open_v2(db.c_str(), &file, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK &&
+        sqlite3_prepare_v2(file, "SELECT COUNT(*) FROM jobs WHERE state = 'leased'", -1, &st,
+                           nullptr) == SQLITE_OK &&
+        sqlite3_step(st) == SQLITE_ROW)
+      n = sqlite3_column_int(st, 0);
+    sqlite3_finalize(st);
+    sqlite3_close(file);
+    return n > 0;
+  };
+  auto counted = [&] {
+    std::map<std::int64_t, int> by_job;
+    each_row(db, "SELECT id, counted FROM jobs", [&](sqlite3_stmt* st) {
+      by_job[sqlite3_column_int64(st, 0)] = sqlite3_column_int(st, 1);
+    });
+    return by_job;
+  };
+  {
+    Process run(argv, path("run1.log"));
+    ASSERT_TRUE(wait_until(leased, 60)) << run.log();
+    run.signal(SIGINT);
+    EXPECT_EQ(run.wait_exit(40), 128 + SIGINT) << run.log();
+    EXPECT_NE(run.log().find("giving the running jobs back"), std::string::npos) << run.log();
+  }
+  EXPECT_FALSE(leased());  // given back before the exit
+  for (const auto& [job, n] : counted()) EXPECT_LE(n, 1) << job;
+  {
+    Process run(argv, path("run2.log"));
+    ASSERT_TRUE(wait_until(leased, 60)) << run.log();
+    run.signal(SIGKILL);
+    EXPECT_EQ(run.wait_exit(10), 128 + SIGKILL);
+  }
+  EXPECT_TRUE(leased());  // the killed run's lease is still in the file
+  Process last(argv, path("run3.log"));
+  ASSERT_EQ(last.wait_exit(150), 0) << last.log();
+  int given_back = 0;
+  each_row(db, "SELECT state, counted, attempt, error FROM jobs", [&](sqlite3_stmt* st) {
+    EXPECT_STREQ(reinterpret_cast<const char*>(sqlite3_column_text(st, 0)), "done");
+    EXPECT_EQ(sqlite3_column_int(st, 1), 1);  // only the lease that finished counts
+    given_back += sqlite3_column_int(st, 2) > 1;
+  });
+  EXPECT_GE(given_back, 1);
+}
+
+TEST_F(Service, AnExportLargerThanAGrpcMessageArrivesWhole) {
+  // Synthetic results through the real worker protocol, no physics: each with a cost block of
+  // 5,000 long-named phases (about 1.5 MB of JSON), so that the export exceeds gRPC's 4 MB.
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());  // 4 jobs
+  for (int k = 0; k < 4; ++k)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec&, v1::CompleteRequest& c) {
+      (*c.mutable_metrics())["solid_fraction"] = 0.55 + 0.01 * k;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+      for (int p = 0; p < 5000; ++p) {
+        auto* phase = c.mutable_cost()->add_phases();
+        phase->set_name("phase " + std::to_string(p) + std::string(200, '.'));
+        phase->set_steps(p);
+      }
+    }));
+  ASSERT_TRUE(campaign_done(id));
+  const auto exported =
+      cli_json(dir_, "export", {"export", std::to_string(id), "--format", "json"}, channel_);
+  EXPECT_GT(fs::file_size(path("export.json")), 4u << 20);
+  ASSERT_EQ(exported.at("jobs").size(), 4u);
+  for (const auto& j : exported.at("jobs")) EXPECT_EQ(j.at("cost").at("phases").size(), 5000u);
+}
+
+}  // namespace
+}  // namespace demcal::test
