@@ -19,7 +19,7 @@
 #include "client/liggghts_fragment.hpp"
 #include "client/service_client.hpp"
 #include "core/common/error.hpp"
-#include "core/lab/lab_spec.hpp"
+#include "core/lab/lab_run_yaml.hpp"
 #include "rpc/journal_line.hpp"
 #include "rpc/material_convert.hpp"
 

@@ -13,7 +13,7 @@
 #include "client/markdown.hpp"
 #include "client/study_journal.hpp"
 #include "core/io/csv.hpp"
-#include "core/lab/lab_spec.hpp"
+#include "core/lab/lab_run_yaml.hpp"
 #include "core/lab/size_extrapolation.hpp"
 #include "core/lab/stage_cache.hpp"
 #include "core/lab/study.hpp"

@@ -16,7 +16,7 @@
 #include <utility>
 
 #include "core/common/error.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/run_cancelled.hpp"
 #include "core/lab/stage_cache.hpp"
 #include "demcal/v1/worker.grpc.pb.h"

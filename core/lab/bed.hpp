@@ -5,7 +5,7 @@
 #include <functional>
 #include <limits>
 
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/particles/insertion.hpp"
 #include "core/sim/health.hpp"
 #include "core/sim/world.hpp"

@@ -9,7 +9,7 @@
 #include "core/common/rng.hpp"
 #include "core/io/vtk.hpp"
 #include "core/lab/bed.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/stages.hpp"
 #include "core/metrics/bulk.hpp"
 #include "core/metrics/stress.hpp"

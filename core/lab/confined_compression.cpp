@@ -10,7 +10,7 @@
 #include <cmath>
 
 #include "core/lab/confinement.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/metrics/bulk.hpp"
 
 namespace demcal::lab {

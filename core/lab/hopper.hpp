@@ -2,7 +2,7 @@
 // hopper (seed 000 §2.7.6): discharge of a wedge hopper slice, periodic front and back.
 #include <array>
 
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/model/hopper_settings.hpp"
 
 namespace demcal::lab {

@@ -7,7 +7,7 @@
 
 #include "core/common/rng.hpp"
 #include "core/lab/bed.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/piston.hpp"
 #include "core/metrics/bulk.hpp"
 #include "core/model/packing_settings.hpp"

@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/model/rotating_drum_settings.hpp"
 #include "core/particles/size_distribution.hpp"
 

@@ -2,7 +2,7 @@
 // shear_cell (seed 000 §2.7.4): the FT4 standard shear test with a vaned shear head (a mesh).
 #include <array>
 
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/model/shear_cell_settings.hpp"
 
 namespace demcal::lab {

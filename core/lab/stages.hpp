@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "core/common/bytes.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/sim/world.hpp"
 
 namespace demcal::lab {

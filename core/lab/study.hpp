@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 
 namespace demcal::lab {
 

@@ -15,7 +15,7 @@
 #include <optional>
 
 #include "core/lab/confinement.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/model/tensile_settings.hpp"
 
 namespace demcal::lab {

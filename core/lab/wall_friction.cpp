@@ -9,7 +9,7 @@
 //   T = int_0^R tau 2 pi r^2 dr = (2/3) pi R^3 tau   =>   tau = 3 T / (2 pi R^3).
 #include <cmath>
 
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/piston.hpp"
 #include "core/lab/stages.hpp"
 #include "core/model/wall_friction_settings.hpp"

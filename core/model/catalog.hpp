@@ -15,8 +15,8 @@
 namespace demcal::lab {
 
 struct MaterialModel;  // material.hpp
-struct LabOutput;      // core/lab/lab_test.hpp: what a runner returns
-struct RunOptions;     // core/lab/lab_test.hpp: how it runs
+struct LabOutput;      // core/lab/lab_run.hpp: what a runner returns
+struct RunOptions;     // core/lab/lab_run.hpp: how it runs
 
 struct MetricInfo {
   std::string name, unit, description;

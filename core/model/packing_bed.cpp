@@ -1,5 +1,6 @@
 // The packing test's die bed as its particles size it, checked before anything runs: metadata
 // without physics, so the coordinator refuses a bed too small for its sampling volume.
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -17,9 +18,11 @@ std::size_t PackingTest::admit(const MaterialModel& material, const PackingSetti
   const double solid = s.particles * particles::number_means(material.simulated_sizes()).volume;
   const double radius = 0.95 * std::cbrt(solid / (0.6 * 2.0 * M_PI));
   const double top = s.cut_fraction * 2.0 * radius * 0.6 / 0.74;
+  // The sampling volume keeps its distance in largest sphere diameters (a clump's largest
+  // member, scaled as the template's radii are: in volume-equivalent radii).
   const auto shape = material.clump_template();
-  const double d_max = 2.0 * particles::max_radius(material.simulated_sizes()) *
-                       (shape ? shape->bounding_radius : 1.0);
+  const double member = shape ? *std::max_element(shape->radii.begin(), shape->radii.end()) : 1.0;
+  const double d_max = 2.0 * particles::max_radius(material.simulated_sizes()) * member;
   const double margin = s.wall_margin * d_max;
   if (radius <= margin || top <= 2.0 * margin)
     throw InputError(where + ".particles",

@@ -15,7 +15,7 @@
 
 #include "core/common/rng.hpp"
 #include "core/io/yaml_node.hpp"
-#include "core/lab/lab_spec.hpp"
+#include "core/lab/lab_run_yaml.hpp"
 #include "tests/common/command.hpp"
 
 namespace {

@@ -1,7 +1,7 @@
 #pragma once
 // Small materials for the lab-test tests: soft Luding spheres of 1 mm radius so that a
 // few hundred particles run in seconds, and cohesionless Hertz spheres.
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/piston.hpp"
 
 namespace demcal::lab::testing {

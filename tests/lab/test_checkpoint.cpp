@@ -10,7 +10,7 @@
 #include <set>
 
 #include "core/common/error.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "lab_test_util.hpp"
 
 namespace demcal::lab {

@@ -10,7 +10,7 @@
 
 #include <cmath>
 
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "lab_test_util.hpp"
 
 namespace demcal::lab {

@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "core/common/error.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/rotating_drum.hpp"
 
 namespace demcal::lab {

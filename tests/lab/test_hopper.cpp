@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "core/lab/hopper.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 
 namespace demcal::lab {
 namespace {

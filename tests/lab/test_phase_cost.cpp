@@ -10,7 +10,7 @@
 
 #include "core/common/error.hpp"
 #include "core/io/yaml_node.hpp"
-#include "core/lab/lab_spec.hpp"
+#include "core/lab/lab_run_yaml.hpp"
 #include "core/model/lab_tests.hpp"
 #include "core/sim/time_step.hpp"
 #include "lab_test_util.hpp"

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <map>
 
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/shear_cell.hpp"
 
 namespace demcal::lab {

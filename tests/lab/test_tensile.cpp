@@ -8,7 +8,7 @@
 #include <memory>
 
 #include "core/lab/confinement.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/stage_cache.hpp"
 #include "core/model/tensile_settings.hpp"
 #include "lab_test_util.hpp"

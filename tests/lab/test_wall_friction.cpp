@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/piston.hpp"
 #include "core/model/wall_friction_settings.hpp"
 #include "lab_test_util.hpp"

@@ -14,7 +14,7 @@
 
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/run_cancelled.hpp"
 #include "rpc/material_convert.hpp"
 #include "server/convert.hpp"

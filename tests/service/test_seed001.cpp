@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "client/spec_yaml.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "core/lab/rotating_drum.hpp"
 #include "process.hpp"
 #include "rpc/material_convert.hpp"

@@ -18,7 +18,7 @@
 #include "client/service_client.hpp"
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "rpc/channel.hpp"

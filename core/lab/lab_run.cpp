@@ -1,4 +1,4 @@
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 
 #include <chrono>
 

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "core/io/yaml_node.hpp"
-#include "core/lab/lab_spec.hpp"
+#include "core/lab/lab_run_yaml.hpp"
 
 namespace demcal::lab {
 namespace {
@@ -32,7 +32,7 @@ MaterialModel every_part() {
   return m;
 }
 
-TEST(LabSpecYaml, AMaterialReadsBackToTheSameModel) {
+TEST(LabRunYaml, AMaterialReadsBackToTheSameModel) {
   const MaterialModel m = every_part();
   const std::string yaml = material_yaml(m);
   const MaterialModel back = read_material(io::YamlNode::load_string(yaml, "m.yaml")["material"]);
@@ -41,7 +41,7 @@ TEST(LabSpecYaml, AMaterialReadsBackToTheSameModel) {
   EXPECT_EQ(get_parameter(back, "particle_law.tangential.mu_s"), 1.0 / 3.0);
 }
 
-TEST(LabSpecYaml, ALabRunReadsBackToTheSameRun) {
+TEST(LabRunYaml, ALabRunReadsBackToTheSameRun) {
   LabRunSpec run;
   run.test = "packing";
   run.settings = {{"particles", 60}, {"cut_fraction", 0.9}};

@@ -1,4 +1,4 @@
-#include "core/lab/lab_spec.hpp"
+#include "core/lab/lab_run_yaml.hpp"
 
 #include <cstdio>
 #include <sstream>

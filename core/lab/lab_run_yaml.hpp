@@ -15,7 +15,7 @@
 #include <string>
 
 #include "core/io/yaml_node.hpp"
-#include "core/lab/lab_test.hpp"
+#include "core/lab/lab_run.hpp"
 
 namespace demcal::lab {
 
