@@ -29,7 +29,7 @@ void check_map_entry(const google::protobuf::Message& entry, const std::string& 
     check_text(name, where, "a key");
   }
   if (value->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE)
-    check_sizes(r->GetMessage(entry, value), where + "." + name);
+    check_fields(r->GetMessage(entry, value), where + "." + name);
   else if (value->cpp_type() == FieldDescriptor::CPPTYPE_STRING)
     check_text(r->GetString(entry, value), where + "." + name, "a text");
 }
@@ -45,7 +45,7 @@ void check_repeated(const google::protobuf::Message& m, const FieldDescriptor* f
     if (f->is_map())
       check_map_entry(r->GetRepeatedMessage(m, f, i), where);
     else if (f->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE)
-      check_sizes(r->GetRepeatedMessage(m, f, i), at);
+      check_fields(r->GetRepeatedMessage(m, f, i), at);
     else if (f->cpp_type() == FieldDescriptor::CPPTYPE_STRING)
       check_text(r->GetRepeatedString(m, f, i), at, "a text");
   }
@@ -53,8 +53,13 @@ void check_repeated(const google::protobuf::Message& m, const FieldDescriptor* f
 
 }  // namespace
 
-void check_sizes(const google::protobuf::Message& message, const std::string& where) {
+void check_fields(const google::protobuf::Message& message, const std::string& where) {
   const auto* r = message.GetReflection();
+  if (const auto& unknown = r->GetUnknownFields(message); unknown.field_count() > 0)
+    throw InputError(where,
+                     fmt::format("field number {} is not one this coordinator knows (sent by "
+                                 "a newer client?): refused rather than ignored",
+                                 unknown.field(0).number()));
   std::vector<const FieldDescriptor*> fields;
   r->ListFields(message, &fields);
   for (const FieldDescriptor* f : fields) {
@@ -62,7 +67,7 @@ void check_sizes(const google::protobuf::Message& message, const std::string& wh
     if (f->is_repeated())
       check_repeated(message, f, at);
     else if (f->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE)
-      check_sizes(r->GetMessage(message, f), at);
+      check_fields(r->GetMessage(message, f), at);
     else if (f->cpp_type() == FieldDescriptor::CPPTYPE_STRING)
       check_text(r->GetString(message, f), at, "a text");
   }

@@ -1,6 +1,6 @@
 #pragma once
 // Checks of what a request carries, before anything else reads it (limits.hpp): its bytes, every
-// repeated field and string of a spec, a worker's texts. Errors name the field.
+// repeated field and string of a spec and its unknown fields, a worker's texts. Errors name the field.
 #include <google/protobuf/message.h>
 
 #include <string>
@@ -8,9 +8,10 @@
 namespace demcal::server {
 
 /// Throws InputError naming the field when a string or a map key of `message` is longer than
-/// kMaxText bytes or a repeated field or map has more than kMaxRepeated entries; `where` is the
-/// path of `message` itself ("spec").
-void check_sizes(const google::protobuf::Message& message, const std::string& where);
+/// kMaxText bytes, a repeated field or map has more than kMaxRepeated entries, or a message holds
+/// a field this build does not know (a newer client's: refused, not silently dropped from what
+/// is stored and run); `where` is the path of `message` itself ("spec").
+void check_fields(const google::protobuf::Message& message, const std::string& where);
 
 /// `text` as an error message repeats it: at most kMaxEcho characters, the rest cut ("...").
 std::string echo(const std::string& text);

@@ -489,7 +489,7 @@ void check_campaign_bytes(const v1::CampaignSpec& spec, const CampaignPlan& plan
 
 CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs) {
   CampaignPlan plan;
-  check_sizes(spec, "spec");
+  check_fields(spec, "spec");
   if (spec.name().empty()) throw InputError("spec.name", "missing");
   check_printable(spec.name(), "spec.name");
   if (!spec.has_material()) throw InputError("spec.material", "missing");

@@ -33,6 +33,15 @@ std::string refusal_of(const server::JobRow& row) {
   return "";
 }
 
+/// What differs between the spec sent and the spec stored (empty: nothing).
+std::string differences(const v1::CampaignSpec& sent, const v1::CampaignSpec& stored) {
+  google::protobuf::util::MessageDifferencer d;
+  std::string report;
+  d.ReportDifferencesToString(&report);
+  d.Compare(sent, stored);
+  return report.substr(0, 2000);
+}
+
 }  // namespace
 
 struct SubmitOracle::State {
@@ -82,8 +91,8 @@ SubmitOracle::Outcome SubmitOracle::submit(const v1::SubmitRequest& request) {
   if (store.campaigns().size() != before + 1) return {true, "not exactly one campaign added"};
   v1::CampaignSpec stored;
   server::from_json(row->spec_json, stored);
-  if (!google::protobuf::util::MessageDifferencer::Equals(stored, request.spec()))
-    return {true, "the stored spec differs from the one sent"};
+  if (const std::string d = differences(request.spec(), stored); !d.empty())
+    return {true, "the stored spec differs from the one sent: " + d};
   (void)server::plan_from_json(row->design_json);
   const auto jobs = store.jobs(row->id);
   if (static_cast<int>(jobs.size()) != reply.design().jobs())
