@@ -1,6 +1,7 @@
 #pragma once
 // Checks of what a request carries, before anything else reads it (limits.hpp): its bytes, every
-// repeated field and string of a spec and its unknown fields, a worker's texts. Errors name the field.
+// repeated field and string of a spec and its unknown fields, a worker's texts. Errors name the
+// field.
 #include <google/protobuf/message.h>
 
 #include <string>

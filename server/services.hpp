@@ -21,9 +21,9 @@ struct ServiceConfig {
   Tokens tokens;
   double heartbeat_seconds = 10.0;
   double idle_retry_seconds = 1.0;
-  int max_starts = 256;              ///< Calibrate `starts`, at most
-  double max_watch_interval = 60.0;  ///< Watch `interval_seconds`, at most
-  double max_checkpoint_mb = 64.0;   ///< a checkpoint's state, at most (MiB)
+  int max_starts = 256;                                 ///< Calibrate `starts`, at most
+  double max_watch_interval = 60.0;                     ///< Watch `interval_seconds`, at most
+  double max_checkpoint_mb = 64.0;                      ///< a checkpoint's state, at most (MiB)
   long max_jobs_per_client = kDefaultMaxJobsPerClient;  ///< unfinished jobs of a token's campaigns
   long max_jobs = kDefaultMaxJobs;                      ///< unfinished jobs of the store, at most
 };

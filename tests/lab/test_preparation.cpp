@@ -10,8 +10,8 @@
 #include "core/common/error.hpp"
 #include "core/io/yaml_node.hpp"
 #include "core/lab/bed.hpp"
-#include "core/lab/lab_run_yaml.hpp"
 #include "core/lab/lab_run.hpp"
+#include "core/lab/lab_run_yaml.hpp"
 #include "core/metrics/bulk.hpp"
 #include "tests/common/input_error.hpp"
 

@@ -1,8 +1,8 @@
 #pragma once
-// The fixture of the service tests with real processes (test_service_*.cpp, test_journal.cpp, ...): a
-// coordinator started (and restarted) on a loopback port with a file of its own, workers, the
-// CLI against it, fake results through the real worker protocol, and the SQLite file read
-// directly. Every wait is bounded.
+// The fixture of the service tests with real processes (test_service_*.cpp, test_journal.cpp, ...):
+// a coordinator started (and restarted) on a loopback port with a file of its own, workers, the CLI
+// against it, fake results through the real worker protocol, and the SQLite file read directly.
+// Every wait is bounded.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 #include <unistd.h>

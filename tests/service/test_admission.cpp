@@ -2,9 +2,9 @@
 // rule added to a test later is covered: every cross-setting rule and every preparation a test
 // cannot run is refused with INVALID_ARGUMENT naming the field; a drum above a worker's particle
 // limit is refused by that worker before it simulates; an abandoned Calibrate stops and frees
-// the next call; a Complete above its byte bound stores nothing. And the property behind admission, over
-// generated specs: whatever Submit accepts, a worker can run (never an accepted spec that fails
-// on every worker as invalid input).
+// the next call; a Complete above its byte bound stores nothing. And the property behind admission,
+// over generated specs: whatever Submit accepts, a worker can run (never an accepted spec that
+// fails on every worker as invalid input).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -158,10 +158,10 @@ TEST_F(Service, ACompleteAboveSixteenMebibytesIsRefusedAndNothingIsStored) {
   v1::CompleteReply reply;
   const auto refused = workers_stub_->Complete(ctx().get(), big, &reply);
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_NE(refused.error_message().find("at most " +
-                                         std::to_string(server::kMaxResultRequestBytes) +
-                                         " for CompleteRequest"),
-            std::string::npos)
+  EXPECT_NE(
+      refused.error_message().find("at most " + std::to_string(server::kMaxResultRequestBytes) +
+                                   " for CompleteRequest"),
+      std::string::npos)
       << refused.error_message();
   EXPECT_EQ(stored_results().size(), 0u);
   EXPECT_TRUE(workers_stub_->Complete(ctx().get(), c, &reply).ok());
