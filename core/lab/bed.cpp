@@ -11,6 +11,7 @@
 #include "core/io/vtk.hpp"
 #include "core/lab/run_cancelled.hpp"
 #include "core/metrics/bulk.hpp"
+#include "core/model/packing_settings.hpp"
 #include "core/particles/insertion.hpp"
 #include "core/sim/step.hpp"
 #include "core/sim/time_step.hpp"
@@ -146,9 +147,7 @@ sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
   Rng rng(options.seed);
   const double solid =
       expected_solid_volume(sizes, static_cast<double>(spec.particles), options.seed);
-  // A settled bed of solid fraction ~0.6 as high as it is wide: pi R^2 2R 0.6 = solid volume.
-  const double radius =
-      spec.die_radius > 0.0 ? spec.die_radius : std::cbrt(solid / (0.6 * 2.0 * M_PI));
+  const double radius = spec.die_radius > 0.0 ? spec.die_radius : die_radius_for(solid);
   // Clumps are inserted by their bounding spheres: the loose column is taller by their volume.
   particles::InsertRequest req = material_insert_request(material, {}, spec.particles);
   const PreparationSpec& prep = material.preparation;

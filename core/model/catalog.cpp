@@ -35,14 +35,18 @@ std::size_t sized_bed(const MaterialModel& material, const typename T::SettingsT
     return static_cast<std::size_t>(std::llround(s.particles));
 }
 
+bool runs_preparation(const LabTestInfo& info, PreparationMethod method) {
+  return std::ranges::find(info.preparations, method) != info.preparations.end();
+}
+
 /// The material's bed preparation against what test T runs and what the method can grow.
 void check_preparation(const LabTestInfo& info, const MaterialModel& material,
                        const std::string& where) {
   const PreparationMethod method = material.preparation.method;
-  const auto& ok = info.preparations;
-  if (std::find(ok.begin(), ok.end(), method) == ok.end()) {
+  if (!runs_preparation(info, method)) {
     std::string names;
-    for (auto m : ok) names += (names.empty() ? "" : ", ") + preparation_method_name(m);
+    for (auto m : info.preparations)
+      names += (names.empty() ? "" : ", ") + preparation_method_name(m);
     throw InputError(where + ".preparation.method",
                      "the " + info.name + " test cannot build its bed by '" +
                          preparation_method_name(method) + "' (it runs: " + names + ")");
@@ -54,16 +58,16 @@ void check_preparation(const LabTestInfo& info, const MaterialModel& material,
 }
 
 template <class T>
-std::size_t admit_as(const MaterialModel& material, const Settings& settings,
-                     const FieldPaths& where) {
-  static const LabTestInfo info = registered_info<T>();
+std::size_t admit_as(const LabTestInfo& info, const MaterialModel& material,
+                     const Settings& settings, const FieldPaths& where) {
   validate_settings(info, settings, where.settings);
   const auto typed = read_settings<typename T::SettingsType>(settings, where.settings);
   check_preparation(info, material, where.material);
   return sized_bed<T>(material, typed, where.settings);
 }
 
-using Admission = std::size_t (*)(const MaterialModel&, const Settings&, const FieldPaths&);
+using Admission = std::size_t (*)(const LabTestInfo&, const MaterialModel&, const Settings&,
+                                  const FieldPaths&);
 
 }  // namespace
 
@@ -105,8 +109,8 @@ std::size_t admit_lab_test(const std::string& test, const MaterialModel& materia
             {decltype(t)::info().name, &admit_as<decltype(t)>}...};
       },
       LabTests{});
-  find_lab_info(test);  // an unknown name: the error listing the known ones
-  return admissions.at(test)(material, settings, where);
+  const LabTestInfo& info = find_lab_info(test);  // an unknown name: the known ones listed
+  return admissions.at(test)(info, material, settings, where);
 }
 
 bool reports_metric(const LabTestInfo& info, const std::string& metric) {
@@ -116,8 +120,7 @@ bool reports_metric(const LabTestInfo& info, const std::string& metric) {
 }
 
 bool accepts_preparation(const std::string& test, PreparationMethod method) {
-  const auto& ok = find_lab_info(test).preparations;
-  return std::find(ok.begin(), ok.end(), method) != ok.end();
+  return runs_preparation(find_lab_info(test), method);
 }
 
 }  // namespace demcal::lab

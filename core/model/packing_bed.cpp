@@ -12,11 +12,11 @@ namespace demcal::lab {
 
 std::size_t PackingTest::admit(const MaterialModel& material, const PackingSettings& s,
                                const std::string& where) {
-  // The die is as wide as a bed of solid fraction 0.6 is high (core/lab/bed.cpp: pi R^2 2R 0.6
-  // = solid volume); the settled bed is at least 2R 0.6 / 0.74 high (no packing of spheres is
-  // denser than 0.74) before the cut. 0.95 covers the sampled solid volume's scatter.
+  // The die the bed is built in (die_radius_for); the settled bed is at least 2R 0.6 / 0.74 high
+  // (no packing of spheres is denser than 0.74) before the cut. 0.95 covers the sampled solid
+  // volume's scatter.
   const double solid = s.particles * particles::number_means(material.simulated_sizes()).volume;
-  const double radius = 0.95 * std::cbrt(solid / (0.6 * 2.0 * M_PI));
+  const double radius = 0.95 * die_radius_for(solid);
   const double top = s.cut_fraction * 2.0 * radius * 0.6 / 0.74;
   // The sampling volume keeps its distance in largest sphere diameters (a clump's largest
   // member, scaled as the template's radii are: in volume-equivalent radii).

@@ -2,6 +2,7 @@
 // The settings of the packing lab test as a campaign names them, and its catalogue entry: metadata
 // the coordinator validates with, no physics (the runner: core/lab/packing.cpp).
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <string>
 
@@ -31,6 +32,12 @@ struct PackingSettings {
   }
   void finalize(const std::string&) {}
 };
+
+/// The radius of the die a die test builds a bed of `solid_volume` in when it does not fix one:
+/// a settled bed of solid fraction 0.6 as high as it is wide, pi R^2 2R 0.6 = solid volume.
+inline double die_radius_for(double solid_volume) {
+  return std::cbrt(solid_volume / (0.6 * 2.0 * M_PI));
+}
 
 /// The packing lab test (seed 000 §2.7.1, §3.1): its catalogue entry here, its runner in
 /// core/lab/packing.cpp.
