@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "rpc/job_kind.hpp"
 #include "rpc/replies.hpp"
 
 namespace demcal::report {
@@ -87,7 +88,7 @@ json read_calibration(v1::CampaignService::StubInterface& stub, const rpc::Chann
 
 bool has_diagnosis_jobs(const json& exported) {
   for (const auto& j : exported.value("jobs", json::array()))
-    if (j.value("kind", "").rfind("diagnose:", 0) == 0) return true;
+    if (job_kind::is_diagnosis(j.value("kind", ""))) return true;
   return false;
 }
 

@@ -180,12 +180,61 @@ lab::MaterialModel to_material_model(const v1::Material& m, const std::string& w
   return model;
 }
 
+namespace {
+
+void set_slot(v1::ContactSlot& out, const contact::SlotSpec& slot) {
+  out.set_model(slot.model);
+  for (const auto& [name, value] : slot.params) (*out.mutable_params())[name] = value;
+}
+
+void set_law(v1::ContactLaw& out, const contact::ContactLawSpec& law) {
+  set_slot(*out.mutable_normal(), law.normal);
+  set_slot(*out.mutable_cohesion(), law.cohesion);
+  set_slot(*out.mutable_tangential(), law.tangential);
+  set_slot(*out.mutable_rolling(), law.rolling);
+}
+
+void set_sizes(v1::SizeDistribution& out, const particles::SizeDistribution& sizes) {
+  if (const auto* one = std::get_if<particles::Monodisperse>(&sizes)) {
+    out.mutable_monodisperse()->set_radius(one->radius);
+  } else if (const auto* ln = std::get_if<particles::LogNormal>(&sizes)) {
+    auto* o = out.mutable_lognormal();
+    o->set_median_radius(ln->median_radius);
+    o->set_sigma_g(ln->sigma_g);
+    o->set_truncate_k(ln->truncate_k);
+  } else {
+    const auto& d = std::get<particles::DiscreteClasses>(sizes);
+    auto* o = out.mutable_discrete();
+    for (const double r : d.radii) o->add_radii(r);
+    for (const double f : d.mass_fractions) o->add_mass_fractions(f);
+  }
+}
+
+}  // namespace
+
+v1::Material to_material_message(const lab::MaterialModel& model) {
+  v1::Material m;
+  set_law(*m.mutable_particle_law(), model.particle_law);
+  set_law(*m.mutable_wall_law(), model.wall_law);
+  set_sizes(*m.mutable_sizes(), model.sizes);
+  m.set_size_scale(model.size_scale);
+  m.set_density(model.density);
+  m.mutable_scaling()->set_law(contact::scaling_law_name(model.scaling));
+  m.mutable_scaling()->set_factor(model.scale_factor);
+  m.mutable_shape()->set_kind(particles::shape_kind_name(model.shape.kind));
+  for (const auto& [name, value] : particles::shape_values(model.shape))
+    (*m.mutable_shape()->mutable_params())[name] = value;
+  m.mutable_preparation()->set_method(lab::preparation_method_name(model.preparation.method));
+  for (const auto& [name, value] : lab::preparation_values(model.preparation))
+    (*m.mutable_preparation()->mutable_params())[name] = value;
+  m.set_real_median_radius(model.real_median_radius);
+  return m;
+}
+
 lab::MaterialModel job_material(const v1::JobSpec& job) {
-  lab::MaterialModel model = to_material_model(job.material(), "job.material");
-  std::map<std::string, double> ordered(job.parameters().begin(), job.parameters().end());
-  for (const auto& [path, value] : ordered) lab::set_parameter(model, path, value);
-  model.validate();
-  return model;
+  return lab::with_run_parameters(
+      to_material_model(job.material(), "job.material"),
+      std::map<std::string, double>(job.parameters().begin(), job.parameters().end()));
 }
 
 std::uint64_t job_seed(const v1::JobSpec& job) {

@@ -17,6 +17,10 @@ namespace demcal::rpc {
 /// ("spec.material.particle_law.normal.params.k1").
 lab::MaterialModel to_material_model(const v1::Material& material, const std::string& where);
 
+/// The proto form of a material model: to_material_model of it gives the model back, value for
+/// value (every slot, size, shape and preparation parameter written out).
+v1::Material to_material_message(const lab::MaterialModel& model);
+
 /// The material of a job: its base material with the job's parameters set (factor values and
 /// fixed parameters).
 lab::MaterialModel job_material(const v1::JobSpec& job);

@@ -23,7 +23,6 @@ constexpr std::uint64_t kVerifySeedOffset = 1'000'000;
 
 /// Everything the calibration of one campaign knows, read from the store.
 struct Loaded {
-  v1::CampaignSpec spec;
   CampaignPlan plan;
   std::vector<JobRow> jobs;
   std::vector<CalibrationRoundRow> round_rows;
@@ -37,14 +36,6 @@ struct Loaded {
   std::vector<calib::FidelityModel> fidelity;
   Eigen::MatrixXd low, high;
 };
-
-/// The polynomial models the calibration fits: main or 2fi (two-level designs).
-doe::ModelKind polynomial_model(const std::string& text, const std::string& where) {
-  const doe::ModelKind m = doe::parse_model_kind(text, where);
-  if (m != doe::ModelKind::kMain && m != doe::ModelKind::kTwoFactor)
-    throw InputError(where, "the calibration fits main or 2fi models");
-  return m;
-}
 
 bool is_calibration_job(const JobRow& j) {
   return (j.kind == job_kind::kVerify && j.std_order > 0) || job_kind::is_stage(j.kind);
@@ -153,18 +144,16 @@ void add_targets(Loaded& l) {
   }
 }
 
-Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& req,
+Loaded load(Store& store, const CampaignRow& row, const CalibrateCall& call,
             std::function<void()> interrupt = {}) {
   Loaded l;
-  l.spec = spec_from_json(row.spec_json);
-  l.plan = plan_from_json(row.design_json);
+  l.plan = stored_plan(row);
   l.jobs = store.jobs(row.id);
   l.round_rows = store.calibration_rounds(row.id);
-  l.options = calibration_options(l.spec.calibration(), "spec.calibration");
-  if (!req.model().empty()) l.options.model = polynomial_model(req.model(), "model");
-  if (req.starts() < 0 || req.starts() > 1000) throw InputError("starts", "must lie in [0, 1000]");
-  l.options.calibration.starts = req.starts() > 0 ? req.starts() : 16;
-  l.options.calibration.seed = req.seed() ? req.seed() : 1;
+  l.options = l.plan.calibration;
+  if (call.model) l.options.model = *call.model;
+  l.options.calibration.starts = call.starts;
+  l.options.calibration.seed = call.seed;
   l.options.calibration.interrupt = std::move(interrupt);
   if (l.plan.targets.empty())
     throw InputError("spec.measurements", "the campaign has no measurements to calibrate against");
@@ -179,7 +168,7 @@ Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& re
   auto& s = l.state;
   s.factors.clear();
   for (const auto& f : l.plan.factors) s.factors.push_back(f.factor);
-  s.jobs_per_point = std::max(1, l.spec.tests_size());
+  s.jobs_per_point = std::max(1, static_cast<int>(l.plan.instances.size()));
   s.stages.push_back(stage_runs(l, columns, s.factors, job_kind::kDesign));
   if (l.plan.fidelity) correct_design(l);
   add_targets(l);
@@ -201,7 +190,7 @@ Loaded load(Store& store, const CampaignRow& row, const v1::CalibrateRequest& re
     l.pending = l.pending || is_open(j);
   }
   // One GP batch keeps every worker busy: as many points as workers have run this campaign.
-  if (l.spec.calibration().batch() == 0)
+  if (l.plan.batch_per_worker)
     l.options.batch = std::clamp(static_cast<int>(workers.size()), 1, 64);
   return l;
 }
@@ -306,7 +295,6 @@ void set_proposed(v1::CalibrateReply& reply, const Loaded& l, const Eigen::Vecto
 std::vector<std::int64_t> queue_rounds(Store& store, const CampaignRow& row, const Loaded& l,
                                        const calib::SequentialDecision& d) {
   const int batch = l.state.rounds.empty() ? 1 : l.state.rounds.back().batch + 1;
-  const bool pinned = l.spec.design().simulation_seeds() == v1::Design::PINNED;
   std::vector<std::int64_t> ids;
   int round = static_cast<int>(l.round_rows.size());
   for (std::size_t b = 0; b < d.batch.size(); ++b) {
@@ -314,9 +302,9 @@ std::vector<std::int64_t> queue_rounds(Store& store, const CampaignRow& row, con
     std::map<std::string, double> parameters;
     for (std::size_t f = 0; f < l.plan.factors.size(); ++f)
       parameters[l.plan.factors[f].path] = d.batch[b](Eigen::Index(f));
-    const auto jobs = jobs_at(at_fidelity(l.spec, l.plan, true), l.spec.material(), parameters,
-                              round, std::string(job_kind::kVerify),
-                              pinned ? 0 : kVerifySeedOffset + std::uint64_t(round));
+    const auto jobs = jobs_of(
+        l.plan, runs_at(l.plan, parameters, true, round, std::string(job_kind::kVerify),
+                        l.plan.pinned_seeds ? 0 : kVerifySeedOffset + std::uint64_t(round)));
     const auto queued = store.add_calibration_round(
         row.id,
         {round, d.stage, proposal_to_json(d.batch[b], d.batch_predicted[b], l.responses, batch),
@@ -334,8 +322,10 @@ std::vector<std::int64_t> queue_stage(Store& store, const CampaignRow& row, cons
   const int stage = d.stage + 1;
   std::vector<PlannedFactor> box = l.plan.factors;
   for (std::size_t f = 0; f < box.size(); ++f) box[f].factor = d.next_box[f];
-  const auto jobs = design_jobs(at_fidelity(l.spec, l.plan, false), l.plan, box,
-                                job_kind::stage(stage), (stage - 1) * l.plan.design.runs());
+  const auto runs =
+      design_runs(l.plan, box, job_kind::stage(stage), (stage - 1) * l.plan.design.runs(), false);
+  admit_runs(l.plan, runs);
+  const auto jobs = jobs_of(l.plan, runs);
   spdlog::info("campaign {}: calibration stage {} queued ({} jobs)", row.id, stage, jobs.size());
   return store.add_calibration_stage(row.id, {stage, box_to_json(d.next_box), now_seconds()}, jobs);
 }
@@ -388,30 +378,11 @@ v1::FidelityCost fidelity_cost(const CampaignPlan& plan, const std::vector<JobRo
     }
   }
   if (c.high_jobs() > 0) {
-    const double per_row = static_cast<double>(plan.tests.size()) * c.high_particle_steps() /
+    const double per_row = static_cast<double>(plan.instances.size()) * c.high_particle_steps() /
                            static_cast<double>(c.high_jobs());
     c.set_all_high_particle_steps(per_row * plan.design.runs());
   }
   return c;
-}
-
-calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
-                                             const std::string& where) {
-  calib::SequentialOptions o;
-  if (spec.rounds()) o.rounds = spec.rounds();
-  if (spec.stages()) o.stages = spec.stages();
-  if (spec.narrow() != 0.0) o.narrow = spec.narrow();
-  o.max_jobs = spec.max_jobs();
-  if (spec.surrogate() == "gp")
-    o.surrogate = calib::Surrogate::kGaussianProcess;
-  else if (!spec.surrogate().empty() && spec.surrogate() != "polynomial")
-    throw InputError(where + ".surrogate",
-                     "unknown surrogate '" + spec.surrogate() + "' (polynomial or gp)");
-  if (spec.batch() < 0) throw InputError(where + ".batch", "must be >= 0");
-  if (spec.batch() > 0) o.batch = spec.batch();
-  if (!spec.model().empty()) o.model = polynomial_model(spec.model(), where + ".model");
-  o.validate(where);
-  return o;
 }
 
 std::vector<v1::CalibrationRound> calibration_rounds(Store& store, const CampaignRow& row) {
@@ -423,9 +394,8 @@ std::vector<v1::CalibrationRound> calibration_rounds(Store& store, const Campaig
 }
 
 v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
-                                      const v1::CalibrateRequest& request,
-                                      std::function<void()> interrupt) {
-  const Loaded l = load(store, row, request, std::move(interrupt));
+                                      const CalibrateCall& call, std::function<void()> interrupt) {
+  const Loaded l = load(store, row, call, std::move(interrupt));
   v1::CalibrateReply reply;
   reply.set_surrogate(l.options.surrogate == calib::Surrogate::kGaussianProcess ? "gp"
                                                                                 : "polynomial");
@@ -460,10 +430,8 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
   add_trade_offs(reply, l, d.proposal);
   if (l.plan.fidelity) add_fidelity(reply, l);
   std::vector<std::int64_t> queued;
-  if (request.verify() && d.step == calib::NextStep::kVerify)
-    queued = queue_rounds(store, row, l, d);
-  if (request.verify() && d.step == calib::NextStep::kNewStage)
-    queued = queue_stage(store, row, l, d);
+  if (call.verify && d.step == calib::NextStep::kVerify) queued = queue_rounds(store, row, l, d);
+  if (call.verify && d.step == calib::NextStep::kNewStage) queued = queue_stage(store, row, l, d);
   for (const auto id : queued) reply.add_verification_jobs(id);
   const int simulations = l.state.jobs_used + static_cast<int>(queued.size());
   reply.set_simulations(simulations);
@@ -472,7 +440,7 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
     reply.set_conclusion(d.conclusion);
   } else {
     reply.set_verification_state(l.state.rounds.empty() ? "none" : "done");
-    if (request.verify() || d.step == calib::NextStep::kDone)
+    if (call.verify || d.step == calib::NextStep::kDone)
       reply.set_conclusion(d.conclusion);
     else if (l.state.rounds.empty())
       reply.set_conclusion("proposal not verified yet (calibrate --verify)");

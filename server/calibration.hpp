@@ -9,14 +9,11 @@
 
 #include "core/calib/sequential.hpp"
 #include "demcal/v1/campaign.pb.h"
+#include "server/convert.hpp"
 #include "server/plan.hpp"
 #include "server/store.hpp"
 
 namespace demcal::server {
-
-/// The spec's calibration options with their defaults; InputError names `where`.<field>.
-calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
-                                             const std::string& where);
 
 /// One Calibrate call: the current proposal, every round so far, and the conclusion. With
 /// `verify` it advances the loop (queues a round or a stage design) when nothing is running.
@@ -24,7 +21,7 @@ calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
 /// `interrupt` is called before every start of every minimisation (calib::CalibrationOptions)
 /// and throws calib::Interrupted when nobody waits for the answer any more.
 v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
-                                      const v1::CalibrateRequest& request,
+                                      const CalibrateCall& call,
                                       std::function<void()> interrupt = {});
 
 /// Particle-steps of a multi-fidelity campaign's finished jobs by level (design and stages at

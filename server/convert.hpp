@@ -1,11 +1,16 @@
 #pragma once
-// The coordinator's edge: proto messages in, domain values out, and back. Nothing else in
-// server/ reads a proto field for domain logic.
+// The coordinator's edge: proto messages in, domain values out, and back. The plan
+// (plan_spec.hpp) reads the campaign's spec; nothing else in server/ reads a proto field for
+// domain logic.
+#include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/doe/analysis.hpp"
+#include "core/doe/model_fit.hpp"
+#include "demcal/v1/campaign.pb.h"
 #include "demcal/v1/worker.pb.h"
 #include "server/analysis.hpp"
 #include "server/plan.hpp"
@@ -16,33 +21,15 @@ namespace demcal::server {
 /// A number in an error message: six significant digits.
 std::string fmt(double v);
 
-/// Validates a spec and plans it; InputError names the field ("spec.factors[2].high").
-/// Factor paths must exist in the material's parameter table (lab::parameters) with bounds
-/// inside the valid range; tests, settings and measured metrics must exist in the catalogue.
-CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs);
-
-/// The name of a test instance, which its responses carry ("<name>.<metric>"): its `name`, or the
-/// lab test's when it has none.
-std::string instance_name(const v1::LabTest& test);
-
-/// Jobs that simulate each test of the spec with `material` at one parameter set (the spec's
-/// fixed parameters, then `parameters`), as design row `std_order` of job kind `kind`, with
-/// the test's seed + `seed_offset`.
-std::vector<NewJob> jobs_at(const v1::CampaignSpec& spec, const v1::Material& material,
-                            const std::map<std::string, double>& parameters, int std_order,
-                            const std::string& kind, std::uint64_t seed_offset = 0);
-
-/// One job per design row and test, the plan's design laid over `box` (the campaign's factors
-/// or a calibration stage's narrowed box), of job kind `kind`. Seeds: see Design.Seeds in the
-/// proto; a later stage adds `stage_offset` to keep its runs' seeds apart from the first.
-/// With `rows` (1-based standard order), only those rows.
-std::vector<NewJob> design_jobs(const v1::CampaignSpec& spec, const CampaignPlan& plan,
-                                const std::vector<PlannedFactor>& box, const std::string& kind,
-                                int stage_offset, const std::vector<int>* rows = nullptr);
-
-/// The spec at one level of the plan's fidelity axis (the low or the high value in every test
-/// instance that has the setting, or as a fixed material parameter); the spec itself without one.
-v1::CampaignSpec at_fidelity(const v1::CampaignSpec& spec, const CampaignPlan& plan, bool high);
+/// A Calibrate call's arguments: the model the surrogate fits (the campaign's when none), the
+/// minimiser's starts and seed, and whether to advance the loop. InputError naming the field.
+struct CalibrateCall {
+  std::optional<doe::ModelKind> model;
+  int starts = 16;
+  std::uint64_t seed = 1;
+  bool verify = false;
+};
+CalibrateCall calibrate_call(const v1::CalibrateRequest& request);
 
 v1::DesignSummary design_summary(const CampaignPlan& plan, int jobs);
 v1::DesignReply design_reply(const CampaignPlan& plan, int jobs);

@@ -10,27 +10,13 @@
 #include "core/common/error.hpp"
 #include "core/diagnose/diagnosis.hpp"
 #include "core/model/material.hpp"
-#include "rpc/material_convert.hpp"
+#include "core/model/preparation.hpp"
 #include "server/analysis.hpp"
 #include "server/convert.hpp"
 #include "server/plan.hpp"
 
 namespace demcal::server {
 namespace {
-
-constexpr std::string_view kPrefix = "diagnose:";
-
-/// Lab seeds per verification at most: each multiplies the diagnosis's verification runs.
-constexpr int kMaxReplicates = 16;
-
-/// An option: `fallback` when unset (0), else `v` if lo < v <= hi.
-double option(double v, double fallback, double lo, double hi, const std::string& field) {
-  if (v == 0.0) return fallback;
-  if (!(v > lo && v <= hi))
-    throw InputError(field, "must be 0 (the default, " + fmt(fallback) + ") or in (" + fmt(lo) +
-                                ", " + fmt(hi) + "]");
-  return v;
-}
 
 /// The material's one median radius as its model states it (real, times sizes.scale; m), 0 for
 /// discrete classes, which have none the size distribution states.
@@ -46,14 +32,14 @@ double median_radius(const lab::MaterialModel& model) {
 /// cohesive parameters (the cohesion slots' in J) the Bond number holds, at the spec's fixed
 /// values: the particle law's, and the wall law's unless a test instance has a wall law of its
 /// own (whose walls then keep their adhesion: a wall path sets every instance's wall law).
-void describe_size(const v1::CampaignSpec& spec, diagnose::Problem& p) {
-  lab::MaterialModel model = rpc::to_material_model(spec.material(), "spec.material");
-  for (const auto& [path, value] : spec.fixed()) lab::set_parameter(model, path, value);
+void describe_size(const CampaignPlan& plan, diagnose::Problem& p) {
+  const lab::MaterialModel model = lab::with_run_parameters(plan.material, plan.fixed);
   p.median_radius = median_radius(model);
   p.real_median_radius = model.real_median_radius;
   p.size_scale = model.size_scale;
-  const bool own_walls = std::any_of(spec.tests().begin(), spec.tests().end(),
-                                     [](const v1::LabTest& t) { return t.has_wall_law(); });
+  const bool own_walls = std::any_of(
+      plan.instances.begin(), plan.instances.end(),
+      [&](const PlannedInstance& i) { return i.material.wall_law != plan.material.wall_law; });
   for (const auto& info : lab::parameters(model)) {
     const bool cohesion = info.path.starts_with("particle_law.cohesion.") ||
                           (!own_walls && info.path.starts_with("wall_law.cohesion."));
@@ -62,8 +48,8 @@ void describe_size(const v1::CampaignSpec& spec, diagnose::Problem& p) {
   }
 }
 
-diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan& plan,
-                               const std::vector<JobRow>& jobs, std::uint64_t seed) {
+diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRow>& jobs,
+                               std::uint64_t seed) {
   diagnose::Problem p;
   for (const auto& f : plan.factors) p.factors.push_back({f.path, f.factor});
   p.design = plan.design.coded;
@@ -71,21 +57,20 @@ diagnose::Problem make_problem(const v1::CampaignSpec& spec, const CampaignPlan&
   p.results = response_matrix(plan, jobs);
   for (const auto& t : plan.targets)
     p.measurements.push_back({t.response, t.value, t.weight, t.uncertainty, t.holdout});
-  const auto& m = spec.material();
-  p.shape_kind = m.shape().kind().empty() ? "sphere" : m.shape().kind();
-  p.rolling_model =
-      m.particle_law().rolling().model().empty() ? "none" : m.particle_law().rolling().model();
-  p.size_kind = m.sizes().has_monodisperse() ? "monodisperse" : "distribution";
-  for (const auto& [path, value] : spec.fixed()) p.fixed[path] = value;
-  const auto model = rpc::to_material_model(m, "spec.material");
+  const auto& model = plan.material;
+  p.shape_kind = particles::shape_kind_name(model.shape.kind);
+  p.rolling_model = model.particle_law.rolling.model;
+  p.size_kind = std::holds_alternative<particles::Monodisperse>(model.sizes) ? "monodisperse"
+                                                                             : "distribution";
+  p.fixed = plan.fixed;
   p.cohesion_model = model.particle_law.cohesion.model;
   p.preparation = lab::preparation_method_name(model.preparation.method);
-  for (const auto& t : spec.tests())
-    p.preparable &= lab::accepts_preparation(t.test(), lab::PreparationMethod::kClusters);
+  for (const auto& i : plan.instances)
+    p.preparable &= lab::accepts_preparation(i.test, lab::PreparationMethod::kClusters);
   p.agitation_time_max = lab::default_agitation_time(model);
   for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
-  describe_size(spec, p);
-  p.options = diagnose_options(spec.diagnose(), "spec.diagnose");
+  describe_size(plan, p);
+  p.options = plan.diagnosis;
   p.options.seed = seed ? seed : 1;
   return p;
 }
@@ -96,8 +81,8 @@ std::map<std::string, diagnose::GroupResults> finished_groups(const std::vector<
                                                               const CampaignPlan& plan) {
   std::map<std::pair<std::string, int>, std::vector<const JobRow*>> rows;
   for (const auto& j : jobs)
-    if (j.kind.starts_with(kPrefix))
-      rows[{j.kind.substr(kPrefix.size()), j.std_order}].push_back(&j);
+    if (job_kind::is_diagnosis(j.kind))
+      rows[{job_kind::diagnosis_group(j.kind), j.std_order}].push_back(&j);
   std::map<std::string, diagnose::GroupResults> out;
   for (const auto& [key, row_jobs] : rows) {
     bool ended = true;
@@ -111,33 +96,6 @@ std::map<std::string, diagnose::GroupResults> finished_groups(const std::vector<
           values[j->test + "." + metric] = value;
   }
   return out;
-}
-
-/// The campaign's material with a candidate's model switches applied. A rolling model switched
-/// on starts at mu_r = 0 so that a wall law copied from the particle law has none.
-v1::Material switched(const v1::Material& base, const std::map<std::string, std::string>& sw) {
-  v1::Material m = base;
-  for (const auto& [what, value] : sw) {
-    if (what == "shape") {
-      m.mutable_shape()->set_kind(value);
-    } else if (what == "particle_law.rolling") {
-      auto* slot = m.mutable_particle_law()->mutable_rolling();
-      slot->set_model(value);
-      (*slot->mutable_params())["mu_r"] = 0.0;
-    } else if (what == "preparation") {
-      // Only the method: the run sets its parameter (the agitation time).
-      m.mutable_preparation()->set_method(value);
-    } else if (what == "sizes" && value == "lognormal" && m.sizes().has_monodisperse()) {
-      // One size becomes the median of a log-normal number distribution; the run sets sigma_g.
-      const double radius = m.sizes().monodisperse().radius();
-      auto* ln = m.mutable_sizes()->mutable_lognormal();
-      ln->set_median_radius(radius);
-      ln->set_sigma_g(diagnose::kSigmaGLow);
-    } else {
-      throw InputError("diagnose", "unknown model switch " + what);
-    }
-  }
-  return m;
 }
 
 // A value the diagnosis does not know yet is NaN (diagnosis.hpp, kPending): its optional field
@@ -212,31 +170,10 @@ v1::DiagnosisReport report_message(const diagnose::Report& r) {
 
 }  // namespace
 
-diagnose::Options diagnose_options(const v1::DiagnoseOptions& o, const std::string& where) {
-  // Ranges: the parameter tables' (rods up to aspect ratio 20, mu_r up to 10, sigma_g up to 10),
-  // a fixed parameter at most 100 x off, a margin below 1 (an error cut by 100 % cannot be).
-  diagnose::Options out;
-  out.candidates.assign(o.candidates().begin(), o.candidates().end());
-  out.aspect_ratio_max =
-      option(o.aspect_ratio_max(), out.aspect_ratio_max, 1.0, 20.0, where + ".aspect_ratio_max");
-  out.rolling_max = option(o.rolling_max(), out.rolling_max, 0.0, 10.0, where + ".rolling_max");
-  out.sigma_g_max =
-      option(o.sigma_g_max(), out.sigma_g_max, diagnose::kSigmaGLow, 10.0, where + ".sigma_g_max");
-  out.fixed_span = option(o.fixed_span(), out.fixed_span, 1.0, 100.0, where + ".fixed_span");
-  out.margin = option(o.margin(), out.margin, 0.0, 0.99, where + ".margin");
-  if (o.replicates() < 0 || o.replicates() > kMaxReplicates)
-    throw InputError(where + ".replicates", "must be 0 (the default, 1) or in [1, " +
-                                                std::to_string(kMaxReplicates) + "]");
-  if (o.replicates() > 0) out.replicates = o.replicates();
-  return out;
-}
-
 v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::uint64_t seed,
                                     bool read_only) {
   v1::DiagnoseReply reply;
-  const CampaignPlan plan = plan_from_json(row.design_json);
-  v1::CampaignSpec spec;
-  from_json(row.spec_json, spec);
+  const CampaignPlan plan = stored_plan(row);
   const auto jobs = store.jobs(row.id);
   const auto design = store.counts(row.id, "design");
   if (design.queued + design.leased > 0) {
@@ -245,16 +182,18 @@ v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::u
                          " of " + std::to_string(design.total()) + " done)");
     return reply;
   }
-  const auto step =
-      diagnose::advance(make_problem(spec, plan, jobs, seed), finished_groups(jobs, plan));
+  const auto step = diagnose::advance(make_problem(plan, jobs, seed), finished_groups(jobs, plan));
   std::set<std::pair<std::string, int>> stored;
   for (const auto& j : jobs) stored.insert({j.kind, j.std_order});
   std::vector<NewJob> fresh;
   for (const auto& req : step.requests) {
-    const std::string kind = std::string(kPrefix) + req.group;
+    const std::string kind = job_kind::diagnosis(req.group);
     if (stored.count({kind, req.row})) continue;
-    const auto add = jobs_at(spec, switched(spec.material(), req.switches), req.parameters, req.row,
-                             kind, static_cast<std::uint64_t>(req.replicate));
+    // At the low fidelity level: the level of the design the diagnosis fits.
+    const auto add = jobs_of(plan,
+                             runs_at(plan, req.parameters, false, req.row, kind,
+                                     static_cast<std::uint64_t>(req.replicate)),
+                             req.switches);
     fresh.insert(fresh.end(), add.begin(), add.end());
   }
   if (read_only) fresh.clear();

@@ -1,20 +1,41 @@
 #pragma once
-// A validated campaign in domain terms: the factors (parameter paths with their doe::Factor
-// boxes), the design, the responses (test.metric) and the measured targets. Built from the
-// proto spec in convert.cpp; stored as JSON in campaigns.design_json so that analysis after a
-// restart uses exactly the design that was run.
+// The validated campaign as one domain value, the plan: its test instances (settings at each
+// fidelity level, material models), fixed values, factors and ties, design, responses and
+// targets, fidelity axis, and calibration and diagnosis options. Built once from the spec at
+// Submit (plan_campaign, the only reader of the spec's fields), stored in campaigns.design_json,
+// and read back by every RPC that needs the campaign (Calibrate, Diagnose, GetEffects, Export):
+// none of them reads the spec again. The jobs of a campaign are built from it here.
+#include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/calib/sequential.hpp"
+#include "core/diagnose/diagnosis.hpp"
 #include "core/doe/design.hpp"
 #include "core/doe/factor.hpp"
+#include "core/model/catalog.hpp"
+#include "core/model/material.hpp"
+#include "demcal/v1/campaign.pb.h"
+#include "server/store.hpp"
 
 namespace demcal::server {
 
+/// One test instance: a lab test under a name of its own (its responses are "<name>.<metric>").
+struct PlannedInstance {
+  std::string name, test;
+  lab::Settings settings_low;   ///< its settings as given, or at the low fidelity level
+  lab::Settings settings_high;  ///< at the high fidelity level (= settings_low without one)
+  lab::MaterialModel material;  ///< the campaign's, with the instance's own wall law
+  std::uint64_t seed = 1;       ///< the simulation seed of its first design row
+  int threads = 0;              ///< 0 = the worker's --threads
+};
+
 struct PlannedFactor {
   std::string path;
-  doe::Factor factor;  ///< factor.name = the label shown in tables
+  doe::Factor factor;             ///< factor.name = the label shown in tables
+  std::vector<std::string> tied;  ///< paths set to the factor's value in every run
 };
 
 struct Target {
@@ -34,15 +55,76 @@ struct FidelityPlan {
 };
 
 struct CampaignPlan {
+  lab::MaterialModel material;          ///< the campaign's, without its fixed values
+  std::map<std::string, double> fixed;  ///< parameter path -> value, in every run
+  std::vector<PlannedInstance> instances;
   std::vector<PlannedFactor> factors;
   doe::Design design;
-  std::vector<std::string> tests;
-  std::vector<std::string> responses;  ///< test.metric, tests in spec order
+  /// Repeated points share their seed (Design.Seeds PINNED) instead of each row its own.
+  bool pinned_seeds = false;
+  std::vector<std::string> responses;  ///< instance.metric, instances in spec order
   std::vector<Target> targets;
   std::optional<FidelityPlan> fidelity;
+  calib::SequentialOptions calibration;
+  /// The calibration verifies as many points per batch as workers ran the campaign (no batch
+  /// size in the spec).
+  bool batch_per_worker = true;
+  diagnose::Options diagnosis;
 };
 
+/// The instances' names, in spec order.
+std::vector<std::string> instance_names(const CampaignPlan& plan);
+
+/// Validates a spec and plans it, with the jobs of its design; InputError names the field
+/// ("spec.factors[2].high"). Factor paths must exist in the material's parameter table
+/// (lab::parameters) with bounds inside the valid range; tests, settings and measured metrics
+/// must exist in the catalogue; every job is admitted as a worker would admit it.
+CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jobs);
+
+/// The plan as stored in campaigns.design_json, and back. A campaign stored before the plan held
+/// the whole campaign (its design_json has no "form") is read with its stored spec: the plan of
+/// `row`.
 std::string plan_to_json(const CampaignPlan& plan);
-CampaignPlan plan_from_json(const std::string& json);
+CampaignPlan stored_plan(const CampaignRow& row);
+
+/// The parameters a run sets on its material at the given factor values (path -> natural): the
+/// fixed values, a fidelity parameter's level, the factors' and each factor's tied paths.
+std::map<std::string, double> run_parameters(const CampaignPlan& plan,
+                                             const std::map<std::string, double>& factors,
+                                             bool high);
+
+/// One planned simulation: an instance at a parameter set, a fidelity level and a seed, as row
+/// `std_order` of job kind `kind`.
+struct PlannedRun {
+  std::size_t instance = 0;  ///< into CampaignPlan::instances
+  int std_order = 0, run_order = 0;
+  std::string kind;
+  std::map<std::string, double> parameters;  ///< run_parameters
+  bool high = false;
+  std::uint64_t seed = 1;
+};
+
+/// One run per design row and instance, the plan's design laid over `box` (the campaign's
+/// factors or a calibration stage's narrowed box), at the low fidelity level (`high`: the high).
+/// Seeds: see Design.Seeds in the proto; a later stage adds `stage_offset` to keep its runs'
+/// seeds apart from the first. With `rows` (1-based standard order), only those rows.
+std::vector<PlannedRun> design_runs(const CampaignPlan& plan, const std::vector<PlannedFactor>& box,
+                                    const std::string& kind, int stage_offset, bool high,
+                                    const std::vector<int>* rows = nullptr);
+
+/// One run per instance at one parameter set (run_parameters of `factors`), as row `std_order`,
+/// with the instance's seed + `seed_offset`.
+std::vector<PlannedRun> runs_at(const CampaignPlan& plan,
+                                const std::map<std::string, double>& factors, bool high,
+                                int std_order, const std::string& kind, std::uint64_t seed_offset);
+
+/// The jobs that simulate the runs, each instance's material under the diagnosis's model
+/// `switches` (lab::with_switches; none: as planned).
+std::vector<NewJob> jobs_of(const CampaignPlan& plan, const std::vector<PlannedRun>& runs,
+                            const std::map<std::string, std::string>& switches = {});
+
+/// Every rule a worker checks before it simulates, on runs planned after Submit (plan_campaign
+/// admits its own); InputError naming the instance's settings and the row.
+void admit_runs(const CampaignPlan& plan, const std::vector<PlannedRun>& runs);
 
 }  // namespace demcal::server

@@ -15,18 +15,6 @@
 namespace demcal::server {
 namespace {
 
-std::string scaling_law_name(contact::ScalingLaw law) {
-  switch (law) {
-    case contact::ScalingLaw::kNone:
-      return "none";
-    case contact::ScalingLaw::kKottlan2018:
-      return "kottlan2018";
-    case contact::ScalingLaw::kTiscar2019:
-      return "tiscar2019";
-  }
-  throw std::logic_error("scaling law without a name");
-}
-
 nlohmann::json law_models(const contact::ContactLawSpec& law) {
   return {{"normal", law.normal.model},
           {"cohesion", law.cohesion.model},
@@ -51,7 +39,7 @@ nlohmann::json material_choices(const lab::MaterialModel& m) {
   return {{"particle_law", law_models(m.particle_law)},
           {"wall_law", law_models(m.wall_law)},
           {"sizes", std::move(sizes)},
-          {"scaling", scaling_law_name(m.scaling)},
+          {"scaling", contact::scaling_law_name(m.scaling)},
           {"shape", particles::shape_kind_name(m.shape.kind)},
           {"preparation", lab::preparation_method_name(m.preparation.method)}};
 }

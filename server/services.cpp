@@ -224,7 +224,7 @@ grpc::Status CampaignServiceImpl::Get(grpc::ServerContext* ctx, const v1::GetReq
   try {
     *reply = campaign_message(*row, store_.counts(row->id), now_seconds(), true);
     for (auto& r : calibration_rounds(store_, *row)) *reply->add_calibration_rounds() = r;
-    const CampaignPlan plan = plan_from_json(row->design_json);
+    const CampaignPlan plan = stored_plan(*row);
     if (plan.fidelity) *reply->mutable_fidelity_cost() = fidelity_cost(plan, store_.jobs(row->id));
   } catch (const std::exception& e) {
     return internal(e);
@@ -297,7 +297,7 @@ grpc::Status CampaignServiceImpl::GetDesign(grpc::ServerContext* ctx, const v1::
   if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
-  *reply = design_reply(plan_from_json(row->design_json), int(store_.counts(row->id).total()));
+  *reply = design_reply(stored_plan(*row), int(store_.counts(row->id).total()));
   return grpc::Status::OK;
 }
 
@@ -320,7 +320,7 @@ grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   try {
-    const CampaignPlan plan = plan_from_json(row->design_json);
+    const CampaignPlan plan = stored_plan(*row);
     const auto jobs = store_.jobs(row->id);
     const Eigen::MatrixXd y = response_matrix(plan, jobs);
     const auto flagged = flagged_runs(jobs);
@@ -379,7 +379,7 @@ grpc::Status CampaignServiceImpl::Calibrate(grpc::ServerContext* ctx,
     std::lock_guard lock(calibrate_mutex_);
     // A call whose client has gone (deadline, Ctrl-C) or that shutdown waits for stops at the
     // next start of its minimisations instead of holding the lock for the next caller.
-    *reply = calibrate_campaign(store_, *row, *req, [ctx, this] {
+    *reply = calibrate_campaign(store_, *row, calibrate_call(*req), [ctx, this] {
       if (ctx->IsCancelled()) throw calib::Interrupted("its client went away");
       if (stopping_) throw calib::Interrupted("the coordinator is stopping");
     });
@@ -435,7 +435,7 @@ grpc::Status CampaignServiceImpl::Export(grpc::ServerContext* ctx, const v1::Exp
     } else {
       const auto series =
           req->series() ? store_.series(row->id) : std::map<std::int64_t, std::string>{};
-      content = export_campaign(*row, plan_from_json(row->design_json), store_.jobs(row->id),
+      content = export_campaign(*row, stored_plan(*row), store_.jobs(row->id),
                                 calibration_rounds(store_, *row), format,
                                 req->series() ? &series : nullptr);
     }

@@ -6,22 +6,6 @@
 
 namespace demcal::server {
 
-namespace job_kind {
-
-namespace {
-constexpr std::string_view kStagePrefix = "stage:";
-}  // namespace
-
-std::string stage(int n) {
-  return std::string(kStagePrefix) + std::to_string(n);
-}
-
-bool is_stage(std::string_view kind) {
-  return kind.starts_with(kStagePrefix);
-}
-
-}  // namespace job_kind
-
 namespace {
 
 Eigen::VectorXd vector_of(const nlohmann::json& j) {

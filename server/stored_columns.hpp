@@ -1,8 +1,8 @@
 #pragma once
 // What the store's text columns hold (server/store.hpp), written and read in one place: the
 // campaign's spec, a job's payload, a result's metrics, flags, cost and curves, a calibration
-// stage's box and a calibration round's proposal; and the job kinds of jobs.kind. The campaign's
-// design (campaigns.design_json) is the plan's own JSON (plan.hpp: plan_to_json, plan_from_json).
+// stage's box and a calibration round's proposal (jobs.kind: rpc/job_kind.hpp). The campaign's
+// design (campaigns.design_json) is the plan's own JSON (plan.hpp: plan_to_json, stored_plan).
 #include <Eigen/Dense>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -14,23 +14,10 @@
 #include "core/doe/factor.hpp"
 #include "demcal/v1/campaign.pb.h"
 #include "demcal/v1/worker.pb.h"
+#include "rpc/job_kind.hpp"
 #include "server/plan.hpp"
 
 namespace demcal::server {
-
-/// jobs.kind: what a job is for. The diagnosis's jobs have the kind "diagnose:<group>"
-/// (server/diagnosis.cpp).
-namespace job_kind {
-/// A row of the campaign's design (std_order = the row).
-inline constexpr std::string_view kDesign = "design";
-/// A design row of a multi-fidelity campaign, run at the high fidelity level as well.
-inline constexpr std::string_view kHighDesign = "design:high";
-/// A job of a calibration round (std_order = the round).
-inline constexpr std::string_view kVerify = "verify";
-/// "stage:<n>": a design row laid over the box of the calibration's stage n.
-std::string stage(int n);
-bool is_stage(std::string_view kind);
-}  // namespace job_kind
 
 /// A JSON column as the document it holds, its values as stored (the export embeds them so).
 nlohmann::json column_document(const std::string& column);

@@ -29,9 +29,11 @@ using RollingModel = std::variant<rolling::None, rolling::Cdt, rolling::Epsd>;
 struct SlotSpec {
   std::string model;
   std::map<std::string, double> params;
+  bool operator==(const SlotSpec&) const = default;
 };
 struct ContactLawSpec {
   SlotSpec normal, cohesion{"none", {}}, tangential, rolling{"none", {}};
+  bool operator==(const ContactLawSpec&) const = default;
 };
 
 struct ContactLaw {

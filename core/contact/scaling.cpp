@@ -1,6 +1,7 @@
 #include "core/contact/scaling.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace demcal::contact {
 namespace {
@@ -65,6 +66,18 @@ ScalingLaw scaling_law_from_name(const std::string& name, const std::string& whe
   if (name == "tiscar2019") return ScalingLaw::kTiscar2019;
   throw InputError(where,
                    "unknown scaling law '" + name + "' (known: none, kottlan2018, tiscar2019)");
+}
+
+std::string scaling_law_name(ScalingLaw law) {
+  switch (law) {
+    case ScalingLaw::kNone:
+      return "none";
+    case ScalingLaw::kKottlan2018:
+      return "kottlan2018";
+    case ScalingLaw::kTiscar2019:
+      return "tiscar2019";
+  }
+  throw std::logic_error("scaling law without a name");
 }
 
 ContactLaw scale(const ContactLaw& law, const ScaleFactors& f) {

@@ -33,6 +33,8 @@ struct ScaleFactors {
 /// The factors simulated / real for a law and its factor (SF or lambda).
 ScaleFactors scale_factors(ScalingLaw law, double factor);
 ScalingLaw scaling_law_from_name(const std::string& name, const std::string& where);
+/// The name scaling_law_from_name reads.
+std::string scaling_law_name(ScalingLaw law);
 
 /// The simulated law: every parameter multiplied by the factor of its unit.
 ContactLaw scale(const ContactLaw& law, const ScaleFactors& f);

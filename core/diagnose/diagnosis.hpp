@@ -36,12 +36,13 @@
 #include <vector>
 
 #include "core/doe/factor.hpp"
+#include "core/particles/size_distribution.hpp"
 
 namespace demcal::diagnose {
 
 inline constexpr double kPending = std::numeric_limits<double>::quiet_NaN();
 /// size_distribution: the narrowest log-normal width it runs (sigma_g = 1 is one size).
-inline constexpr double kSigmaGLow = 1.01;
+inline constexpr double kSigmaGLow = particles::kNarrowestLogNormal;
 /// preparation: the shortest agitation it runs, as a fraction of the longest (an agitation
 /// time of 0 is pouring; the preparation reads 0 as "the default").
 inline constexpr double kAgitationLowFraction = 1e-3;

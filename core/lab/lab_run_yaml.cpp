@@ -66,27 +66,6 @@ std::string sizes_yaml(const particles::SizeDistribution& sizes) {
   return "{discrete: {radii: [" + radii + "], mass_fractions: [" + fractions + "]}}";
 }
 
-std::string scaling_law_name(contact::ScalingLaw law) {
-  switch (law) {
-    case contact::ScalingLaw::kKottlan2018:
-      return "kottlan2018";
-    case contact::ScalingLaw::kTiscar2019:
-      return "tiscar2019";
-    case contact::ScalingLaw::kNone:
-      break;
-  }
-  return "none";
-}
-
-/// The parameters of the preparation's method with their values.
-std::map<std::string, double> preparation_values(const PreparationSpec& prep) {
-  std::map<std::string, double> out;
-  for (const auto& name : preparation_params(prep.method))
-    for (const auto& info : PreparationSpec::table())
-      if (name == info.name) out[name] = prep.*(info.field);
-  return out;
-}
-
 }  // namespace
 
 std::string material_yaml(const MaterialModel& m) {
@@ -97,8 +76,8 @@ std::string material_yaml(const MaterialModel& m) {
   y << "  sizes: " << sizes_yaml(m.sizes) << "\n"
     << "  size_scale: " << exact(m.size_scale) << "\n"
     << "  density: " << exact(m.density) << "\n"
-    << "  scaling: {law: " << scaling_law_name(m.scaling) << ", factor: " << exact(m.scale_factor)
-    << "}\n";
+    << "  scaling: {law: " << contact::scaling_law_name(m.scaling)
+    << ", factor: " << exact(m.scale_factor) << "}\n";
   if (m.shape.kind != particles::ShapeKind::kSphere)
     y << "  shape: "
       << flow_block("kind", particles::shape_kind_name(m.shape.kind),

@@ -260,6 +260,13 @@ MaterialModel with_parameters(MaterialModel model, const std::vector<ParameterVa
   return model;
 }
 
+MaterialModel with_run_parameters(MaterialModel model,
+                                  const std::map<std::string, double>& parameters) {
+  for (const auto& [path, value] : parameters) set_parameter(model, path, value);
+  model.validate();
+  return model;
+}
+
 void set_parameter(MaterialModel& model, const std::string& path, double value) {
   for (const auto& info : parameters(model))
     if (info.path == path) {

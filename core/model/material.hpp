@@ -11,6 +11,7 @@
 //   radius) scaling.factor
 //   shape.<param>                 e.g. shape.aspect_ratio (particles::ShapeSpec, per shape kind)
 //   preparation.<param>           e.g. preparation.cluster_time (PreparationSpec, per method)
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -96,5 +97,9 @@ struct ParameterValue {
 /// first wrong value's `where`. The given model is not changed.
 MaterialModel with_parameters(MaterialModel model, const std::vector<ParameterValue>& values);
 double get_parameter(const MaterialModel& model, const std::string& path);
+/// The material of a run: every parameter set in path order, then the whole model validated
+/// (a run's parameters may pass through an invalid pair on the way, e.g. D_min above D_max).
+MaterialModel with_run_parameters(MaterialModel model,
+                                  const std::map<std::string, double>& parameters);
 
 }  // namespace demcal::lab

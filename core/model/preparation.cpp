@@ -43,6 +43,14 @@ std::vector<std::string> preparation_params(PreparationMethod method) {
   return {};
 }
 
+std::map<std::string, double> preparation_values(const PreparationSpec& prep) {
+  std::map<std::string, double> out;
+  for (const auto& name : preparation_params(prep.method))
+    for (const auto& info : PreparationSpec::table())
+      if (name == info.name) out[name] = prep.*(info.field);
+  return out;
+}
+
 PreparationSpec make_preparation(const std::string& method,
                                  const std::map<std::string, double>& params,
                                  const std::string& where) {

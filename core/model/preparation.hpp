@@ -83,6 +83,9 @@ std::string preparation_method_name(PreparationMethod method);
 /// The parameters that act in the given method (the others are refused for it).
 std::vector<std::string> preparation_params(PreparationMethod method);
 
+/// The parameters of the preparation's method with their values (make_preparation reads them).
+std::map<std::string, double> preparation_values(const PreparationSpec& prep);
+
 /// A preparation from its method and parameters; errors name `where.<param>` for an unknown,
 /// out-of-range or foreign parameter.
 PreparationSpec make_preparation(const std::string& method,

@@ -28,6 +28,10 @@ struct LogNormal {
   double truncate_k = 2.5;
 };
 
+/// The narrowest log-normal width a material switched from one size to a distribution starts
+/// from, and the narrowest the diagnosis runs (sigma_g = 1 is one size).
+inline constexpr double kNarrowestLogNormal = 1.01;
+
 using SizeDistribution = std::variant<Monodisperse, DiscreteClasses, LogNormal>;
 
 /// Checks a distribution, naming the field under `where` on error.

@@ -93,7 +93,8 @@ SubmitOracle::Outcome SubmitOracle::submit(const v1::SubmitRequest& request) {
   server::from_json(row->spec_json, stored);
   if (const std::string d = differences(request.spec(), stored); !d.empty())
     return {true, "the stored spec differs from the one sent: " + d};
-  (void)server::plan_from_json(row->design_json);
+  if (server::plan_to_json(server::stored_plan(*row)) != row->design_json)
+    return {true, "the stored plan does not read back as itself"};
   const auto jobs = store.jobs(row->id);
   if (static_cast<int>(jobs.size()) != reply.design().jobs())
     return {true, std::to_string(jobs.size()) + " jobs stored, the reply says " +

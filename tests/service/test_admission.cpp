@@ -19,6 +19,7 @@
 #include "rpc/material_convert.hpp"
 #include "server/convert.hpp"
 #include "server/limits.hpp"
+#include "server/plan.hpp"
 #include "tests/service/service_fixture.hpp"
 
 namespace demcal::test {

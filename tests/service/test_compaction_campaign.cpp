@@ -13,6 +13,7 @@
 
 #include "client/spec_yaml.hpp"
 #include "server/convert.hpp"
+#include "server/plan.hpp"
 #include "tests/service/process.hpp"
 
 namespace demcal::test {

@@ -1,34 +1,48 @@
 // Every campaign spec in examples/ (a file with a top-level `design:`) reads and plans as the
-// coordinator would plan it: a user who copies one gets a campaign, not an error.
+// coordinator would plan it: a user who copies one gets a campaign, not an error. Its planned
+// runs keep their run keys (what a journal finds a run by), and its plan reads back as stored.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "client/spec_yaml.hpp"
+#include "core/io/yaml_node.hpp"
+#include "core/lab/lab_run_yaml.hpp"
+#include "rpc/material_convert.hpp"
 #include "server/convert.hpp"
+#include "server/plan.hpp"
+#include "server/run_key.hpp"
 
 namespace demcal {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<fs::path> campaign_examples() {
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::vector<fs::path> example_files(const std::regex& marker) {
   std::vector<fs::path> out;
-  const std::regex design("(^|\n)design:");
-  for (const auto& entry : fs::directory_iterator(fs::path(DEMCAL_SOURCE_DIR) / "examples")) {
-    if (entry.path().extension() != ".yaml") continue;
-    std::ifstream in(entry.path());
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (std::regex_search(text.str(), design)) out.push_back(entry.path());
-  }
+  for (const auto& entry : fs::directory_iterator(fs::path(DEMCAL_SOURCE_DIR) / "examples"))
+    if (entry.path().extension() == ".yaml" && std::regex_search(read_text(entry.path()), marker))
+      out.push_back(entry.path());
   std::sort(out.begin(), out.end());
   return out;
+}
+
+std::vector<fs::path> campaign_examples() {
+  return example_files(std::regex("(^|\n)design:"));
 }
 
 TEST(Examples, EveryCampaignSpecReadsAndPlans) {
@@ -41,12 +55,104 @@ TEST(Examples, EveryCampaignSpecReadsAndPlans) {
     try {
       const auto file = cli::read_campaign_spec(f.string());
       const auto plan = server::plan_campaign(file.spec, jobs);
-      EXPECT_FALSE(plan.tests.empty());
+      EXPECT_FALSE(plan.instances.empty());
       EXPECT_FALSE(plan.targets.empty());
       EXPECT_FALSE(jobs.empty());
     } catch (const std::exception& e) {
       ADD_FAILURE() << e.what();
     }
+  }
+}
+
+nlohmann::json job_keys(const std::vector<server::NewJob>& jobs) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& j : jobs)
+    out.push_back({j.kind, j.std_order, j.run_order, j.test, j.run_key.key});
+  return out;
+}
+
+/// The diagnosis's model switches, each as the golden file names it.
+const std::vector<std::map<std::string, std::string>> kSwitches = {
+    {{"sizes", "lognormal"}},
+    {{"preparation", "clusters"}},
+    {{"shape", "rod"}},
+    {{"shape", "cluster"}},
+    {{"particle_law.rolling", "cdt"}}};
+
+/// tests/data/run-keys/examples.json (its README says what it holds): the design's jobs, a
+/// calibration stage over the lower half of the box, a verification at the centre at the high
+/// level, and a diagnosis run at the centre under each switch.
+TEST(Examples, EveryCampaignPlansTheRunKeysItAlwaysPlanned) {
+  const auto golden = nlohmann::json::parse(
+      read_text(fs::path(DEMCAL_SOURCE_DIR) / "tests/data/run-keys/examples.json"));
+  const auto files = campaign_examples();
+  ASSERT_EQ(files.size(), golden.size());
+  int compared = 0;
+  for (const auto& f : files) {
+    const std::string name = f.filename().string();
+    SCOPED_TRACE(name);
+    ASSERT_TRUE(golden.contains(name));
+    const auto& want = golden.at(name);
+    std::vector<server::NewJob> jobs;
+    const auto plan = server::plan_campaign(cli::read_campaign_spec(f.string()).spec, jobs);
+    EXPECT_EQ(job_keys(jobs), want.at("jobs"));
+    auto box = plan.factors;
+    for (auto& b : box) b.factor.high = b.factor.to_natural(0.0);
+    EXPECT_EQ(job_keys(server::jobs_of(
+                  plan, server::design_runs(plan, box, "stage2", plan.design.runs(), false))),
+              want.at("stage"));
+    std::map<std::string, double> centre;
+    for (const auto& b : plan.factors) centre[b.path] = b.factor.to_natural(0.0);
+    EXPECT_EQ(
+        job_keys(server::jobs_of(plan, server::runs_at(plan, centre, true, 3, "verify", 1000003))),
+        want.at("verify"));
+    for (const auto& sw : kSwitches) {
+      const std::string key = sw.begin()->first + "=" + sw.begin()->second;
+      const auto& expected = want.at("switch").at(key);
+      const auto runs = server::runs_at(plan, centre, false, 2, "diagnose:x", 1);
+      if (expected.is_string()) {
+        EXPECT_ANY_THROW(server::jobs_of(plan, runs, sw)) << key;
+      } else {
+        EXPECT_EQ(job_keys(server::jobs_of(plan, runs, sw)), expected) << key;
+      }
+    }
+    compared += static_cast<int>(want.at("jobs").size());
+  }
+  EXPECT_GT(compared, 500);
+}
+
+TEST(Examples, EveryPlanReadsBackAsStored) {
+  for (const auto& f : campaign_examples()) {
+    SCOPED_TRACE(f.filename().string());
+    std::vector<server::NewJob> jobs;
+    const auto file = cli::read_campaign_spec(f.string());
+    server::CampaignRow row;
+    row.spec_json = server::to_json(file.spec);
+    row.design_json = server::plan_to_json(server::plan_campaign(file.spec, jobs));
+    EXPECT_EQ(server::plan_to_json(server::stored_plan(row)), row.design_json);
+  }
+}
+
+/// Every material of the examples (campaigns' and lab runs') gives itself back through its proto
+/// form: each parameter and each choice a run key holds.
+TEST(Examples, EveryMaterialKeepsEveryValueThroughItsProtoForm) {
+  std::vector<lab::MaterialModel> materials;
+  for (const auto& f : campaign_examples())
+    materials.push_back(rpc::to_material_model(cli::read_campaign_spec(f.string()).spec.material(),
+                                               "spec.material"));
+  for (const auto& f : example_files(std::regex("(^|\n)test:")))
+    materials.push_back(lab::read_lab_run(io::YamlNode::load_file(f.string())).material);
+  ASSERT_GE(materials.size(), 20u);
+  for (const auto& m : materials) {
+    const lab::MaterialModel back = rpc::to_material_model(rpc::to_material_message(m), "m");
+    EXPECT_EQ(back.particle_law, m.particle_law);
+    EXPECT_EQ(back.wall_law, m.wall_law);
+    EXPECT_EQ(lab::parameters(back).size(), lab::parameters(m).size());
+    for (const auto& p : lab::parameters(m)) {
+      const double was = lab::get_parameter(m, p.path), is = lab::get_parameter(back, p.path);
+      EXPECT_TRUE(is == was || (std::isnan(is) && std::isnan(was))) << p.path;  // NaN: derived
+    }
+    EXPECT_EQ(lab::material_yaml(back), lab::material_yaml(m));
   }
 }
 

@@ -10,6 +10,7 @@
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
 #include "server/convert.hpp"
+#include "server/plan.hpp"
 
 namespace demcal::test {
 namespace {

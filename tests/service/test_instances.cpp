@@ -13,6 +13,7 @@
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
 #include "server/convert.hpp"
+#include "server/plan.hpp"
 #include "tests/service/process.hpp"
 
 namespace demcal::test {
@@ -92,7 +93,7 @@ TEST(TestInstances, EachInstanceIsAResponseAndAJobOfItsOwn) {
   const auto file = cli::parse_campaign_spec(drums_spec(), "drums.yaml");
   std::vector<server::NewJob> jobs;
   const auto plan = server::plan_campaign(file.spec, jobs);
-  EXPECT_EQ(plan.tests, (std::vector<std::string>{"drum_ptfe", "drum_coated"}));
+  EXPECT_EQ(server::instance_names(plan), (std::vector<std::string>{"drum_ptfe", "drum_coated"}));
   const auto has = [&](const std::string& r) {
     return std::find(plan.responses.begin(), plan.responses.end(), r) != plan.responses.end();
   };
@@ -105,17 +106,18 @@ TEST(TestInstances, EachInstanceIsAResponseAndAJobOfItsOwn) {
   // 4 runs x 2 instances; the job row carries the instance, the payload the lab test and the
   // instance's wall law.
   ASSERT_EQ(jobs.size(), 8u);
-  std::map<std::string, double> wall_mu;
+  std::map<std::string, double> wall_mu, particle_mu;
   for (const auto& job : jobs) {
     v1::JobSpec spec;
     server::from_json(job.payload, spec);
     EXPECT_EQ(spec.test(), "rotating_drum");
-    wall_mu[job.test] = spec.material().has_wall_law()
-                            ? spec.material().wall_law().tangential().params().at("mu_s")
-                            : -1.0;
+    wall_mu[job.test] = spec.material().wall_law().tangential().params().at("mu_s");
+    particle_mu[job.test] = spec.material().particle_law().tangential().params().at("mu_s");
   }
   EXPECT_EQ(wall_mu.at("drum_ptfe"), 0.1);
-  EXPECT_EQ(wall_mu.at("drum_coated"), -1.0);  // the material's: a copy of the particle law
+  // The material's wall law: a copy of the particle law, written out in the job.
+  EXPECT_EQ(wall_mu.at("drum_coated"), particle_mu.at("drum_coated"));
+  EXPECT_NE(wall_mu.at("drum_coated"), 0.1);
 }
 
 TEST(TestInstances, BadInstancesAreRefusedNamingTheField) {

@@ -17,6 +17,7 @@
 #include "process.hpp"
 #include "rpc/material_convert.hpp"
 #include "server/convert.hpp"
+#include "server/plan.hpp"
 
 namespace demcal::test {
 namespace {
@@ -52,8 +53,9 @@ TEST(Seed001Example, PlansWithTheSeedsMeasurementsAndOneDrumPerSurface) {
   const auto file = cli::parse_campaign_spec(example(), "seed001_granules.yaml");
   std::vector<server::NewJob> jobs;
   const auto plan = server::plan_campaign(file.spec, jobs);
-  EXPECT_EQ(plan.tests, (std::vector<std::string>{"compression", "drum_ptfe", "drum_pp",
-                                                  "drum_aluminium", "drum_coated"}));
+  EXPECT_EQ(server::instance_names(plan),
+            (std::vector<std::string>{"compression", "drum_ptfe", "drum_pp", "drum_aluminium",
+                                      "drum_coated"}));
   std::map<std::string, double> target;
   for (const auto& t : plan.targets) target[t.response] = t.value;
   EXPECT_EQ(target,

@@ -17,6 +17,7 @@
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
 #include "server/convert.hpp"
+#include "server/plan.hpp"
 #include "tests/fuzz/submit_oracle.hpp"
 
 namespace demcal::test {

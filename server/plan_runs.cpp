@@ -1,0 +1,106 @@
+// The runs of a plan and the jobs that simulate them (plan.hpp).
+#include <algorithm>
+
+#include "core/model/campaign_model.hpp"
+#include "rpc/material_convert.hpp"
+#include "server/convert.hpp"
+#include "server/plan.hpp"
+#include "server/run_key.hpp"
+
+namespace demcal::server {
+namespace {
+
+/// The simulation seed of design row `row` (0-based, standard order) of an instance whose first
+/// row has `seed`: its own by default, so that repeated points (centre points, replicates)
+/// measure the run-to-run noise; pinned, a repeated point shares its replicate's seed.
+std::uint64_t design_seed(const CampaignPlan& plan, std::uint64_t seed, int row) {
+  const int offset = plan.pinned_seeds ? plan.design.replicate[std::size_t(row)] - 1 : row;
+  return seed + static_cast<std::uint64_t>(offset);
+}
+
+v1::JobSpec job_spec(const CampaignPlan& plan, const PlannedRun& run,
+                     const lab::MaterialModel& material) {
+  const auto& instance = plan.instances[run.instance];
+  v1::JobSpec job;
+  job.set_test(instance.test);
+  for (const auto& [name, value] : run.high ? instance.settings_high : instance.settings_low)
+    (*job.mutable_settings())[name] = value;
+  *job.mutable_material() = rpc::to_material_message(material);
+  for (const auto& [path, value] : run.parameters) (*job.mutable_parameters())[path] = value;
+  job.set_seed(run.seed);
+  job.set_threads(instance.threads);
+  return job;
+}
+
+}  // namespace
+
+std::map<std::string, double> run_parameters(const CampaignPlan& plan,
+                                             const std::map<std::string, double>& factors,
+                                             bool high) {
+  std::map<std::string, double> out = plan.fixed;
+  const auto& f = plan.fidelity;
+  if (f && !f->path.starts_with(lab::kSettingsPrefix)) out[f->path] = high ? f->high : f->low;
+  for (const auto& [path, value] : factors) out[path] = value;
+  for (const auto& factor : plan.factors)
+    if (const auto it = factors.find(factor.path); it != factors.end())
+      for (const auto& tied : factor.tied) out[tied] = it->second;
+  return out;
+}
+
+std::vector<PlannedRun> design_runs(const CampaignPlan& plan, const std::vector<PlannedFactor>& box,
+                                    const std::string& kind, int stage_offset, bool high,
+                                    const std::vector<int>* rows) {
+  std::vector<PlannedRun> runs;
+  const auto& design = plan.design;
+  for (int r = 0; r < design.runs(); ++r) {
+    if (rows && std::find(rows->begin(), rows->end(), r + 1) == rows->end()) continue;
+    std::map<std::string, double> factors;
+    for (std::size_t f = 0; f < box.size(); ++f)
+      factors[box[f].path] = box[f].factor.to_natural(design.coded(r, Eigen::Index(f)));
+    const auto parameters = run_parameters(plan, factors, high);
+    for (std::size_t i = 0; i < plan.instances.size(); ++i) {
+      const std::uint64_t seed = design_seed(plan, plan.instances[i].seed, r) +
+                                 (plan.pinned_seeds ? 0 : static_cast<std::uint64_t>(stage_offset));
+      runs.push_back({i, r + 1, design.run_order[std::size_t(r)], kind, parameters, high, seed});
+    }
+  }
+  return runs;
+}
+
+std::vector<PlannedRun> runs_at(const CampaignPlan& plan,
+                                const std::map<std::string, double>& factors, bool high,
+                                int std_order, const std::string& kind, std::uint64_t seed_offset) {
+  std::vector<PlannedRun> runs;
+  const auto parameters = run_parameters(plan, factors, high);
+  for (std::size_t i = 0; i < plan.instances.size(); ++i)
+    runs.push_back({i, std_order, static_cast<int>(i) + 1, kind, parameters, high,
+                    plan.instances[i].seed + seed_offset});
+  return runs;
+}
+
+std::vector<NewJob> jobs_of(const CampaignPlan& plan, const std::vector<PlannedRun>& runs,
+                            const std::map<std::string, std::string>& switches) {
+  std::vector<lab::MaterialModel> materials;
+  for (const auto& instance : plan.instances)
+    materials.push_back(switches.empty() ? instance.material
+                                         : lab::with_switches(instance.material, switches));
+  std::vector<NewJob> jobs;
+  for (const auto& run : runs) {
+    const v1::JobSpec job = job_spec(plan, run, materials[run.instance]);
+    jobs.push_back({run.std_order, run.run_order, plan.instances[run.instance].name, run.kind,
+                    to_json(job), run_key(job)});
+  }
+  return jobs;
+}
+
+void admit_runs(const CampaignPlan& plan, const std::vector<PlannedRun>& runs) {
+  for (const auto& run : runs) {
+    const auto& instance = plan.instances[run.instance];
+    const std::string where = "spec.tests[" + std::to_string(run.instance) + "]";
+    lab::admit_run(instance.test, instance.material, run.parameters,
+                   run.high ? instance.settings_high : instance.settings_low,
+                   {where + ".settings", "spec.material"}, run.std_order);
+  }
+}
+
+}  // namespace demcal::server

@@ -1,0 +1,125 @@
+#include "server/plan_spec.hpp"
+
+#include "core/common/error.hpp"
+#include "rpc/material_convert.hpp"
+#include "server/convert.hpp"
+
+namespace demcal::server {
+namespace {
+
+/// Lab seeds per diagnosis verification at most: each multiplies its verification runs.
+constexpr int kMaxDiagnosisReplicates = 16;
+
+/// The material a test instance runs with: `material` with the instance's own wall law, if any.
+v1::Material instance_material(const v1::Material& material, const v1::LabTest& t) {
+  v1::Material m = material;
+  if (t.has_wall_law()) *m.mutable_wall_law() = t.wall_law();
+  return m;
+}
+
+/// The model of a test instance: the campaign's with the instance's wall law; errors in that law
+/// name the instance's field.
+lab::MaterialModel instance_model(const v1::CampaignSpec& spec, const v1::LabTest& t,
+                                  const std::string& where) {
+  try {
+    return rpc::to_material_model(instance_material(spec.material(), t), "spec.material");
+  } catch (const InputError& e) {
+    const std::string base = "spec.material.wall_law";
+    if (!t.has_wall_law() || e.where().rfind(base, 0) != 0) throw;
+    throw InputError(where + ".wall_law" + e.where().substr(base.size()), e.message());
+  }
+}
+
+PlannedInstance read_instance(const v1::CampaignSpec& spec, int i) {
+  const auto& t = spec.tests(i);
+  const lab::Settings settings = rpc::to_settings(t.settings());
+  return {instance_name(t),
+          t.test(),
+          settings,
+          settings,
+          instance_model(spec, t, "spec.tests[" + std::to_string(i) + "]"),
+          t.seed() ? t.seed() : 1,
+          t.threads()};
+}
+
+PlannedFactor read_factor(const v1::Factor& f) {
+  return {f.path(),
+          doe::Factor{f.name().empty() ? f.path() : f.name(), f.low(), f.high(),
+                      f.scale() == v1::Factor::LOG ? doe::Scale::kLog : doe::Scale::kLinear},
+          {f.tied().begin(), f.tied().end()}};
+}
+
+/// An option: `fallback` when unset (0), else `v` if lo < v <= hi.
+double option(double v, double fallback, double lo, double hi, const std::string& field) {
+  if (v == 0.0) return fallback;
+  if (!(v > lo && v <= hi))
+    throw InputError(field, "must be 0 (the default, " + fmt(fallback) + ") or in (" + fmt(lo) +
+                                ", " + fmt(hi) + "]");
+  return v;
+}
+
+}  // namespace
+
+std::string instance_name(const v1::LabTest& t) {
+  return t.name().empty() ? t.test() : t.name();
+}
+
+CampaignPlan read_plan_spec(const v1::CampaignSpec& spec) {
+  CampaignPlan plan;
+  plan.material = rpc::to_material_model(spec.material(), "spec.material");
+  plan.fixed = {spec.fixed().begin(), spec.fixed().end()};
+  for (int i = 0; i < spec.tests_size(); ++i) plan.instances.push_back(read_instance(spec, i));
+  for (const auto& f : spec.factors()) plan.factors.push_back(read_factor(f));
+  plan.pinned_seeds = spec.design().simulation_seeds() == v1::Design::PINNED;
+  plan.calibration = calibration_options(spec.calibration(), "spec.calibration");
+  plan.batch_per_worker = spec.calibration().batch() == 0;
+  plan.diagnosis = diagnose_options(spec.diagnose(), "spec.diagnose");
+  return plan;
+}
+
+doe::ModelKind polynomial_model(const std::string& text, const std::string& where) {
+  const doe::ModelKind m = doe::parse_model_kind(text, where);
+  if (m != doe::ModelKind::kMain && m != doe::ModelKind::kTwoFactor)
+    throw InputError(where, "the calibration fits main or 2fi models");
+  return m;
+}
+
+calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
+                                             const std::string& where) {
+  calib::SequentialOptions o;
+  if (spec.rounds()) o.rounds = spec.rounds();
+  if (spec.stages()) o.stages = spec.stages();
+  if (spec.narrow() != 0.0) o.narrow = spec.narrow();
+  o.max_jobs = spec.max_jobs();
+  if (spec.surrogate() == "gp")
+    o.surrogate = calib::Surrogate::kGaussianProcess;
+  else if (!spec.surrogate().empty() && spec.surrogate() != "polynomial")
+    throw InputError(where + ".surrogate",
+                     "unknown surrogate '" + spec.surrogate() + "' (polynomial or gp)");
+  if (spec.batch() < 0) throw InputError(where + ".batch", "must be >= 0");
+  if (spec.batch() > 0) o.batch = spec.batch();
+  if (!spec.model().empty()) o.model = polynomial_model(spec.model(), where + ".model");
+  o.validate(where);
+  return o;
+}
+
+diagnose::Options diagnose_options(const v1::DiagnoseOptions& o, const std::string& where) {
+  // Ranges: the parameter tables' (rods up to aspect ratio 20, mu_r up to 10, sigma_g up to 10),
+  // a fixed parameter at most 100 x off, a margin below 1 (an error cut by 100 % cannot be).
+  diagnose::Options out;
+  out.candidates.assign(o.candidates().begin(), o.candidates().end());
+  out.aspect_ratio_max =
+      option(o.aspect_ratio_max(), out.aspect_ratio_max, 1.0, 20.0, where + ".aspect_ratio_max");
+  out.rolling_max = option(o.rolling_max(), out.rolling_max, 0.0, 10.0, where + ".rolling_max");
+  out.sigma_g_max =
+      option(o.sigma_g_max(), out.sigma_g_max, diagnose::kSigmaGLow, 10.0, where + ".sigma_g_max");
+  out.fixed_span = option(o.fixed_span(), out.fixed_span, 1.0, 100.0, where + ".fixed_span");
+  out.margin = option(o.margin(), out.margin, 0.0, 0.99, where + ".margin");
+  if (o.replicates() < 0 || o.replicates() > kMaxDiagnosisReplicates)
+    throw InputError(where + ".replicates", "must be 0 (the default, 1) or in [1, " +
+                                                std::to_string(kMaxDiagnosisReplicates) + "]");
+  if (o.replicates() > 0) out.replicates = o.replicates();
+  return out;
+}
+
+}  // namespace demcal::server
