@@ -12,7 +12,7 @@
 
 #include "core/common/error.hpp"
 #include "core/doe/alias_structure.hpp"
-#include "server/plan_spec.hpp"
+#include "server/plan_input.hpp"
 #include "server/stored_columns.hpp"
 
 namespace demcal::server {

@@ -1,6 +1,6 @@
 #pragma once
 // The coordinator's edge: proto messages in, domain values out, and back. The plan
-// (plan_spec.hpp) reads the campaign's spec; nothing else in server/ reads a proto field for
+// (plan_input.hpp) reads the campaign's spec; nothing else in server/ reads a proto field for
 // domain logic.
 #include <cstdint>
 #include <map>

@@ -12,7 +12,7 @@
 #include "server/admission.hpp"
 #include "server/convert.hpp"
 #include "server/limits.hpp"
-#include "server/plan_spec.hpp"
+#include "server/plan_input.hpp"
 
 namespace demcal::server {
 namespace {
@@ -269,7 +269,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
   check_printable(spec.name(), "spec.name");
   if (!spec.has_material()) throw InputError("spec.material", "missing");
   check_instances(spec);
-  CampaignPlan plan = read_plan_spec(spec);
+  CampaignPlan plan = read_plan_input(spec);
   plan_design(spec, plan);
   plan_fidelity(spec, plan);
   check_campaign_bytes(spec, plan);

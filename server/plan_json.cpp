@@ -6,7 +6,7 @@
 #include "rpc/material_convert.hpp"
 #include "server/convert.hpp"
 #include "server/plan.hpp"
-#include "server/plan_spec.hpp"
+#include "server/plan_input.hpp"
 #include "server/stored_columns.hpp"
 
 namespace demcal::server {
@@ -155,7 +155,7 @@ void design_from(const Json& j, CampaignPlan& p) {
 /// fidelity axis as stored, the rest read from its stored spec, the instances' settings at the
 /// stored fidelity levels.
 CampaignPlan earlier_plan(const Json& j, const CampaignRow& row) {
-  CampaignPlan p = read_plan_spec(spec_from_json(row.spec_json));
+  CampaignPlan p = read_plan_input(spec_from_json(row.spec_json));
   design_from(j, p);
   if (p.fidelity) {
     const lab::CampaignFidelity f{p.fidelity->path, p.fidelity->low, p.fidelity->high};

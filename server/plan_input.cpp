@@ -1,4 +1,4 @@
-#include "server/plan_spec.hpp"
+#include "server/plan_input.hpp"
 
 #include "core/common/error.hpp"
 #include "rpc/material_convert.hpp"
@@ -64,7 +64,7 @@ std::string instance_name(const v1::LabTest& t) {
   return t.name().empty() ? t.test() : t.name();
 }
 
-CampaignPlan read_plan_spec(const v1::CampaignSpec& spec) {
+CampaignPlan read_plan_input(const v1::CampaignSpec& spec) {
   CampaignPlan plan;
   plan.material = rpc::to_material_model(spec.material(), "spec.material");
   plan.fixed = {spec.fixed().begin(), spec.fixed().end()};

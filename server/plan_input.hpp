@@ -16,7 +16,7 @@ std::string instance_name(const v1::LabTest& test);
 
 /// The plan's structure from the spec; InputError naming the field of a material or an option
 /// out of range. Design, responses, targets and fidelity are not filled in.
-CampaignPlan read_plan_spec(const v1::CampaignSpec& spec);
+CampaignPlan read_plan_input(const v1::CampaignSpec& spec);
 
 /// The calibration options of a spec (InputError naming `where`.<field>).
 calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
