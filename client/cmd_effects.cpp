@@ -165,7 +165,7 @@ std::string yaml_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptio
   return "# demcal campaign " + std::to_string(id) + " '" + campaign.name() +
          "': the calibrated material (" +
          (cal.conclusion().empty() ? cal.verification_state() : cal.conclusion()) + ")\n" +
-         lab::material_yaml(job_material(campaign.spec(), nullptr, parameters));
+         io::material_yaml(job_material(campaign.spec(), nullptr, parameters));
 }
 
 struct ExportOptions {

@@ -212,6 +212,12 @@ void set_sizes(v1::SizeDistribution& out, const particles::SizeDistribution& siz
 
 }  // namespace
 
+v1::ContactLaw to_law_message(const contact::ContactLawSpec& law) {
+  v1::ContactLaw out;
+  set_law(out, law);
+  return out;
+}
+
 v1::Material to_material_message(const lab::MaterialModel& model) {
   v1::Material m;
   set_law(*m.mutable_particle_law(), model.particle_law);

@@ -21,6 +21,9 @@ lab::MaterialModel to_material_model(const v1::Material& material, const std::st
 /// value (every slot, size, shape and preparation parameter written out).
 v1::Material to_material_message(const lab::MaterialModel& model);
 
+/// The proto form of a contact law (every slot written out).
+v1::ContactLaw to_law_message(const contact::ContactLawSpec& law);
+
 /// The material of a job: its base material with the job's parameters set (factor values and
 /// fixed parameters).
 lab::MaterialModel job_material(const v1::JobSpec& job);

@@ -228,7 +228,7 @@ lab::CampaignModel campaign_model(const CampaignPlan& plan) {
   for (std::size_t i = 0; i < plan.instances.size(); ++i) {
     const auto& p = plan.instances[i];
     c.instances.push_back(
-        {p.name, p.test, p.settings_low, p.material, "spec." + idx("tests", int(i))});
+        {p.name, p.test, p.settings_low, p.material, p.seed, "spec." + idx("tests", int(i))});
   }
   for (std::size_t i = 0; i < plan.factors.size(); ++i) {
     const auto& f = plan.factors[i];
@@ -251,6 +251,7 @@ void apply_model(const std::vector<lab::ModelledInstance>& modelled, CampaignPla
     auto& p = plan.instances[i];
     p.settings_low = modelled[i].low;
     p.settings_high = modelled[i].high;
+    p.waits_for = modelled[i].waits_for;
     for (const auto& m : modelled[i].metrics) plan.responses.push_back(p.name + "." + m);
   }
 }

@@ -30,6 +30,9 @@ struct PlannedInstance {
   lab::MaterialModel material;  ///< the campaign's, with the instance's own wall law
   std::uint64_t seed = 1;       ///< the simulation seed of its first design row
   int threads = 0;              ///< 0 = the worker's --threads
+  /// The instance whose job of a row this one's is leased after (a tensile test after the
+  /// confined compression whose conditioned bed it starts from); empty: none.
+  std::string waits_for;
 };
 
 struct PlannedFactor {

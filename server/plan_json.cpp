@@ -35,7 +35,8 @@ Json instance_json(const PlannedInstance& i) {
           {"settings_high", i.settings_high},
           {"material", material_json(i.material)},
           {"seed", i.seed},
-          {"threads", i.threads}};
+          {"threads", i.threads},
+          {"waits_for", i.waits_for}};
 }
 
 PlannedInstance instance_from(const Json& j) {
@@ -45,7 +46,8 @@ PlannedInstance instance_from(const Json& j) {
           j.at("settings_high").get<lab::Settings>(),
           material_from(j.at("material"), "plan.instances.material"),
           j.at("seed").get<std::uint64_t>(),
-          j.at("threads").get<int>()};
+          j.at("threads").get<int>(),
+          j.at("waits_for")};
 }
 
 Json calibration_json(const CampaignPlan& p) {

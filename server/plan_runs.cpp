@@ -87,8 +87,9 @@ std::vector<NewJob> jobs_of(const CampaignPlan& plan, const std::vector<PlannedR
   std::vector<NewJob> jobs;
   for (const auto& run : runs) {
     const v1::JobSpec job = job_spec(plan, run, materials[run.instance]);
-    jobs.push_back({run.std_order, run.run_order, plan.instances[run.instance].name, run.kind,
-                    to_json(job), run_key(job)});
+    const auto& instance = plan.instances[run.instance];
+    jobs.push_back({run.std_order, run.run_order, instance.name, run.kind, to_json(job),
+                    run_key(job), instance.waits_for});
   }
   return jobs;
 }

@@ -352,12 +352,12 @@ std::vector<std::int64_t> Store::insert_job_rows(std::int64_t campaign_id,
   std::vector<std::int64_t> ids;
   Statement s(*this,
               "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state, "
-              "run_key, run_protocol) VALUES (?, ?, ?, ?, ?, ?, 'queued', ?, ?)");
+              "run_key, run_protocol, waits_for) VALUES (?, ?, ?, ?, ?, ?, 'queued', ?, ?, ?)");
   for (std::size_t i = first; i < end; ++i) {
     const auto& job = jobs[i];
     s.bind(1, campaign_id).bind(2, job.std_order).bind(3, job.run_order).bind(4, job.test);
     s.bind(5, job.kind).bind(6, job.payload).bind(7, job.run_key.key);
-    s.bind(8, job.run_key.protocol).step();
+    s.bind(8, job.run_key.protocol).bind(9, job.waits_for).step();
     s.reset();
     ids.push_back(sqlite3_last_insert_rowid(db_));
   }
@@ -578,7 +578,10 @@ std::optional<std::pair<std::int64_t, std::string>> Store::next_queued() {
               "JOIN campaigns c ON c.id = j.campaign_id "
               "WHERE j.state = 'queued' AND c.state = 'running' AND c.ready = 1 AND "
               "(COALESCE(j.run_key, '') = '' OR NOT EXISTS (SELECT 1 FROM jobs t "
-              "WHERE t.run_key = j.run_key AND t.state = 'leased')) "
+              "WHERE t.run_key = j.run_key AND t.state = 'leased')) AND "
+              "(j.waits_for = '' OR NOT EXISTS (SELECT 1 FROM jobs w WHERE w.campaign_id = "
+              "j.campaign_id AND w.kind = j.kind AND w.std_order = j.std_order AND w.test = "
+              "j.waits_for AND w.state IN ('queued', 'leased'))) "
               "ORDER BY j.campaign_id, j.kind, j.run_order, j.id LIMIT 1");
   if (!s.step()) return std::nullopt;
   return std::pair{s.i64(0), s.text(1)};

@@ -23,6 +23,14 @@ std::string lacks(const std::string& path, const CampaignInstance& instance) {
          "' (its own wall_law lacks it)";
 }
 
+/// The first instance of `test` with `seed`'s name, empty when none.
+std::string first_instance(const std::vector<CampaignInstance>& instances, const std::string& test,
+                           std::uint64_t seed) {
+  for (const auto& i : instances)
+    if (i.test == test && i.seed == seed) return i.name;
+  return {};
+}
+
 /// Each instance's test in the catalogue and admitted with its settings and material.
 std::vector<ModelledInstance> model_instances(const std::vector<CampaignInstance>& instances) {
   std::vector<ModelledInstance> out;
@@ -34,8 +42,10 @@ std::vector<ModelledInstance> model_instances(const std::vector<CampaignInstance
       throw InputError(i.where + ".test", e.message());
     }
     admit_lab_test(i.test, i.material, i.settings, {i.where + ".settings", "spec.material"});
-    ModelledInstance m{{}, i.settings, i.settings};
+    ModelledInstance m{{}, i.settings, i.settings, {}};
     for (const auto& metric : info->metrics) m.metrics.push_back(metric.name);
+    if (!info->starts_from.empty())
+      m.waits_for = first_instance(instances, info->starts_from, i.seed);
     out.push_back(std::move(m));
   }
   return out;

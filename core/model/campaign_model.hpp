@@ -5,6 +5,7 @@
 // the catalogue comes back with it: each instance's metrics and its settings at both fidelity
 // levels. And the diagnosis's model switches on a material model.
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -21,6 +22,7 @@ struct CampaignInstance {
   std::string test;  ///< the lab test
   Settings settings;
   MaterialModel material;  ///< the campaign's, with the instance's own wall law if it has one
+  std::uint64_t seed = 1;  ///< the simulation seed of its first row
   std::string where;       ///< its field, e.g. "spec.tests[2]"
 };
 
@@ -61,6 +63,9 @@ struct CampaignModel {
 struct ModelledInstance {
   std::vector<std::string> metrics;
   Settings low, high;
+  /// The instance whose job of a row this one's waits for: the first of the test it starts from
+  /// (LabTestInfo::starts_from) with its seed; empty when none.
+  std::string waits_for;
 };
 
 /// The prefix of a fidelity axis that is a test setting.

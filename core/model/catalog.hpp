@@ -51,6 +51,10 @@ struct LabTestInfo {
   /// What the runner reports beside its metrics, as context and never as a response (a drum's
   /// particle count, its centrifuging at every speed): a result may carry these names too.
   std::vector<std::string> also_reported = {};
+  /// The test whose conditioned bed a run of this one starts from, taken from the stage cache
+  /// when a run of it with the same material, settings and seed kept it (core/lab/stage_cache.hpp):
+  /// the coordinator leases this test's job of a design row after that test's job of the row.
+  std::string starts_from = {};
   /// Filled in by the registry from the test's type (lab_catalog()):
   std::vector<RuleDoc> rules = {};                   ///< cross-setting rules
   std::vector<PreparationMethod> preparations = {};  ///< the bed preparations it can run

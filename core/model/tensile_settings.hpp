@@ -83,7 +83,9 @@ struct TensileTest {
             {{"tensile_strength", "kPa",
               "peak tensile stress on the piston less the weight of the powder stuck to it, over "
               "the piston area"}},
-            settings_docs<TensileSettings>()};
+            settings_docs<TensileSettings>(),
+            {},
+            "confined_compression"};
   }
   static LabOutput run(const MaterialModel& material, const Settings& settings,
                        const RunOptions& options);

@@ -412,7 +412,7 @@ calibration: {rounds: 1, stages: 1}
              " --lab-specs " + (dir / "specs").string());
   ASSERT_EQ(exported.exit_code, 0) << exported.out;
 
-  const auto material = demcal::lab::read_material(
+  const auto material = demcal::io::read_material(
       demcal::io::YamlNode::load_file((dir / "material.yaml").string())["material"]);
   ASSERT_FALSE(calibration["proposed"].empty());
   for (const auto& [path, value] : calibration["proposed"].items())

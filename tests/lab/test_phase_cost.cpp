@@ -109,7 +109,7 @@ TEST(PhaseCost, APhaseShortOfItsTargetFlagsItsMetrics) {
 
 TEST(PhaseCost, Lh220ReachesEveryTargetOfAConfinedCompression) {
   // The material of examples/lh220_diagnosis_campaign.yaml (seed 000 Tables 4-6, SF 10).
-  const auto material = read_material(io::YamlNode::load_string(R"(
+  const auto material = io::read_material(io::YamlNode::load_string(R"(
 particle_law:
   normal: {model: luding, youngs_modulus: 3.0e7, k2_ratio: 16, kc_ratio: 0.2, phi_f: 0.02, restitution: 0.65}
   cohesion: {model: van_der_waals, hamaker: 5.0e-18, d_min: 4.0e-10, d_max: 1.0e-7}

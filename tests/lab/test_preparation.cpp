@@ -29,7 +29,7 @@ density: 2500
 )";
 
 MaterialModel read(const std::string& extra) {
-  return read_material(io::YamlNode::load_string(std::string(kMaterial) + extra));
+  return io::read_material(io::YamlNode::load_string(std::string(kMaterial) + extra));
 }
 
 std::string error_of(const std::string& extra) {
@@ -159,7 +159,7 @@ TEST(Preparation, GrowthFillsTheDieAtTheTargetWithoutPressingContactsAndWithReal
 
 TEST(Preparation, GrowthThroughConfinedCompressionReachesEveryPhase) {
   // The LH220 material of bench/materials (cohesive Luding, CDT rolling resistance, SF 10).
-  const MaterialModel m = read_material(io::YamlNode::load_string(R"(
+  const MaterialModel m = io::read_material(io::YamlNode::load_string(R"(
 particle_law:
   normal: {model: luding, youngs_modulus: 3.0e7, k2_ratio: 16, kc_ratio: 0.2, phi_f: 0.02, restitution: 0.65}
   cohesion: {model: van_der_waals, hamaker: 5.0e-18, d_min: 4.0e-10, d_max: 1.0e-7}

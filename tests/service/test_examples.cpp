@@ -121,6 +121,24 @@ TEST(Examples, EveryCampaignPlansTheRunKeysItAlwaysPlanned) {
   EXPECT_GT(compared, 500);
 }
 
+/// Seed 000 starts its tensile test from the bed the confined compression conditioned (§2.7.3):
+/// each tensile job of the LH220 campaign is leased after its row's compression (the stage cache
+/// then hands it that bed), and no other job waits.
+TEST(Examples, TheTensileJobsOfTheLh220CampaignWaitForTheirRowsCompression) {
+  std::vector<server::NewJob> jobs;
+  server::plan_campaign(
+      cli::read_campaign_spec(std::string(DEMCAL_SOURCE_DIR) +
+                              "/examples/lh220_calibration_campaign.yaml")
+          .spec,
+      jobs);
+  int tensile = 0;
+  for (const auto& j : jobs) {
+    EXPECT_EQ(j.waits_for, j.test == "tensile" ? "confined_compression" : "") << j.test;
+    tensile += j.test == "tensile";
+  }
+  EXPECT_EQ(tensile, 33);
+}
+
 TEST(Examples, EveryPlanReadsBackAsStored) {
   for (const auto& f : campaign_examples()) {
     SCOPED_TRACE(f.filename().string());
@@ -152,7 +170,7 @@ TEST(Examples, EveryMaterialKeepsEveryValueThroughItsProtoForm) {
       const double was = lab::get_parameter(m, p.path), is = lab::get_parameter(back, p.path);
       EXPECT_TRUE(is == was || (std::isnan(is) && std::isnan(was))) << p.path;  // NaN: derived
     }
-    EXPECT_EQ(lab::material_yaml(back), lab::material_yaml(m));
+    EXPECT_EQ(io::material_yaml(back), io::material_yaml(m));
   }
 }
 

@@ -352,6 +352,36 @@ TEST(Store, AJobWaitsWhileAnotherJobRunsItsRunKey) {
   EXPECT_EQ(s.counts(id).done, 3);
 }
 
+TEST(Store, AJobWaitingForAnotherOfItsRowIsLeasedOnceThatOneHasEnded) {
+  Store s(":memory:", {10.0, 3});
+  // Row 1: the tensile job (listed first) waits for the compression; row 2 likewise; a verify
+  // job of row 1 waits for nothing of the design.
+  const std::vector<NewJob> jobs = {
+      {1, 1, "tensile", "design", "{}", {}, "compression"},
+      {1, 1, "compression", "design", "{}"},
+      {2, 2, "tensile", "design", "{}", {}, "compression"},
+      {2, 2, "compression", "design", "{}"},
+  };
+  const auto id = s.create_campaign("c", "{}", "{}", jobs, 0.0);
+  const auto a = s.lease("w1", 1.0);
+  const auto b = s.lease("w2", 1.0);
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(std::pair(a->test, a->std_order), std::pair(std::string("compression"), 1));
+  EXPECT_EQ(std::pair(b->test, b->std_order), std::pair(std::string("compression"), 2));
+  EXPECT_FALSE(s.lease("w3", 1.0));  // both tensile jobs wait for their rows' compressions
+  // A failed compression ends its row's wait as a finished one does.
+  EXPECT_EQ(s.fail(b->id, b->attempt, "w2", "diverged", false, false, 2.0), kOk);
+  const auto c = s.lease("w2", 2.0);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(std::pair(c->test, c->std_order), std::pair(std::string("tensile"), 2));
+  EXPECT_FALSE(s.lease("w3", 2.0));
+  EXPECT_EQ(s.complete(a->id, a->attempt, "w1", R"({"x":1})", 1.0, 3.0), kOk);
+  const auto d = s.lease("w1", 3.0);
+  ASSERT_TRUE(d);
+  EXPECT_EQ(std::pair(d->test, d->std_order), std::pair(std::string("tensile"), 1));
+  EXPECT_EQ(s.counts(id).leased, 2);
+}
+
 TEST(Store, RunsOfAJournalAreTakenByTheJobsOfTheirKeysAndNeverReplaceARunHeld) {
   Store s(":memory:");
   const std::string series = R"({"curve":{"columns":["t"],"rows":[[1.0]]}})";
@@ -585,7 +615,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 10);
+    EXPECT_EQ(Store::latest_schema_version(), 11);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
