@@ -180,7 +180,8 @@ std::pair<std::string, std::string> split_status(const std::string& text) {
 void read_material_blocks(const std::string& yaml, const std::string& name, Json& json) {
   const io::YamlNode root = io::YamlNode::load_string(yaml, name);
   if (const auto m = root.child("material"))
-    json["material"] = Json::parse(rpc::message_json(rpc::to_material_message(io::read_material(*m))));
+    json["material"] =
+        Json::parse(rpc::message_json(rpc::to_material_message(io::read_material(*m))));
   const auto tests = root.child("tests");
   if (!tests) return;
   const auto items = tests->items();

@@ -50,7 +50,8 @@ std::string sizes_yaml(const particles::SizeDistribution& sizes) {
     return "{monodisperse: {radius: " + yaml_number(m->radius) + "}}";
   if (const auto* l = std::get_if<particles::LogNormal>(&sizes))
     return "{lognormal: {median_radius: " + yaml_number(l->median_radius) +
-           ", sigma_g: " + yaml_number(l->sigma_g) + ", truncate_k: " + yaml_number(l->truncate_k) + "}}";
+           ", sigma_g: " + yaml_number(l->sigma_g) + ", truncate_k: " + yaml_number(l->truncate_k) +
+           "}}";
   const auto& d = std::get<particles::DiscreteClasses>(sizes);
   std::string radii, fractions;
   for (std::size_t k = 0; k < d.radii.size(); ++k) {

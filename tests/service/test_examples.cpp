@@ -126,11 +126,10 @@ TEST(Examples, EveryCampaignPlansTheRunKeysItAlwaysPlanned) {
 /// then hands it that bed), and no other job waits.
 TEST(Examples, TheTensileJobsOfTheLh220CampaignWaitForTheirRowsCompression) {
   std::vector<server::NewJob> jobs;
-  server::plan_campaign(
-      cli::read_campaign_spec(std::string(DEMCAL_SOURCE_DIR) +
-                              "/examples/lh220_calibration_campaign.yaml")
-          .spec,
-      jobs);
+  server::plan_campaign(cli::read_campaign_spec(std::string(DEMCAL_SOURCE_DIR) +
+                                                "/examples/lh220_calibration_campaign.yaml")
+                            .spec,
+                        jobs);
   int tensile = 0;
   for (const auto& j : jobs) {
     EXPECT_EQ(j.waits_for, j.test == "tensile" ? "confined_compression" : "") << j.test;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 
 #include "client/spec_yaml.hpp"
@@ -214,6 +215,58 @@ TEST(TestInstances, EmbeddedRunReportsEachInstanceAsItsOwnMetric) {
   sqlite3_finalize(st);
   sqlite3_close(db);
   EXPECT_EQ(by_test, (std::map<std::string, int>{{"drum_coated", 5}, {"drum_ptfe", 5}})) << out;
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+/// Seed 000 §2.7.3: the tensile test starts from the bed its confined compression conditioned. A
+/// campaign of both (the tensile listed first, the settings of tests/lab/test_tensile.cpp) run by
+/// the embedded default: every tensile job is leased after its row's compression and starts from
+/// that bed (its phases are the unload and the pull only).
+TEST(TestInstances, ATensileJobStartsFromTheBedItsRowsCompressionConditioned) {
+  const std::string spec = R"(name: tensile-after-compression
+material:
+  particle_law:
+    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, kc_ratio: 0.5, phi_f: 0.05, restitution: 0.3}
+    cohesion: {model: van_der_waals, hamaker: 1.0e-18, d_max: 1.0e-5}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 1.0e-3}}
+  density: 1500
+tests:
+  - {test: tensile, seed: 1, settings: {particles: 100, wall_stiffness_factor: 1, wall_hamaker_factor: 10, wall_k2_factor: 1, consolidation_stress: 5000, pull_distance: 1, cycles: 1}}
+  - {test: confined_compression, seed: 1, settings: {particles: 100, wall_stiffness_factor: 1, max_stress: 5000, cycles: 1}}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.2, high: 0.4}
+  - {path: particle_law.normal.restitution, low: 0.3, high: 0.5}
+design: {type: full_factorial}
+calibration: {stages: 1, rounds: 1}
+measurements:
+  - {test: tensile, metric: tensile_strength, value: 1.0}
+)";
+  const fs::path dir = fs::temp_directory_path() / ("demcal_tensile_" + std::to_string(getpid()));
+  Process run = embedded_run(DEMCAL_CLI_BIN, dir, spec);
+  ASSERT_EQ(run.wait_exit(600), 0) << run.log();
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open_v2((dir / "work/campaign.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr),
+            SQLITE_OK);
+  sqlite3_stmt* st = nullptr;
+  sqlite3_prepare_v2(db,
+                     "SELECT j.kind, j.std_order, r.cost_json FROM jobs j JOIN results r ON "
+                     "r.job_id = j.id WHERE j.test = 'tensile' AND j.state = 'done'",
+                     -1, &st, nullptr);
+  int tensile = 0;
+  while (st && sqlite3_step(st) == SQLITE_ROW) {
+    ++tensile;
+    const auto cost =
+        nlohmann::json::parse(reinterpret_cast<const char*>(sqlite3_column_text(st, 2)));
+    std::vector<std::string> phases;
+    for (const auto& p : cost.at("phases")) phases.push_back(p.at("name"));
+    EXPECT_EQ(phases, (std::vector<std::string>{"unload", "pull"}))
+        << reinterpret_cast<const char*>(sqlite3_column_text(st, 0)) << " row "
+        << sqlite3_column_int(st, 1);
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  EXPECT_GE(tensile, 5) << run.log();  // 4 design rows and at least one verification
   if (!HasFailure()) fs::remove_all(dir);
 }
 
