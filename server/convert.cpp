@@ -17,12 +17,6 @@
 
 namespace demcal::server {
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << std::setprecision(6) << v;
-  return s.str();
-}
-
 std::string to_json(const google::protobuf::Message& message) {
   std::string out;
   google::protobuf::util::JsonPrintOptions o;
@@ -54,7 +48,7 @@ std::vector<std::string> factor_legend(const CampaignPlan& plan) {
     const auto& f = plan.factors[i];
     std::string s = std::string(1, doe::factor_letter(int(i))) + "=" + f.factor.name;
     if (f.factor.name != f.path) s += " (" + f.path + ")";
-    s += " [" + fmt(f.factor.low) + ", " + fmt(f.factor.high) + "]";
+    s += " [" + message_number(f.factor.low) + ", " + message_number(f.factor.high) + "]";
     if (f.factor.scale == doe::Scale::kLog) s += " log";
     out.push_back(s);
   }

@@ -18,9 +18,6 @@
 
 namespace demcal::server {
 
-/// A number in an error message: six significant digits.
-std::string fmt(double v);
-
 /// A Calibrate call's arguments: the model the surrogate fits (the campaign's when none), the
 /// minimiser's starts and seed, and whether to advance the loop. InputError naming the field.
 struct CalibrateCall {

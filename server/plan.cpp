@@ -194,7 +194,8 @@ void plan_fidelity(const v1::CampaignSpec& spec, CampaignPlan& plan) {
   if (!std::isfinite(f.low())) throw InputError("spec.fidelity.low", "must be finite");
   if (!std::isfinite(f.high())) throw InputError("spec.fidelity.high", "must be finite");
   if (f.low() == f.high())
-    throw InputError("spec.fidelity.high", "must differ from low (" + fmt(f.low()) + ")");
+    throw InputError("spec.fidelity.high",
+                     "must differ from low (" + message_number(f.low()) + ")");
   plan.fidelity = FidelityPlan{f.path(), f.low(), f.high(), planned_high_rows(f, plan.design)};
   const long jobs = static_cast<long>(plan.design.runs() + plan.fidelity->high_rows.size()) *
                     std::max(1, spec.tests_size());

@@ -53,8 +53,8 @@ PlannedFactor read_factor(const v1::Factor& f) {
 double option(double v, double fallback, double lo, double hi, const std::string& field) {
   if (v == 0.0) return fallback;
   if (!(v > lo && v <= hi))
-    throw InputError(field, "must be 0 (the default, " + fmt(fallback) + ") or in (" + fmt(lo) +
-                                ", " + fmt(hi) + "]");
+    throw InputError(field, "must be 0 (the default, " + message_number(fallback) + ") or in (" +
+                                message_number(lo) + ", " + message_number(hi) + "]");
   return v;
 }
 

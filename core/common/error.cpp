@@ -1,5 +1,8 @@
 #include "core/common/error.hpp"
 
+#include <iomanip>
+#include <sstream>
+
 namespace demcal {
 
 const char* to_string(SimulationFailure::Reason reason) {
@@ -14,6 +17,12 @@ const char* to_string(SimulationFailure::Reason reason) {
       return "unstable_time_step";
   }
   return "unknown";
+}
+
+std::string message_number(double value, int digits) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << value;
+  return s.str();
 }
 
 }  // namespace demcal

@@ -37,4 +37,7 @@ class SimulationFailure : public std::runtime_error {
 
 const char* to_string(SimulationFailure::Reason reason);
 
+/// A number as a message shows it: `digits` significant digits.
+std::string message_number(double value, int digits = 6);
+
 }  // namespace demcal

@@ -2,21 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <set>
-#include <sstream>
 
 #include "core/common/error.hpp"
 
 namespace demcal::lab {
 namespace {
-
-/// A number in an error message: six significant digits.
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << std::setprecision(6) << v;
-  return s.str();
-}
 
 std::string lacks(const std::string& path, const CampaignInstance& instance) {
   return "'" + path + "' is not a parameter of test '" + instance.name +
@@ -74,11 +65,13 @@ void check_factor_bounds(const CampaignFactor& f, const ParameterInfo& info) {
   if (!std::isfinite(f.low)) throw InputError(f.where + ".low", "must be finite");
   if (!std::isfinite(f.high)) throw InputError(f.where + ".high", "must be finite");
   if (!(f.low < f.high))
-    throw InputError(f.where + ".high", "must be above low (" + fmt(f.low) + ")");
-  const std::string range =
-      " the valid range [" + fmt(info.lo) + ", " + fmt(info.hi) + "] " + info.unit;
-  if (f.low < info.lo) throw InputError(f.where + ".low", fmt(f.low) + " is below" + range);
-  if (f.high > info.hi) throw InputError(f.where + ".high", fmt(f.high) + " is above" + range);
+    throw InputError(f.where + ".high", "must be above low (" + message_number(f.low) + ")");
+  const std::string range = " the valid range [" + message_number(info.lo) + ", " +
+                            message_number(info.hi) + "] " + info.unit;
+  if (f.low < info.lo)
+    throw InputError(f.where + ".low", message_number(f.low) + " is below" + range);
+  if (f.high > info.hi)
+    throw InputError(f.where + ".high", message_number(f.high) + " is above" + range);
   if (f.log && !(f.low > 0)) throw InputError(f.where + ".low", "must be > 0 on a log scale");
 }
 
