@@ -86,7 +86,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
 
 /// The plan as stored in campaigns.design_json, and back. A campaign stored before the plan held
 /// the whole campaign (its design_json has no "form") is read with its stored spec: the plan of
-/// `row`.
+/// `row`, its instances waiting for none (PlannedInstance::waits_for is set at Submit).
 std::string plan_to_json(const CampaignPlan& plan);
 CampaignPlan stored_plan(const CampaignRow& row);
 

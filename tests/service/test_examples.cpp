@@ -150,6 +150,28 @@ TEST(Examples, EveryPlanReadsBackAsStored) {
   }
 }
 
+/// A campaign stored before the plan held the whole campaign (its design_json the design,
+/// responses, targets and fidelity axis only) reads as the plan of its stored spec; its jobs wait
+/// for none (the catalogue's starts_from is consulted at Submit only).
+TEST(Examples, APlanOfTheEarlierFormReadsWithItsStoredSpec) {
+  for (const auto& f : campaign_examples()) {
+    SCOPED_TRACE(f.filename().string());
+    std::vector<server::NewJob> jobs;
+    const auto file = cli::read_campaign_spec(f.string());
+    auto plan = server::plan_campaign(file.spec, jobs);
+    auto earlier = nlohmann::json::parse(server::plan_to_json(plan));
+    for (const char* key :
+         {"form", "material", "fixed", "instances", "pinned_seeds", "calibration", "diagnosis"})
+      earlier.erase(key);
+    for (auto& factor : earlier["factors"]) factor.erase("tied");
+    server::CampaignRow row;
+    row.spec_json = server::to_json(file.spec);
+    row.design_json = earlier.dump();
+    for (auto& i : plan.instances) i.waits_for.clear();
+    EXPECT_EQ(server::plan_to_json(server::stored_plan(row)), server::plan_to_json(plan));
+  }
+}
+
 /// Every material of the examples (campaigns' and lab runs') gives itself back through its proto
 /// form: each parameter and each choice a run key holds.
 TEST(Examples, EveryMaterialKeepsEveryValueThroughItsProtoForm) {
