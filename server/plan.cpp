@@ -207,10 +207,10 @@ void plan_fidelity(const v1::CampaignSpec& spec, CampaignPlan& plan) {
 
 /// The bytes the campaign's jobs would store at most kMaxCampaignPayloadBytes: the material is
 /// copied into every job, so its size times the jobs, checked before any job is built.
-void check_campaign_bytes(const v1::CampaignSpec& spec, const CampaignPlan& plan) {
+void check_campaign_bytes(const CampaignPlan& plan) {
   const std::size_t rows =
       std::size_t(plan.design.runs()) + (plan.fidelity ? plan.fidelity->high_rows.size() : 0);
-  const std::size_t jobs = rows * std::size_t(std::max(1, spec.tests_size()));
+  const std::size_t jobs = rows * std::max<std::size_t>(1, plan.instances.size());
   const std::size_t material = to_json(rpc::to_material_message(plan.material)).size();
   if (jobs * material > kMaxCampaignPayloadBytes)
     throw InputError("spec.material",
@@ -274,7 +274,7 @@ CampaignPlan plan_campaign(const v1::CampaignSpec& spec, std::vector<NewJob>& jo
   CampaignPlan plan = read_plan_input(spec);
   plan_design(spec, plan);
   plan_fidelity(spec, plan);
-  check_campaign_bytes(spec, plan);
+  check_campaign_bytes(plan);
   apply_model(lab::model_campaign(campaign_model(plan)), plan);
   plan_targets(spec, plan);
   jobs = jobs_of(plan, design_runs(plan, plan.factors, std::string(job_kind::kDesign), 0, false));
