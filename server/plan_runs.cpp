@@ -19,13 +19,13 @@ std::uint64_t design_seed(const CampaignPlan& plan, std::uint64_t seed, int row)
 }
 
 v1::JobSpec job_spec(const CampaignPlan& plan, const PlannedRun& run,
-                     const lab::MaterialModel& material) {
+                     const v1::Material& material) {
   const auto& instance = plan.instances[run.instance];
   v1::JobSpec job;
   job.set_test(instance.test);
   for (const auto& [name, value] : run.high ? instance.settings_high : instance.settings_low)
     (*job.mutable_settings())[name] = value;
-  *job.mutable_material() = rpc::to_material_message(material);
+  *job.mutable_material() = material;
   for (const auto& [path, value] : run.parameters) (*job.mutable_parameters())[path] = value;
   job.set_seed(run.seed);
   job.set_threads(instance.threads);
@@ -80,10 +80,11 @@ std::vector<PlannedRun> runs_at(const CampaignPlan& plan,
 
 std::vector<NewJob> jobs_of(const CampaignPlan& plan, const std::vector<PlannedRun>& runs,
                             const std::map<std::string, std::string>& switches) {
-  std::vector<lab::MaterialModel> materials;
+  // Each instance's material in proto form once, not once a job.
+  std::vector<v1::Material> materials;
   for (const auto& instance : plan.instances)
-    materials.push_back(switches.empty() ? instance.material
-                                         : lab::with_switches(instance.material, switches));
+    materials.push_back(rpc::to_material_message(
+        switches.empty() ? instance.material : lab::with_switches(instance.material, switches)));
   std::vector<NewJob> jobs;
   for (const auto& run : runs) {
     const v1::JobSpec job = job_spec(plan, run, materials[run.instance]);

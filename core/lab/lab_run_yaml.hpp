@@ -7,9 +7,9 @@
 //   material: {...}
 #include <string>
 
+#include "core/io/material_yaml.hpp"
 #include "core/io/yaml_node.hpp"
 #include "core/lab/lab_run.hpp"
-#include "core/io/material_yaml.hpp"
 
 namespace demcal::lab {
 

@@ -35,7 +35,8 @@ MaterialModel every_part() {
 TEST(LabRunYaml, AMaterialReadsBackToTheSameModel) {
   const MaterialModel m = every_part();
   const std::string yaml = io::material_yaml(m);
-  const MaterialModel back = io::read_material(io::YamlNode::load_string(yaml, "m.yaml")["material"]);
+  const MaterialModel back =
+      io::read_material(io::YamlNode::load_string(yaml, "m.yaml")["material"]);
   EXPECT_EQ(material_identity(back), material_identity(m)) << yaml;
   EXPECT_EQ(back.real_median_radius, m.real_median_radius);
   EXPECT_EQ(get_parameter(back, "particle_law.tangential.mu_s"), 1.0 / 3.0);
