@@ -12,6 +12,7 @@
 #include <random>
 
 #include "core/common/error.hpp"
+#include "rpc/material_convert.hpp"
 
 namespace demcal::cli {
 namespace {
@@ -170,7 +171,9 @@ void EmbeddedService::refuse_if_another_spec(std::int64_t id, const SpecFile& fi
   req.set_id(id);
   v1::Campaign stored;
   check(stub_->Get(rpc::make_context(channel_, 60).get(), req, &stored), "get");
-  if (google::protobuf::util::MessageDifferencer::Equals(stored.spec(), file.spec)) return;
+  if (google::protobuf::util::MessageDifferencer::Equals(rpc::canonical_spec(stored.spec()),
+                                                         rpc::canonical_spec(file.spec)))
+    return;
   throw InputError("", "campaign " + std::to_string(id) + " '" + file.spec.name() + "' in " +
                            workdir_.string() + " was submitted with another spec than " +
                            file.name +

@@ -237,6 +237,22 @@ v1::Material to_material_message(const lab::MaterialModel& model) {
   return m;
 }
 
+v1::CampaignSpec canonical_spec(const v1::CampaignSpec& spec) {
+  v1::CampaignSpec out = spec;
+  if (!spec.has_material()) return out;
+  *out.mutable_material() =
+      to_material_message(to_material_model(spec.material(), "spec.material"));
+  for (int i = 0; i < out.tests_size(); ++i) {
+    auto& test = *out.mutable_tests(i);
+    if (!test.has_wall_law()) continue;
+    v1::Material own = spec.material();
+    *own.mutable_wall_law() = test.wall_law();
+    const auto where = "spec.tests[" + std::to_string(i) + "]";
+    *test.mutable_wall_law() = to_material_message(to_material_model(own, where)).wall_law();
+  }
+  return out;
+}
+
 lab::MaterialModel job_material(const v1::JobSpec& job) {
   return lab::with_run_parameters(
       to_material_model(job.material(), "job.material"),

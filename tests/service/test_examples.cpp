@@ -1,6 +1,7 @@
 // Every campaign spec in examples/ (a file with a top-level `design:`) reads and plans as the
 // coordinator would plan it: a user who copies one gets a campaign, not an error. Its planned
 // runs keep their run keys (what a journal finds a run by), and its plan reads back as stored.
+#include <google/protobuf/util/message_differencer.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -169,6 +170,30 @@ TEST(Examples, APlanOfTheEarlierFormReadsWithItsStoredSpec) {
     row.design_json = earlier.dump();
     for (auto& i : plan.instances) i.waits_for.clear();
     EXPECT_EQ(server::plan_to_json(server::stored_plan(row)), server::plan_to_json(plan));
+  }
+}
+
+/// A campaign stored by an earlier build, whose spec left the material's defaults out (no wall law
+/// when it is the particle law, no shape, preparation or size scale), is the same campaign as the
+/// spec read today: a work directory of it resumes. A changed factor bound is another campaign.
+TEST(Examples, ASpecStoredWithoutTheMaterialsDefaultsReadsAsTheSameCampaign) {
+  for (const auto& f : campaign_examples()) {
+    SCOPED_TRACE(f.filename().string());
+    const v1::CampaignSpec today = cli::read_campaign_spec(f.string()).spec;
+    v1::CampaignSpec earlier = today;
+    auto& m = *earlier.mutable_material();
+    if (google::protobuf::util::MessageDifferencer::Equals(m.wall_law(), m.particle_law()))
+      m.clear_wall_law();
+    m.clear_shape();
+    m.clear_preparation();
+    m.set_size_scale(0.0);
+    ASSERT_FALSE(google::protobuf::util::MessageDifferencer::Equals(earlier, today));
+    EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(rpc::canonical_spec(earlier),
+                                                                   rpc::canonical_spec(today)));
+    v1::CampaignSpec other = earlier;
+    other.mutable_factors(0)->set_high(other.factors(0).high() * 0.75);
+    EXPECT_FALSE(google::protobuf::util::MessageDifferencer::Equals(rpc::canonical_spec(other),
+                                                                    rpc::canonical_spec(today)));
   }
 }
 
