@@ -137,6 +137,7 @@ nlohmann::json study_json(const lab::StudyResult& r, const std::string& test,
                       {"flags", rep.flags},
                       {"wall_seconds", rep.wall_seconds}});
     j["runs"].push_back({{"value", run.value},
+                         {"x", lab::size_coordinate(r.axis, r.scaling, run.value)},
                          {"particles", run.particles},
                          {"metrics", run.metrics},
                          {"spread", run.spread},
@@ -330,6 +331,7 @@ void add_lab_command(CLI::App& app) {
   list->add_flag("--markdown", *markdown,
                  "as Markdown tables (the reference in docs/lab-tests.md)");
   list->callback([markdown] { *markdown ? list_labs_markdown() : list_labs(); });
+  add_lab_compare_command(*lab);
 }
 
 }  // namespace demcal::cli

@@ -8,6 +8,7 @@ void add_contact_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_models_command(CLI::App& app);
 void add_lab_command(CLI::App& app);
+void add_lab_compare_command(CLI::App& lab);  // `lab compare`, under `lab`
 void add_design_command(CLI::App& app);
 void add_analyze_command(CLI::App& app);
 void add_submit_command(CLI::App& app);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <utility>
 
 #include "core/common/error.hpp"
 #include "core/common/line_fit.hpp"
@@ -89,9 +90,52 @@ LineExtrapolation extrapolate_line(const std::vector<double>& x, const std::vect
   fit.residual_sd = std::sqrt(sse / (n - 2.0));
   fit.t_quantile = doe::student_t_quantile(0.5 + 0.5 * kExtrapolationConfidence, n - 2.0);
   // The interval for the mean at x0 (Montgomery and Runger §11-6.2).
-  fit.half_width = fit.t_quantile * fit.residual_sd * std::sqrt(1.0 / n + square(x0 - xbar) / sxx);
+  fit.leverage = 1.0 / n + square(x0 - xbar) / sxx;
+  fit.half_width = fit.t_quantile * fit.residual_sd * std::sqrt(fit.leverage);
   test_lack_of_fit(x, y, sse, fit);
   return fit;
+}
+
+DifferenceInterval mean_difference(const std::vector<double>& a, const std::vector<double>& b,
+                                   const std::string& where) {
+  const auto moments = [&](const std::vector<double>& v) {
+    if (v.size() < 2) throw InputError(where, "a difference of means needs 2 or more replicates");
+    double mean = 0.0;
+    for (double y : v) {
+      if (!std::isfinite(y)) throw InputError(where, "a replicate's value is not finite");
+      mean += y / static_cast<double>(v.size());
+    }
+    double ss = 0.0;
+    for (double y : v) ss += square(y - mean);
+    // mean and the variance of the mean, s^2 / n
+    return std::pair{mean, ss / static_cast<double>(v.size() - 1) / static_cast<double>(v.size())};
+  };
+  const auto [mean_a, var_a] = moments(a);
+  const auto [mean_b, var_b] = moments(b);
+  const double v = var_a + var_b;
+  if (!(v > 0.0)) throw InputError(where, "the replicates have no scatter to judge by");
+  DifferenceInterval d;
+  d.estimate = mean_a - mean_b;
+  d.df = square(v) / (square(var_a) / static_cast<double>(a.size() - 1) +
+                      square(var_b) / static_cast<double>(b.size() - 1));
+  d.t_quantile = doe::student_t_quantile(0.5 + 0.5 * kExtrapolationConfidence, d.df);
+  d.half_width = d.t_quantile * std::sqrt(v);
+  return d;
+}
+
+DifferenceInterval line_difference(const LineExtrapolation& a, const LineExtrapolation& b,
+                                   const std::string& where) {
+  if (a.x0 != b.x0)
+    throw InputError(where, "the two lines are evaluated at different sizes (x " +
+                                std::to_string(a.x0) + " and " + std::to_string(b.x0) + ")");
+  DifferenceInterval d;
+  d.estimate = a.estimate - b.estimate;
+  d.df = a.points + b.points - 4;
+  const double pooled = (square(a.residual_sd) * (a.points - 2) +
+                         square(b.residual_sd) * (b.points - 2)) / d.df;
+  d.t_quantile = doe::student_t_quantile(0.5 + 0.5 * kExtrapolationConfidence, d.df);
+  d.half_width = d.t_quantile * std::sqrt(pooled * (a.leverage + b.leverage));
+  return d;
 }
 
 double size_coordinate(StudyAxis axis, contact::ScalingLaw law, double value) {

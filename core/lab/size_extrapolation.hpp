@@ -59,6 +59,7 @@ struct LineExtrapolation {
   double half_width = 0.0;   ///< of the confidence interval for the mean at x0
   double residual_sd = 0.0;  ///< s
   double t_quantile = 0.0;   ///< t_{1 - alpha/2, n-2}
+  double leverage = 0.0;     ///< 1/n + (x0 - xbar)^2 / Sxx: the variance of the estimate over s^2
   std::optional<LackOfFit> lack_of_fit;
   std::string lack_of_fit_note;  ///< why there is no test, when there is none
 
@@ -71,6 +72,40 @@ struct LineExtrapolation {
 /// distinct x, or with x and y of different lengths.
 LineExtrapolation extrapolate_line(const std::vector<double>& x, const std::vector<double>& y,
                                    double x0, const std::string& where);
+
+/// The difference of two studies' results with its kExtrapolationConfidence interval.
+struct DifferenceInterval {
+  double estimate = 0.0;    ///< a - b
+  double half_width = 0.0;  ///< t_quantile x the standard error of the estimate
+  double df = 0.0;          ///< degrees of freedom of the t quantile
+  double t_quantile = 0.0;
+
+  double low() const { return estimate - half_width; }
+  double high() const { return estimate + half_width; }
+};
+
+/// The difference of the means of two sets of replicates at one study value, by Welch's interval,
+/// which does not take their scatters as equal (Welch, B. L., 1947, "The generalization of
+/// 'Student's' problem when several different population variances are involved", Biometrika
+/// 34, 28-35):
+///   d = mean_a - mean_b,  v = s_a^2 / n_a + s_b^2 / n_b,
+///   nu = v^2 / ((s_a^2 / n_a)^2 / (n_a - 1) + (s_b^2 / n_b)^2 / (n_b - 1)),
+///   d +- t_{1 - alpha/2, nu} sqrt(v).
+/// InputError naming `where` unless each set holds at least 2 finite values with some scatter
+/// between the two.
+DifferenceInterval mean_difference(const std::vector<double>& a, const std::vector<double>& b,
+                                   const std::string& where);
+
+/// The difference a - b of two lines of extrapolate_line at the same x0: the model of both
+/// studies with an indicator and its product with x (Kleinbaum, D. G., Kupper, L. L., Muller,
+/// K. E. and Nizam, A., "Applied Regression Analysis and Other Multivariable Methods", 3rd ed.,
+/// 1998, ch. 14: comparing two straight-line regression equations), whose residual variance is
+/// the two fits' pooled, taken as one:
+///   s_p^2 = (SSE_a + SSE_b) / (n_a + n_b - 4),  SSE = s^2 (n - 2),
+///   d = yhat_a(x0) - yhat_b(x0) +- t_{1 - alpha/2, n_a + n_b - 4} s_p sqrt(lev_a + lev_b).
+/// InputError naming `where` when the two lines are evaluated at different x0.
+DifferenceInterval line_difference(const LineExtrapolation& a, const LineExtrapolation& b,
+                                   const std::string& where);
 
 /// The size coordinate x of a study value (header comment): N^(-1/3) for a particle count, the
 /// length factor of `law` for a coarse-graining factor.

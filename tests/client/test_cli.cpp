@@ -16,6 +16,7 @@
 #include "core/common/rng.hpp"
 #include "core/io/yaml_node.hpp"
 #include "core/lab/lab_run_yaml.hpp"
+#include "core/lab/size_extrapolation.hpp"
 #include "tests/common/command.hpp"
 
 namespace {
@@ -226,6 +227,63 @@ TEST(Cli, LabStudyExtrapolatesToAnotherSize) {
   const auto& sf = j["extrapolated"]["solid_fraction"];
   EXPECT_NEAR(std::stod(cell("solid_fraction_mean")), sf["estimate"].get<double>(), 1e-12);
   EXPECT_NEAR(std::stod(cell("solid_fraction_sd")), sf["ci_half_width"].get<double>(), 1e-12);
+  fs::remove_all(dir);
+}
+
+/// A study.json as `lab study --out` writes it, reduced to what a comparison reads: per value its
+/// size coordinate and each replicate's metric "angle", extrapolated to x0 = 0.5.
+nlohmann::json study_of(const std::vector<std::vector<double>>& angles) {
+  nlohmann::json j{{"axis", "scale_factor"}, {"runs", nlohmann::json::array()}};
+  const std::vector<double> values{1000, 8000, 27000};
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    nlohmann::json reps = nlohmann::json::array();
+    for (double a : angles[i]) reps.push_back({{"metrics", {{"angle", a}}}});
+    j["runs"].push_back({{"value", values[i]}, {"x", std::cbrt(values[i])}, {"replicates", reps}});
+  }
+  j["extrapolated"]["angle"] = {{"value", 0.125}, {"x", 0.5}};
+  return j;
+}
+
+TEST(Cli, LabCompareGivesTheDifferencesOfTwoStudies) {
+  const fs::path dir = scratch_dir("compare");
+  const std::vector<std::vector<double>> a{{40, 42, 44}, {43, 46, 46}, {47, 50, 50}},
+      b{{37, 38, 41}, {41, 41, 44}, {44, 45, 49}};
+  for (const auto& [name, angles] : {std::pair{"a", a}, std::pair{"b", b}}) {
+    fs::create_directories(dir / name);
+    std::ofstream(dir / name / "study.json") << study_of(angles).dump();
+  }
+  const Result r =
+      demcal("lab compare " + (dir / "a").string() + " " + (dir / "b").string() + " --format json");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out)["metrics"]["angle"];
+  ASSERT_EQ(j["values"].size(), 3u);
+  std::vector<double> xa, ya, xb, yb;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto d = demcal::lab::mean_difference(a[i], b[i], "angle");
+    const auto& row = j["values"][i]["difference"];
+    EXPECT_NEAR(row["estimate"].get<double>(), d.estimate, 1e-12);
+    EXPECT_NEAR(row["ci_low"].get<double>(), d.low(), 1e-12);
+    EXPECT_NEAR(row["df"].get<double>(), d.df, 1e-12);
+    for (double v : a[i])
+      xa.push_back(std::cbrt(j["values"][i]["value"].get<double>())), ya.push_back(v);
+    for (double v : b[i])
+      xb.push_back(std::cbrt(j["values"][i]["value"].get<double>())), yb.push_back(v);
+  }
+  const auto line =
+      demcal::lab::line_difference(demcal::lab::extrapolate_line(xa, ya, 0.5, "a"),
+                                   demcal::lab::extrapolate_line(xb, yb, 0.5, "b"), "w");
+  const auto& e = j["extrapolated"]["difference"];
+  EXPECT_NEAR(e["estimate"].get<double>(), line.estimate, 1e-12);
+  EXPECT_NEAR(e["ci_high"].get<double>(), line.high(), 1e-12);
+  EXPECT_EQ(e["df"].get<double>(), 14.0);
+  // A study written before each value carried its size coordinate is refused, saying how to mend
+  // it.
+  auto old = study_of(a);
+  for (auto& run : old["runs"]) run.erase("x");
+  std::ofstream(dir / "a" / "study.json") << old.dump();
+  const Result refused = demcal("lab compare " + (dir / "a").string() + " " + (dir / "b").string());
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.out.find("size coordinate"), std::string::npos) << refused.out;
   fs::remove_all(dir);
 }
 
