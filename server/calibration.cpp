@@ -414,9 +414,10 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
   reply.set_stage(d.stage);
   reply.set_objective(d.proposal.objective);
   add_metrics(reply, l, &d.proposal);
-  if (d.within) {
-    // The calibrated set is the verified one, with what was predicted there.
-    const auto& accepted = l.state.rounds[std::size_t(d.accepted_round)];
+  if (d.within || d.best_round >= 0) {
+    // The calibrated set is a verified one, with what was predicted there: the round within
+    // tolerance, or, once the calibration has ended without one, its best round.
+    const auto& accepted = l.state.rounds[std::size_t(d.within ? d.accepted_round : d.best_round)];
     set_proposed(reply, l, accepted.natural);
     for (int m = 0; m < reply.metrics_size(); ++m) {
       auto* o = reply.mutable_metrics(m);

@@ -134,6 +134,11 @@ const VerifiedRound* best_round(const SequentialState& state, PointScore* score)
   return best;
 }
 
+/// The index of `round` in state.rounds; -1 for none.
+int round_index(const SequentialState& state, const VerifiedRound* round) {
+  return round ? static_cast<int>(round - state.rounds.data()) : -1;
+}
+
 std::string spent(const SequentialState& state) {
   return std::to_string(state.rounds.size()) + " round(s) (" + std::to_string(state.jobs_used) +
          " simulations)";
@@ -180,7 +185,9 @@ SequentialDecision gp_step(const SequentialState& state, const SequentialOptions
     return d;
   }
   PointScore best_score;
-  d.conclusion = not_within(state, best_round(state, &best_score), best_score);
+  const VerifiedRound* best = best_round(state, &best_score);
+  d.best_round = round_index(state, best);
+  d.conclusion = not_within(state, best, best_score);
   return d;
 }
 
@@ -364,6 +371,7 @@ SequentialDecision next_step(const SequentialState& state, const SequentialOptio
                    ": a design in a box narrowed around the best point so far";
     return d;
   }
+  d.best_round = round_index(state, best);
   d.conclusion = not_within(state, best, best_score);
   return d;
 }

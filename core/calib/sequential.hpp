@@ -106,6 +106,10 @@ struct SequentialDecision {
   bool within = false;
   /// When within: the index in state.rounds of the verified round that is (the calibrated set).
   int accepted_round = -1;
+  /// When done without a round within: the index in state.rounds of the verified round closest
+  /// to the targets (the smallest worst deviation in tolerances), the set the conclusion names;
+  /// -1 when no round was verified.
+  int best_round = -1;
   /// "within uncertainty after N rounds (M simulations)", or which metric is not and by how
   /// much, or what runs next.
   std::string conclusion;

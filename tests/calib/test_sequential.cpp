@@ -159,6 +159,17 @@ TEST(Sequential, UnreachableTargetStopsAtTheJobBudgetAndNamesTheMetric) {
       << o.last.conclusion;
   EXPECT_NE(o.last.conclusion.find("m1 simulated"), std::string::npos) << o.last.conclusion;
   EXPECT_NE(o.last.conclusion.find("x its tolerance"), std::string::npos) << o.last.conclusion;
+  // The set it ends with is the verified round closest to the targets, the one it names.
+  ASSERT_GE(o.last.best_round, 0);
+  const auto worst = [&](const VerifiedRound& r) {
+    double w = 0.0;
+    for (std::size_t m = 0; m < o.state.targets.size(); ++m)
+      w = std::max(w, std::abs((*r.simulated)(Eigen::Index(m)) - o.state.targets[m].target) /
+                          tolerance(o.state.targets[m]));
+    return w;
+  };
+  for (const auto& r : o.state.rounds)
+    EXPECT_LE(worst(o.state.rounds[std::size_t(o.last.best_round)]), worst(r));
 }
 
 TEST(Sequential, OptionsOutOfRangeNameTheField) {
