@@ -3,7 +3,6 @@
 // metric by metric: at every value both ran, the difference of their means with Welch's interval;
 // where both were extrapolated to the same value, the difference of their lines there with the
 // pooled interval (core/lab/size_extrapolation.hpp; docs/lab-tests.md, "Comparing two studies").
-#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -70,13 +69,14 @@ std::vector<double> replicate_values(const StudyFile& s, const nlohmann::json& r
   return v;
 }
 
-nlohmann::json side_json(const std::vector<double>& v) {
-  double mean = 0.0, ss = 0.0;
-  for (double y : v) mean += y / static_cast<double>(v.size());
-  for (double y : v) ss += (y - mean) * (y - mean);
-  return {{"mean", mean},
-          {"sd", v.size() > 1 ? std::sqrt(ss / static_cast<double>(v.size() - 1)) : 0.0},
-          {"n", v.size()}};
+/// One side of a row: the mean and the seed-to-seed spread the study summarised for the value.
+nlohmann::json side_json(const StudyFile& s, const nlohmann::json& run, const std::string& metric) {
+  const auto mean = run.value("metrics", nlohmann::json::object());
+  const auto sd = run.value("spread", nlohmann::json::object());
+  if (!mean.contains(metric) || !sd.contains(metric))
+    throw InputError(s.dir,
+                     "no mean or spread of metric '" + metric + "' at " + run.at("value").dump());
+  return {{"mean", mean[metric]}, {"sd", sd[metric]}, {"n", run.at("replicates").size()}};
 }
 
 nlohmann::json difference_json(const lab::DifferenceInterval& d) {
@@ -109,8 +109,10 @@ nlohmann::json compare_metric(const StudyFile& a, const StudyFile& b, const std:
     for (const auto& rb : b.doc["runs"]) {
       if (ra.at("value") != rb.at("value")) continue;
       const auto va = replicate_values(a, ra, metric), vb = replicate_values(b, rb, metric);
-      nlohmann::json row{
-          {"value", ra.at("value")}, {"x", ra.at("x")}, {"a", side_json(va)}, {"b", side_json(vb)}};
+      nlohmann::json row{{"value", ra.at("value")},
+                         {"x", ra.at("x")},
+                         {"a", side_json(a, ra, metric)},
+                         {"b", side_json(b, rb, metric)}};
       try {
         row["difference"] = difference_json(lab::mean_difference(va, vb, metric));
       } catch (const InputError& e) {

@@ -98,17 +98,13 @@ LineExtrapolation extrapolate_line(const std::vector<double>& x, const std::vect
 
 DifferenceInterval mean_difference(const std::vector<double>& a, const std::vector<double>& b,
                                    const std::string& where) {
+  // The mean and the variance of the mean, s^2 / n.
   const auto moments = [&](const std::vector<double>& v) {
     if (v.size() < 2) throw InputError(where, "a difference of means needs 2 or more replicates");
-    double mean = 0.0;
-    for (double y : v) {
+    for (double y : v)
       if (!std::isfinite(y)) throw InputError(where, "a replicate's value is not finite");
-      mean += y / static_cast<double>(v.size());
-    }
-    double ss = 0.0;
-    for (double y : v) ss += square(y - mean);
-    // mean and the variance of the mean, s^2 / n
-    return std::pair{mean, ss / static_cast<double>(v.size() - 1) / static_cast<double>(v.size())};
+    const SampleMoments m = sample_moments(v);
+    return std::pair{m.mean, square(m.sd) / static_cast<double>(v.size())};
   };
   const auto [mean_a, var_a] = moments(a);
   const auto [mean_b, var_b] = moments(b);
@@ -131,8 +127,8 @@ DifferenceInterval line_difference(const LineExtrapolation& a, const LineExtrapo
   DifferenceInterval d;
   d.estimate = a.estimate - b.estimate;
   d.df = a.points + b.points - 4;
-  const double pooled = (square(a.residual_sd) * (a.points - 2) +
-                         square(b.residual_sd) * (b.points - 2)) / d.df;
+  const double pooled =
+      (square(a.residual_sd) * (a.points - 2) + square(b.residual_sd) * (b.points - 2)) / d.df;
   d.t_quantile = doe::student_t_quantile(0.5 + 0.5 * kExtrapolationConfidence, d.df);
   d.half_width = d.t_quantile * std::sqrt(pooled * (a.leverage + b.leverage));
   return d;

@@ -10,18 +10,13 @@ namespace {
 /// Mean and sample standard deviation of every metric over the replicates, and the metrics some
 /// replicate flagged.
 void summarise(StudyRun& run) {
-  const double n = static_cast<double>(run.replicates.size());
+  std::vector<double> values;
   for (const auto& [name, unused] : run.replicates.front().metrics) {
-    double sum = 0.0;
-    for (const auto& rep : run.replicates) sum += rep.metrics.at(name);
-    const double mean = sum / n;
-    double squares = 0.0;
-    for (const auto& rep : run.replicates) {
-      const double d = rep.metrics.at(name) - mean;
-      squares += d * d;
-    }
-    run.metrics[name] = mean;
-    run.spread[name] = n > 1.0 ? std::sqrt(squares / (n - 1.0)) : 0.0;
+    values.clear();
+    for (const auto& rep : run.replicates) values.push_back(rep.metrics.at(name));
+    const SampleMoments m = sample_moments(values);
+    run.metrics[name] = m.mean;
+    run.spread[name] = m.sd;
   }
   for (const auto& rep : run.replicates)
     for (const auto& [name, why] : rep.flags) run.flagged.insert(name);
@@ -52,6 +47,18 @@ bool agree(const StudyRun& a, const StudyRun& b, const std::string& metric) {
 }
 
 }  // namespace
+
+SampleMoments sample_moments(const std::vector<double>& values) {
+  const double n = static_cast<double>(values.size());
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  SampleMoments m;
+  m.mean = sum / n;
+  double squares = 0.0;
+  for (double v : values) squares += (v - m.mean) * (v - m.mean);
+  m.sd = n > 1.0 ? std::sqrt(squares / (n - 1.0)) : 0.0;
+  return m;
+}
 
 std::optional<std::size_t> converged_index(const std::vector<StudyRun>& runs,
                                            const std::string& metric) {

@@ -64,6 +64,14 @@ struct StudyJournal {
   std::function<void(double value, const StudyReplicate& replicate)> add;
 };
 
+/// The mean of `values` and their sample standard deviation (0 for a single value); `values` must
+/// not be empty.
+struct SampleMoments {
+  double mean = 0.0;
+  double sd = 0.0;
+};
+SampleMoments sample_moments(const std::vector<double>& values);
+
 /// The most seeds a study runs per value.
 inline constexpr int kMaxStudySeeds = 10;
 

@@ -231,14 +231,20 @@ TEST(Cli, LabStudyExtrapolatesToAnotherSize) {
 }
 
 /// A study.json as `lab study --out` writes it, reduced to what a comparison reads: per value its
-/// size coordinate and each replicate's metric "angle", extrapolated to x0 = 0.5.
+/// size coordinate, the mean and spread of metric "angle" and each replicate's value, extrapolated
+/// to x0 = 0.5.
 nlohmann::json study_of(const std::vector<std::vector<double>>& angles) {
   nlohmann::json j{{"axis", "scale_factor"}, {"runs", nlohmann::json::array()}};
   const std::vector<double> values{1000, 8000, 27000};
   for (std::size_t i = 0; i < values.size(); ++i) {
     nlohmann::json reps = nlohmann::json::array();
     for (double a : angles[i]) reps.push_back({{"metrics", {{"angle", a}}}});
-    j["runs"].push_back({{"value", values[i]}, {"x", std::cbrt(values[i])}, {"replicates", reps}});
+    const auto m = demcal::lab::sample_moments(angles[i]);
+    j["runs"].push_back({{"value", values[i]},
+                         {"x", std::cbrt(values[i])},
+                         {"metrics", {{"angle", m.mean}}},
+                         {"spread", {{"angle", m.sd}}},
+                         {"replicates", reps}});
   }
   j["extrapolated"]["angle"] = {{"value", 0.125}, {"x", 0.5}};
   return j;

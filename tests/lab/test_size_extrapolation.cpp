@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-
 #include <cmath>
 #include <limits>
 
@@ -208,11 +207,13 @@ TEST(StudyDifference, LineDifferenceIsTheIndicatorModelsEstimateAndInterval) {
   // g = (0, 0, 1, x0), s^2 its residual SS over n - 4.
   Rng rng(5);
   std::vector<double> xa, ya, xb, yb;
-  synthetic({1.0, 2.0, 3.0, 4.0}, 3, 0.4, [](double x) { return 40.0 + 0.3 * x; }, rng, xa, ya);
-  synthetic({1.0, 2.0, 3.0}, 2, 0.6, [](double x) { return 37.0 + 0.9 * x; }, rng, xb, yb);
+  synthetic(
+      {1.0, 2.0, 3.0, 4.0}, 3, 0.4, [](double x) { return 40.0 + 0.3 * x; }, rng, xa, ya);
+  synthetic(
+      {1.0, 2.0, 3.0}, 2, 0.6, [](double x) { return 37.0 + 0.9 * x; }, rng, xb, yb);
   const double x0 = 0.25;
-  const auto d = line_difference(extrapolate_line(xa, ya, x0, "a"),
-                                 extrapolate_line(xb, yb, x0, "b"), "w");
+  const auto d =
+      line_difference(extrapolate_line(xa, ya, x0, "a"), extrapolate_line(xb, yb, x0, "b"), "w");
   const Eigen::Index n = static_cast<Eigen::Index>(xa.size() + xb.size());
   Eigen::MatrixXd X(n, 4);
   Eigen::VectorXd y(n);
@@ -230,9 +231,9 @@ TEST(StudyDifference, LineDifferenceIsTheIndicatorModelsEstimateAndInterval) {
   EXPECT_EQ(d.df, static_cast<double>(n - 4));
   EXPECT_NEAR(d.half_width, d.t_quantile * std::sqrt(s2 * g.dot(xtx_inv * g)), 1e-9);
   // Lines evaluated at different sizes have no difference to give.
-  EXPECT_THROW(line_difference(extrapolate_line(xa, ya, 0.0, "a"),
-                               extrapolate_line(xb, yb, x0, "b"), "w"),
-               InputError);
+  EXPECT_THROW(
+      line_difference(extrapolate_line(xa, ya, 0.0, "a"), extrapolate_line(xb, yb, x0, "b"), "w"),
+      InputError);
 }
 
 /// A study value of metrics "a" and "b" from replicates with the given values of "a" ("b" = 1).
