@@ -12,15 +12,28 @@
 namespace demcal::cli {
 namespace {
 
-/// "3 of version 1, 2 of version 4": the runs of each protocol version but the coordinator's.
-std::string other_protocols(const std::vector<v1::JournalRun>& runs, int protocol) {
-  std::map<int, int> count;
+/// The version of `test`'s protocol the coordinator runs (its reply to ImportRuns).
+int coordinator_protocol(const v1::ImportRunsReply& reply, const std::string& test) {
+  const auto own = reply.test_protocol().find(test);
+  return own == reply.test_protocol().end() ? reply.protocol() : own->second;
+}
+
+/// "3 shear_cell runs of version 2 (the coordinator runs 3), 1 tensile run of version 1 (2)": the
+/// journal's runs of each test and version the coordinator does not run.
+std::string other_protocols(const std::vector<v1::JournalRun>& runs,
+                            const v1::ImportRunsReply& reply) {
+  std::map<std::pair<std::string, int>, int> count;
   for (const auto& run : runs)
-    if (run.protocol() != protocol) ++count[run.protocol()];
+    if (run.protocol() != coordinator_protocol(reply, run.test()))
+      ++count[{run.test(), run.protocol()}];
   std::string text;
-  for (const auto& [version, n] : count)
-    text +=
-        (text.empty() ? "" : ", ") + std::to_string(n) + " of version " + std::to_string(version);
+  for (const auto& [test_version, n] : count) {
+    const auto& [test, version] = test_version;
+    text += (text.empty() ? "" : ", ") + std::to_string(n) + " " + test + " run" +
+            (n == 1 ? "" : "s") + " of version " + std::to_string(version) +
+            (text.empty() ? " (the coordinator runs " : " (") +
+            std::to_string(coordinator_protocol(reply, test)) + ")";
+  }
   return text;
 }
 
@@ -88,14 +101,14 @@ void import_journal(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& 
     total.set_known(total.known() + reply.known());
     total.set_other_protocol(total.other_protocol() + reply.other_protocol());
     total.set_protocol(reply.protocol());
+    *total.mutable_test_protocol() = reply.test_protocol();
   }
   out << "journal " << journal.path().string() << ": " << journal.runs().size() << " run(s) read, "
       << total.kept() << " new to the coordinator, " << total.known() << " held already\n";
   if (total.other_protocol() > 0)
     out << "journal " << journal.path().string() << ": " << total.other_protocol()
-        << " run(s) not taken: simulated under another lab protocol ("
-        << other_protocols(journal.runs(), total.protocol()) << "; this coordinator runs version "
-        << total.protocol() << "), whose results may differ\n";
+        << " run(s) not taken: simulated under another version of their test's protocol ("
+        << other_protocols(journal.runs(), total) << "), whose results may differ\n";
 }
 
 JournalKeeper::JournalKeeper(CampaignJournal& journal, v1::CampaignService::Stub& stub,

@@ -36,8 +36,9 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
                                                             {},
                                                             options_.fsync_every_commit,
                                                             options_.give_back_leases_at_start});
-  // Jobs of a file from before run keys get theirs, so that later jobs can take their results.
-  store_->fill_run_keys(payload_run_key);
+  // Jobs of a file from before run keys get theirs, so that later jobs can take their results,
+  // and jobs still to run the keys of this build's protocol versions.
+  store_->refresh_run_keys(payload_run_key);
   if (options_.max_starts < 1 || options_.max_starts > 1000)
     throw std::invalid_argument("--max-starts must lie in [1, 1000]");
   if (!(options_.max_watch_interval >= kMinWatchInterval && options_.max_watch_interval <= 3600))

@@ -85,7 +85,7 @@ ImportCounts import_runs(Store& store, const v1::ImportRunsRequest& request) {
     if (const std::string error = rpc::journal_run_error(run); !error.empty())
       throw InputError(run.source().empty() ? "runs[" + std::to_string(i) + "]" : run.source(),
                        error);
-    if (run.protocol() != lab::kProtocolVersion)
+    if (run.protocol() != lab::protocol_version(run.test()))
       ++counts.other_protocol;
     else
       runs.push_back(finished_run(run));

@@ -80,11 +80,14 @@ RunKey run_key(const v1::JobSpec& job) {
   const lab::MaterialModel material = rpc::job_material(job);
   // nlohmann::json keeps object keys sorted: the dump is canonical, and its numbers are the
   // shortest text that reads back to the same double.
-  const nlohmann::json canonical = {
-      {"protocol", lab::kProtocolVersion},      {"test", job.test()},
-      {"settings", settings_values(job)},       {"seed", rpc::job_seed(job)},
-      {"material", material_choices(material)}, {"parameters", material_values(material)}};
-  return {sha256_hex(canonical.dump()), lab::kProtocolVersion};
+  const int protocol = lab::protocol_version(job.test());
+  const nlohmann::json canonical = {{"protocol", protocol},
+                                    {"test", job.test()},
+                                    {"settings", settings_values(job)},
+                                    {"seed", rpc::job_seed(job)},
+                                    {"material", material_choices(material)},
+                                    {"parameters", material_values(material)}};
+  return {sha256_hex(canonical.dump()), protocol};
 }
 
 RunKey payload_run_key(const std::string& payload) {

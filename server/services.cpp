@@ -456,6 +456,8 @@ grpc::Status CampaignServiceImpl::ImportRuns(grpc::ServerContext* ctx,
     reply->set_known(counts.known);
     reply->set_other_protocol(counts.other_protocol);
     reply->set_protocol(lab::kProtocolVersion);
+    for (const auto& [test, version] : lab::kOwnProtocolVersions)
+      (*reply->mutable_test_protocol())[std::string(test)] = version;
     spdlog::info("journal runs imported: {} new, {} held already, {} of another lab protocol",
                  counts.kept, counts.known, counts.other_protocol);
     return grpc::Status::OK;

@@ -677,17 +677,23 @@ int Store::import_runs(const std::vector<FinishedRun>& runs) {
   return added;
 }
 
-void Store::fill_run_keys(const std::function<RunKey(const std::string& payload)>& key_of) {
+void Store::refresh_run_keys(const std::function<RunKey(const std::string& payload)>& key_of) {
   Guard lock(*this);
   Transaction tx(*this);
-  std::vector<std::pair<std::int64_t, std::string>> missing;
+  std::vector<std::pair<std::int64_t, RunKey>> changed;
   {
-    Statement s(*this, "SELECT id, payload FROM jobs WHERE run_key IS NULL");
-    while (s.step()) missing.emplace_back(s.i64(0), s.text(1));
+    Statement s(
+        *this,
+        "SELECT id, payload, COALESCE(run_key, ''), run_protocol, run_key IS NULL FROM jobs "
+        "WHERE run_key IS NULL OR state != 'done'");
+    while (s.step()) {
+      RunKey key = key_of(s.text(1));
+      if (s.i64(4) != 0 || key.key != s.text(2) || key.protocol != s.i64(3))
+        changed.emplace_back(s.i64(0), std::move(key));
+    }
   }
   Statement u(*this, "UPDATE jobs SET run_key = ?, run_protocol = ? WHERE id = ?");
-  for (const auto& [id, payload] : missing) {
-    const RunKey key = key_of(payload);
+  for (const auto& [id, key] : changed) {
     u.bind(1, key.key).bind(2, key.protocol).bind(3, id).step();
     u.reset();
   }

@@ -218,9 +218,11 @@ class Store {
   /// Keeps runs read from a journal for the jobs with their run keys; a key held already keeps
   /// the run it has. Returns how many were new.
   int import_runs(const std::vector<FinishedRun>& runs);
-  /// Sets the run key of every job that has none yet (jobs of a file from before run keys) to
-  /// `key_of(payload)`; an empty key marks a job that is never reused.
-  void fill_run_keys(const std::function<RunKey(const std::string& payload)>& key_of);
+  /// Sets the run key of every job that has none yet (jobs of a file from before run keys) and of
+  /// every job not done to `key_of(payload)`: a job planned under another version of its test's
+  /// protocol is simulated under this one and must be known by this one's key. A done job keeps
+  /// the key its result was simulated under. An empty key marks a job that is never reused.
+  void refresh_run_keys(const std::function<RunKey(const std::string& payload)>& key_of);
   /// Extends the current, unexpired lease held by `worker`.
   LeaseAnswer heartbeat(std::int64_t job_id, int attempt, const std::string& worker, double now);
   /// Stores the result of the current, unexpired lease held by `worker` exactly once; a retry

@@ -31,7 +31,8 @@ PistonBedRequest confinement_request(const MaterialModel& material,
 std::string conditioned_bed_identity(const MaterialModel& material,
                                      const ConfinedCompressionSettings& s,
                                      const RunOptions& options) {
-  std::string id = protocol_line() + "bed conditioned by confined_compression\n";
+  std::string id =
+      protocol_line("confined_compression") + "bed conditioned by confined_compression\n";
   for (const auto& info : ConfinedCompressionSettings::table()) {
     char line[96];
     std::snprintf(line, sizeof line, "settings.%s=%.17g\n", std::string(info.name).c_str(),

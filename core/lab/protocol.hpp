@@ -1,12 +1,31 @@
 #pragma once
-// The version of the lab tests' protocols. A finished run is known by its run key, a hash of
+// The versions of the lab tests' protocols. A finished run is known by its run key, a hash of
 // everything that determines its result (the material, the test and its settings, the seed) and
-// of this number: a journal or a store hands a run's result to a later job with the same key
-// instead of simulating it again (docs/journal.md). Raise it whenever a change to a lab test's
-// protocol (its phases, targets, metrics or their definitions) changes its results, so that no
-// result of the old protocol is taken for a run of the new one.
+// of its test's protocol version: a journal or a store hands a run's result to a later job with
+// the same key instead of simulating it again (docs/journal.md). Raise a test's version whenever a
+// change to its protocol (its phases, targets, metrics or their definitions) changes its results,
+// so that no result of the old protocol is taken for a run of the new one, while the runs of the
+// other tests stay valid.
+#include <array>
+#include <string_view>
+#include <utility>
+
 namespace demcal::lab {
 
+/// The version of every test whose protocol has not changed on its own since this number was
+/// raised for all of them.
 inline constexpr int kProtocolVersion = 2;
+
+/// The tests with a version of their own:
+///   shear_cell 3: the head is lowered into the settled bed instead of placed in it at once.
+inline constexpr std::array<std::pair<std::string_view, int>, 1> kOwnProtocolVersions = {
+    {{"shear_cell", 3}}};
+
+/// The protocol version of lab test `test`.
+constexpr int protocol_version(std::string_view test) {
+  for (const auto& [name, version] : kOwnProtocolVersions)
+    if (name == test) return version;
+  return kProtocolVersion;
+}
 
 }  // namespace demcal::lab

@@ -172,8 +172,49 @@ sim::World cell_world(const MaterialModel& material, const ShearCellSettings& s,
   return w;
 }
 
-/// Fills the vessel, settles the bed and hangs the head over it, its vanes in the bed's top;
-/// records the fill and settle phases.
+/// The names of every metric of the test: what a phase of the bed's making that missed its target
+/// flags.
+std::vector<std::string> every_metric() {
+  std::vector<std::string> names;
+  for (const auto& m : find_lab_info(ShearCellSettings::kName).metrics) names.push_back(m.name);
+  return names;
+}
+
+/// Hangs the head over the settled bed, its vane tips a quarter diameter above the bed top, and
+/// lowers it at tip_speed until its disk is half a diameter above the bed top, the vanes
+/// h_v - d/2 deep in the bed (phase "insert head"). A head placed there at once would cut the
+/// particles under its vanes up to 0.9 radii deep, each overlap an energy of the order of k1 r^2
+/// set free in one step: more than the bed's whole potential energy, and for a cohesive bed of
+/// small particles more than the kinetic energy the health check allows.
+void insert_head(ShearCell& c, const ShearCellSettings& s, double h_v, LabOutput& out) {
+  sim::World& w = c.w;
+  const PhaseClock clock(w);
+  const double final_z = metrics::bed_top(w) + 0.5 * c.d;
+  const double travel = h_v - 0.25 * c.d;  // vane_height >= 0.5: at least d/4
+  const double head_z = final_z + travel;
+  c.r_head = c.radius - 0.25 * c.d;
+  auto head = walls::make_wall("head",
+                               walls::make_vane_head({0, 0, head_z}, {0, 0, 1}, c.r_head, h_v,
+                                                     static_cast<int>(s.vanes), 32),
+                               kWallPiston);
+  head.pivot = {0, 0, head_z};
+  w.walls.push_back(head);
+  w.walls[kHead].velocity = {0, 0, -s.tip_speed};
+  // The time step may change on the way: the head stops where it is due, not after a step count.
+  const long most_steps = 4 * std::lround(travel / s.tip_speed / w.dt) + 1;
+  run_checked(w, most_steps, c.limits,
+              [&](sim::World& ww) { return ww.walls[kHead].pivot.z > final_z; });
+  w.walls[kHead].velocity = {};
+  const bool reached = w.walls[kHead].pivot.z <= final_z;
+  char target[128];
+  std::snprintf(target, sizeof target,
+                "vane tips lowered at tip_speed from d/4 above the bed top to %.3g d below it",
+                h_v / c.d - 0.5);
+  out.add_phase(clock.stop(w, "insert head", target, reached), every_metric());
+}
+
+/// Fills the vessel, settles the bed and lowers the head into it (insert_head); records the fill,
+/// settle and insert head phases.
 ShearCell build_cell(const MaterialModel& material, const ShearCellSettings& s,
                      const RunOptions& options, LabOutput& out) {
   ShearCell c;
@@ -202,18 +243,9 @@ ShearCell build_cell(const MaterialModel& material, const ShearCellSettings& s,
   // Settings and metrics are real stresses; the bed feels them x the scaling law's stress factor.
   c.real_kpa = 1e3 * material.factors().stress;
   settle_spec.rest_stress = kShearPreKPa * c.real_kpa * s.stress_scale;
-  out.add_phase(settle(w, settle_spec, c.limits, material.factors().time), {});
+  out.add_phase(settle(w, settle_spec, c.limits, material.factors().time), every_metric());
 
-  // The head: its disk half a diameter above the bed top, vanes reaching into the bed's top.
-  const double head_z = metrics::bed_top(w) + 0.5 * c.d;
-  auto head =
-      walls::make_wall("head",
-                       walls::make_vane_head({0, 0, head_z}, {0, 0, 1}, c.radius - 0.25 * c.d, h_v,
-                                             static_cast<int>(s.vanes), 32),
-                       kWallPiston);
-  head.pivot = {0, 0, head_z};
-  w.walls.push_back(head);
-  c.r_head = c.radius - 0.25 * c.d;
+  insert_head(c, s, h_v, out);
 
   c.sigma_pre = kShearPreKPa * c.real_kpa * s.stress_scale;
   c.servo.axis = {0, 0, 1};  // the floor pushes the bed up against the head

@@ -30,8 +30,8 @@ std::uint64_t fnv1a(const std::string& text) {
 
 }  // namespace
 
-std::string protocol_line() {
-  return "demcal lab protocol " + std::to_string(kProtocolVersion) + "\n";
+std::string protocol_line(std::string_view test) {
+  return "demcal lab protocol " + std::to_string(protocol_version(test)) + "\n";
 }
 
 StageCache::StageCache(std::filesystem::path dir) : dir_(std::move(dir)) {

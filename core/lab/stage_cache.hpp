@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace demcal::lab {
 
@@ -33,8 +34,8 @@ class StageCache {
   std::filesystem::path dir_;
 };
 
-/// The first line of every identity: the lab protocol's version (core/lab/protocol.hpp), so a
-/// record made under another protocol is never taken.
-std::string protocol_line();
+/// The first line of every identity: the protocol version (core/lab/protocol.hpp) of the test
+/// whose stage it is, so a record made under another protocol is never taken.
+std::string protocol_line(std::string_view test);
 
 }  // namespace demcal::lab

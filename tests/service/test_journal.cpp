@@ -2,8 +2,8 @@
 // campaign in one store takes the first's results instead of leasing its jobs; `demcal run
 // --journal` interrupted and resumed in a fresh work directory gives the uninterrupted run's
 // effects to the bit with no run simulated twice; a journal of another spec gives exactly the runs
-// whose keys match; runs of another lab protocol version are not taken; lines cut short are
-// dropped and malformed lines refused with their file and line.
+// whose keys match; runs of another version of their test's protocol are not taken; lines cut short
+// are dropped and malformed lines refused with their file and line.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -227,6 +227,19 @@ TEST_F(Journal, ImportRunsRefusesAnInvalidRunNamingItsLineAndKeepsNothingOfTheCa
   EXPECT_EQ(reply.known(), 0);
   EXPECT_EQ(reply.other_protocol(), 1);
   EXPECT_EQ(reply.protocol(), lab::kProtocolVersion);
+  // A test with a version of its own: its runs of the common version are another protocol's.
+  EXPECT_EQ(reply.test_protocol().at("shear_cell"), lab::protocol_version("shear_cell"));
+  EXPECT_NE(lab::protocol_version("shear_cell"), lab::kProtocolVersion);
+  v1::ImportRunsRequest shear;
+  *shear.add_runs() = *good;
+  shear.mutable_runs(0)->set_run_key(std::string(64, 'd'));
+  shear.mutable_runs(0)->set_test("shear_cell");
+  ASSERT_TRUE(campaigns_->ImportRuns(ctx().get(), shear, &reply).ok());
+  EXPECT_EQ(reply.other_protocol(), 1);
+  EXPECT_EQ(reply.kept(), 0);
+  shear.mutable_runs(0)->set_protocol(lab::protocol_version("shear_cell"));
+  ASSERT_TRUE(campaigns_->ImportRuns(ctx().get(), shear, &reply).ok());
+  EXPECT_EQ(reply.kept(), 1);
   ASSERT_TRUE(campaigns_->ImportRuns(ctx().get(), req, &reply).ok());
   EXPECT_EQ(reply.kept(), 0);
   EXPECT_EQ(reply.known(), 1);
@@ -297,15 +310,17 @@ TEST_F(Journal, RunsOfAnotherLabProtocolVersionAreNotTaken) {
   auto lines = file_lines(journal);
   std::string err;
   auto changed = nlohmann::json::parse(lines[2]);
-  changed["protocol"] = lab::kProtocolVersion + 1;
+  const std::string test = changed.at("test");
+  const int version = lab::protocol_version(test);
+  changed["protocol"] = version + 1;
   lines[2] = changed.dump();
   write_lines(journal, lines);
   ASSERT_EQ(run(path("a.yaml"), "again", journal, err), 0) << err;
-  EXPECT_NE(
-      err.find("1 run(s) not taken: simulated under another lab protocol (1 of version " +
-               std::to_string(lab::kProtocolVersion + 1) + "; this coordinator runs version " +
-               std::to_string(lab::kProtocolVersion) + ")"),
-      std::string::npos)
+  EXPECT_NE(err.find("1 run(s) not taken: simulated under another version of their test's "
+                     "protocol (1 " +
+                     test + " run of version " + std::to_string(version + 1) +
+                     " (the coordinator runs " + std::to_string(version) + "))"),
+            std::string::npos)
       << err;
   for (const auto& job : stored_jobs("again"))
     EXPECT_EQ(job.reused, job.run_key != changed.at("run_key")) << job.run_key;

@@ -639,17 +639,24 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
     EXPECT_EQ(s.result_count(1), 1);
     EXPECT_FALSE(js[0].reused());  // a result from before reuse: simulated
     // A job from before run keys gets its key when the coordinator computes it (here: a name).
-    s.fill_run_keys([](const std::string& payload) {
+    s.refresh_run_keys([](const std::string& payload) {
       return RunKey{payload == R"({"p":1})" ? "old-key" : "", 1};
     });
     EXPECT_EQ(s.job(1)->run_key, (RunKey{"old-key", 1}));
-    s.fill_run_keys([](const std::string&) { return RunKey{"not asked", 1}; });
-    EXPECT_EQ(s.job(1)->run_key.key, "old-key");  // computed once
+    s.refresh_run_keys([](const std::string&) { return RunKey{"not asked", 1}; });
+    EXPECT_EQ(s.job(1)->run_key.key, "old-key");  // a done job keeps the key of its result
 
     const auto ids = s.add_jobs(1, {{1, 1, "packing", "diagnose:shape", "{}"}});
     ASSERT_EQ(ids.size(), 1u);
     EXPECT_GT(ids[0], 1);  // a new id after the migrated job's
     EXPECT_EQ(s.counts(1, "diagnose:shape").queued, 1);
+    // A job still to run takes the key of the build that runs it (another version of its test's
+    // protocol: another key); the done job keeps the key its result was simulated under.
+    s.refresh_run_keys([](const std::string& payload) {
+      return RunKey{payload == "{}" ? "this-build" : "not asked", 3};
+    });
+    EXPECT_EQ(s.job(ids[0])->run_key, (RunKey{"this-build", 3}));
+    EXPECT_EQ(s.job(1)->run_key, (RunKey{"old-key", 1}));
     EXPECT_EQ(s.campaign(1)->state, "running");
     EXPECT_ANY_THROW(s.add_jobs(1, {{1, 1, "packing", "bogus", "{}"}}));
     js = s.jobs(1);
