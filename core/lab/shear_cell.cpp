@@ -10,11 +10,12 @@
 // a uniform shear stress tau over that disk the torque is
 //   T = int_0^R tau 2 pi r r dr = (2/3) pi R^3 tau,   so   tau = 3 T / (2 pi R^3).
 //
-// Phases: fill and settle; consolidate at sigma_pre = 3 kPa; pre-shear at constant tip speed for
-// pre_shear_travel diameters: pre_shear_stress is the mean tau of the last third (steady state).
-// Then, for every sigma_x of Table 3, starting again from the pre-sheared state (the seed's
-// restart files): re-consolidate at sigma_pre with the head at rest, reduce to sigma_x, and
-// drive the head by torque: the set torque ramps up, the head turns at
+// Phases: fill and settle; insert head (lowered into the bed); consolidate at sigma_pre = 3 kPa;
+// pre-shear at constant tip speed for pre_shear_travel diameters: pre_shear_stress is the mean tau
+// of the last third (steady state). Then re-consolidate the pre-sheared state at sigma_pre with
+// the head at rest, once, and for every sigma_x of Table 3 start again from that state (the seed's
+// restart files): reduce to sigma_x, and drive the head by torque: the set torque ramps up, the
+// head turns at
 //   omega = clamp(k (T_set - T), 0, omega_max)
 // and the bed has yielded once the tips have travelled 1.5 diameters; the yield shear stress is
 // the largest tau (mean over 0.5 d of tip travel) on the way. A least-squares line through the five
@@ -334,18 +335,25 @@ struct YieldStep {
   bool yielded = false;  ///< the tips moved 1.5 diameters within the time
 };
 
-/// One shear step (phase `name`) from a copy of the pre-sheared cell: re-consolidated at sigma_pre,
-/// reduced to sigma_x, then sheared under torque control, the set torque ramped to twice the
-/// pre-shear torque; the yield point is the peak of the shear stress averaged over the time the
-/// tips need for 0.5 d at full speed (a shorter mean would pick up contact noise, not the bed's
-/// strength).
+/// Re-consolidates the pre-sheared cell at sigma_pre with the head at rest (phase
+/// "re-consolidate"): the state every shear step starts from (the seed's restart files). The five
+/// steps start from the same state, so it is made once.
+void reconsolidate(ShearCell& c, const ShearCellSettings& s, LabOutput& out) {
+  const PhaseClock clock(c.w);
+  c.servo_run(c.w, c.sigma_pre, s.consolidation_time, {});
+  out.add_phase(clock.stop(c.w, "re-consolidate", "fixed time under the servo", true), {});
+}
+
+/// One shear step (phase `name`) from a copy of the re-consolidated cell: reduced to sigma_x, then
+/// sheared under torque control, the set torque ramped to twice the pre-shear torque; the yield
+/// point is the peak of the shear stress averaged over the time the tips need for 0.5 d at full
+/// speed (a shorter mean would pick up contact noise, not the bed's strength).
 YieldStep shear_step(ShearCell& c, const std::string& name, double step_kpa,
                      const ShearCellSettings& s, double tau_pre, LabOutput& out) {
   sim::World v = c.w;
   const PhaseClock step_clock(v);
   YieldStep y;
   y.sigma_x = step_kpa * c.real_kpa * s.stress_scale;
-  c.servo_run(v, c.sigma_pre, s.consolidation_time, {});
   c.servo_run(v, y.sigma_x, s.consolidation_time, {});
   const double torque_pre = tau_pre * 2.0 * M_PI * std::pow(c.r_head, 3) / 3.0;
   const double t0 = v.time;
@@ -388,8 +396,8 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
   Series points{{"sigma_x_kpa", "sigma_measured_kpa", "yield_shear_stress_kpa"}, {}};
   LineFit locus;
   std::vector<double> ys;
-  // The stages: the pre-sheared cell, then each shear step done.
-  std::vector<std::string> names{"pre-shear"};
+  // The stages: the pre-sheared cell re-consolidated, then each shear step done.
+  std::vector<std::string> names{"re-consolidated"};
   for (const double kpa : kShearNormalKPa) {
     char name[64];
     std::snprintf(name, sizeof name, "shear step %g kPa", kpa);
@@ -410,9 +418,10 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
     c = build_cell(material, s, options, out);
     pre = pre_shear(c, s, options, out);
     write_snapshot(c.w, options, "shear_cell_preshear", out, c.radius);
+    reconsolidate(c, s, out);
     stages.reached(0, c.w);
   }
-  // The shear steps, each from the pre-sheared state (c.w, left as it is); the locus uses the
+  // The shear steps, each from the re-consolidated state (c.w, left as it is); the locus uses the
   // normal stress measured on the floor at the yield point.
   for (std::size_t k = next - 1; k < kShearNormalKPa.size(); ++k) {
     const YieldStep y = shear_step(c, stages.name(k + 1), kShearNormalKPa[k], s, pre.tau, out);
