@@ -14,6 +14,7 @@
 #include "client/study_journal.hpp"
 #include "core/io/csv.hpp"
 #include "core/lab/lab_run_yaml.hpp"
+#include "core/lab/protocol.hpp"
 #include "core/lab/size_extrapolation.hpp"
 #include "core/lab/stage_cache.hpp"
 #include "core/lab/study.hpp"
@@ -240,7 +241,8 @@ void run_lab_study(const StudyOptions& opt) {
     kept.emplace(std::filesystem::path(opt.out_dir) / "replicates.jsonl",
                  nlohmann::json{{"spec", spec_text.str()},
                                 {"axis", by_scale ? "scale_factor" : "particles"},
-                                {"threads", opt.threads}});
+                                {"threads", opt.threads},
+                                {"protocol", lab::protocol_version(spec.test)}});
     if (kept->runs_read() > 0)
       std::cerr << "study: " << kept->runs_read() << " finished run(s) read from " << opt.out_dir
                 << "/replicates.jsonl\n";

@@ -40,8 +40,8 @@ void StudyJournalFile::take(const std::string& text, std::size_t line) {
   if (line == 1) {
     if (j.value("study", nlohmann::json()) != identity_)
       throw InputError(file_.path().string(),
-                       "holds the runs of another study (its spec, axis or --threads "
-                       "differ): remove it or give another --out");
+                       "holds the runs of another study (its spec, axis, --threads or the "
+                       "test's lab protocol version differ): remove it or give another --out");
     return;
   }
   const double value = j.at("value").get<double>();

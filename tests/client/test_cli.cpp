@@ -171,6 +171,20 @@ TEST(Cli, LabStudyGoesOnWhereItStopped) {
   EXPECT_NE(other.out.find("replicates.jsonl: holds the runs of another study"), std::string::npos)
       << other.out;
   EXPECT_EQ(file_lines(journal), kept);
+  // So is the same spec's file written under another version of the test's protocol: its runs
+  // are not this build's.
+  auto header = nlohmann::json::parse(kept[0]);
+  header["study"]["protocol"] = header["study"]["protocol"].get<int>() + 1;
+  {
+    std::ofstream changed(journal, std::ios::trunc);
+    changed << header.dump() << "\n";
+    for (std::size_t i = 1; i < kept.size(); ++i) changed << kept[i] << "\n";
+  }
+  const Result other_protocol = demcal(study);
+  EXPECT_NE(other_protocol.exit_code, 0);
+  EXPECT_NE(other_protocol.out.find("replicates.jsonl: holds the runs of another study"),
+            std::string::npos)
+      << other_protocol.out;
   fs::remove_all(dir);
 }
 
