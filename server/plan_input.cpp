@@ -39,7 +39,8 @@ PlannedInstance read_instance(const v1::CampaignSpec& spec, int i) {
           settings,
           instance_model(spec, t, "spec.tests[" + std::to_string(i) + "]"),
           t.seed() ? t.seed() : 1,
-          t.threads()};
+          t.threads(),
+          {}};
 }
 
 PlannedFactor read_factor(const v1::Factor& f) {

@@ -293,7 +293,9 @@ TEST_F(Journal, AJournalOfAnotherSpecGivesExactlyTheRunsWhoseKeysMatch) {
   int taken = 0;
   for (const auto& job : stored_jobs("b")) {
     EXPECT_EQ(job.reused, a_metrics.count(job.run_key) > 0) << job.run_key;
-    if (job.reused) EXPECT_EQ(job.metrics, a_metrics[job.run_key]);
+    if (job.reused) {
+      EXPECT_EQ(job.metrics, a_metrics[job.run_key]);
+    }
     taken += job.reused;
   }
   EXPECT_EQ(taken, 2);

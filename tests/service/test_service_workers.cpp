@@ -232,11 +232,11 @@ TEST_F(Service, AResultsCurvesAreCheckedStoredAndExported) {
   ASSERT_TRUE(cli::read_export(*campaigns_, channel_, id, "json", content, true).ok());
   bool found = false;
   const auto exported = nlohmann::json::parse(content);
-  for (const auto& job : exported.at("jobs")) {
-    ASSERT_TRUE(job.contains("series"));
-    if (job["job_id"] != good.job_id()) continue;
+  for (const auto& row : exported.at("jobs")) {
+    ASSERT_TRUE(row.contains("series"));
+    if (row["job_id"] != good.job_id()) continue;
     found = true;
-    const auto& s = job["series"]["stress_strain"];
+    const auto& s = row["series"]["stress_strain"];
     EXPECT_EQ(s["columns"], nlohmann::json({"strain", "stress_kPa"}));
     EXPECT_EQ(s["rows"], nlohmann::json({{0.0, 0.0}, {0.01, 5.0}, {0.02, 15.0}}));
   }
