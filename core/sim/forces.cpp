@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <span>
 #include <vector>
 
 #include "core/sim/pair_input.hpp"
@@ -120,7 +121,11 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
         const int i = *it;
         double* h = hist + static_cast<std::ptrdiff_t>(i) * kSlots * kSlot;
         walls::WallGeometry g[kSlots];
-        const int found = walls::mesh_contacts(*mesh, p.x[i], p.radius[i], range, g);
+        const auto k = static_cast<std::size_t>(it - near.begin());
+        const std::vector<int>& start = w.wall_reach[wall_index].triangle_start;
+        const std::span<const int> candidates(w.wall_reach[wall_index].triangles.data() + start[k],
+                                              static_cast<std::size_t>(start[k + 1] - start[k]));
+        const int found = walls::mesh_contacts(*mesh, candidates, p.x[i], p.radius[i], range, g);
         bool used[kSlots] = {};
         int slot_of[kSlots];
         for (int c = 0; c < found; ++c) {

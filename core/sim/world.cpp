@@ -116,6 +116,23 @@ void World::balance_owners() {
   }
 }
 
+namespace {
+
+/// Lists the triangles of `mesh` each particle of reach.near may touch before it or the mesh
+/// moves by `margin` (WallReach::triangles).
+void list_triangles(const walls::Mesh& mesh, const particles::ParticleStore& particles,
+                    double range, double margin, World::WallReach& reach) {
+  reach.triangle_start.assign(1, 0);
+  reach.triangles.clear();
+  for (const int i : reach.near) {
+    walls::mesh_candidates(mesh, particles.x[i], particles.radius[i] + range + margin,
+                           reach.triangles);
+    reach.triangle_start.push_back(static_cast<int>(reach.triangles.size()));
+  }
+}
+
+}  // namespace
+
 void World::refresh_wall_reach() {
   if (wall_reach.size() != walls.size()) wall_reach.assign(walls.size(), {});
   const double margin = 1.5 * skin_;
@@ -125,7 +142,10 @@ void World::refresh_wall_reach() {
     double range = 0.0;
     for (int m = 0; m < n_materials_; ++m)
       range = std::max(range, wall_law(wall.material, m).range());
-    if (reach.valid && reach.range == range &&
+    const walls::Mesh* mesh = std::get_if<walls::Mesh>(&wall.shape);
+    // A restored state has a mesh's near particles but not their triangles: listed again.
+    const bool triangles_listed = !mesh || reach.triangle_start.size() == reach.near.size() + 1;
+    if (reach.valid && triangles_listed && reach.range == range &&
         walls::surface_shift(reach.shape, wall.shape, reach.extent) <= 0.5 * skin_)
       continue;
     const Vec3 origin = walls::reference_point(wall.shape);
@@ -147,6 +167,10 @@ void World::refresh_wall_reach() {
     reach.shape = wall.shape;
     reach.range = range;
     reach.valid = true;
+    if (mesh)
+      list_triangles(*mesh, particles, range, margin, reach);
+    else
+      reach.triangle_start.clear();
   }
 }
 

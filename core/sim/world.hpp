@@ -143,6 +143,10 @@ class World {
     double range = -1.0;    ///< the wall laws' reach beyond contact when listed (m)
     double extent = 0.0;    ///< the largest distance of a particle from the shape's reference (m)
     bool valid = false;
+    /// A mesh's triangles each listed particle may touch, with the same margin: near[k]'s are
+    /// triangles[triangle_start[k] .. triangle_start[k + 1]), ascending (walls::mesh_candidates).
+    /// Not part of a saved state: a restored mesh wall is listed again.
+    std::vector<int> triangle_start, triangles;
   };
   std::vector<WallReach> wall_reach;
   /// Lists again the particles of every wall whose list is out of date (forces.cpp calls it

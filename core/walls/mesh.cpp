@@ -70,7 +70,23 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
-int mesh_contacts(const Mesh& mesh, const Vec3& x, double r, double range, WallGeometry* out) {
+namespace {
+
+/// Whether triangle t's bounding box lies farther than `reach` from x along some axis: then the
+/// triangle does too.
+bool box_out_of_reach(const Mesh& mesh, const std::array<int, 3>& t, const Vec3& x, double reach) {
+  const auto& v = mesh.vertices;
+  const Vec3 &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
+  for (int k = 0; k < 3; ++k)
+    if (std::min({a[k], b[k], c[k]}) > x[k] + reach || std::max({a[k], b[k], c[k]}) < x[k] - reach)
+      return true;
+  return false;
+}
+
+/// mesh_contacts over the triangles `each_triangle(visit)` hands to visit, in ascending order.
+template <class EachTriangle>
+int contacts_among(const Mesh& mesh, const Vec3& x, double r, double range, WallGeometry* out,
+                   EachTriangle each_triangle) {
   struct Candidate {
     Vec3 point;
     double dist;
@@ -84,28 +100,24 @@ int mesh_contacts(const Mesh& mesh, const Vec3& x, double r, double range, WallG
     for (int k = 0; k < 3; ++k)
       if (x[k] + reach < mesh.lo[k] || x[k] - reach > mesh.hi[k]) return 0;
   const auto& v = mesh.vertices;
-  for (const auto& t : mesh.triangles) {
-    const Vec3 &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
+  each_triangle([&](const std::array<int, 3>& t) {
     // Box rejection before the Voronoi search.
-    bool outside = false;
-    for (int k = 0; k < 3 && !outside; ++k)
-      outside = std::min({a[k], b[k], c[k]}) > x[k] + reach ||
-                std::max({a[k], b[k], c[k]}) < x[k] - reach;
-    if (outside) continue;
+    if (box_out_of_reach(mesh, t, x, reach)) return;
+    const Vec3 &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
     int feature = 0;
     const Vec3 q = closest_point_on_triangle(x, a, b, c, feature);
     const double d2 = norm2(q - x);
-    if (d2 > reach * reach || d2 == 0.0) continue;
+    if (d2 > reach * reach || d2 == 0.0) return;
     if (n_cand == kMaxCandidates) {
       // Keep the nearest kMaxCandidates (only dense fans around a vertex get here).
       auto far = std::max_element(cand.begin(), cand.end(),
                                   [](const auto& l, const auto& m) { return l.dist < m.dist; });
-      if (far->dist * far->dist <= d2) continue;
+      if (far->dist * far->dist <= d2) return;
       *far = {q, std::sqrt(d2), feature == 0};
-      continue;
+      return;
     }
     cand[n_cand++] = {q, std::sqrt(d2), feature == 0};
-  }
+  });
   if (n_cand == 0) return 0;
   // Faces first, then edges and vertices, each nearest first; a non-face candidate shadowed by an
   // accepted contact (its point on or beyond that contact's tangent plane) is the same surface.
@@ -140,6 +152,26 @@ int mesh_contacts(const Mesh& mesh, const Vec3& x, double r, double range, WallG
     out[i].point = kept[k].point;
   }
   return n;
+}
+
+}  // namespace
+
+int mesh_contacts(const Mesh& mesh, const Vec3& x, double r, double range, WallGeometry* out) {
+  return contacts_among(mesh, x, r, range, out, [&](auto visit) {
+    for (const auto& t : mesh.triangles) visit(t);
+  });
+}
+
+int mesh_contacts(const Mesh& mesh, std::span<const int> candidates, const Vec3& x, double r,
+                  double range, WallGeometry* out) {
+  return contacts_among(mesh, x, r, range, out, [&](auto visit) {
+    for (const int t : candidates) visit(mesh.triangles[static_cast<std::size_t>(t)]);
+  });
+}
+
+void mesh_candidates(const Mesh& mesh, const Vec3& x, double reach, std::vector<int>& out) {
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    if (!box_out_of_reach(mesh, mesh.triangles[t], x, reach)) out.push_back(static_cast<int>(t));
 }
 
 Mesh make_quad(const Vec3& corner, const Vec3& u, const Vec3& v) {

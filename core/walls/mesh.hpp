@@ -17,6 +17,7 @@
 // A contact sliding across triangles of one surface (or rolling round a convex edge) changes its
 // normal slowly, so it keeps its tangential spring; see forces.cpp.
 #include <array>
+#include <span>
 #include <vector>
 
 #include "core/common/vec3.hpp"
@@ -52,6 +53,13 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
 /// The contacts of a sphere with a mesh (at most Mesh::kMaxContacts, deepest first), each with
 /// the nearest point and n pointing from the centre into the wall; returns how many.
 int mesh_contacts(const Mesh& mesh, const Vec3& x, double r, double range, WallGeometry* out);
+/// The same among the triangles `candidates` (indices, ascending) only: the same contacts when
+/// they hold every triangle within reach (mesh_candidates).
+int mesh_contacts(const Mesh& mesh, std::span<const int> candidates, const Vec3& x, double r,
+                  double range, WallGeometry* out);
+/// Appends, ascending, the triangles whose bounding box comes within `reach` of x: every
+/// triangle a sphere of radius r at x touches or comes within range of, for reach >= r + range.
+void mesh_candidates(const Mesh& mesh, const Vec3& x, double reach, std::vector<int>& out);
 
 // Builders. Triangles are two-sided: either face touches particles.
 /// Quad corner, corner+u, corner+u+v, corner+v (two triangles).
