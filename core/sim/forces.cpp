@@ -64,7 +64,8 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
   const double* inverse_mass = w.contact_inverse_mass();
   const walls::Mesh* mesh = std::get_if<walls::Mesh>(&wall.shape);
   // Only the particles that may touch the wall (World::wall_reach), those of [lo, hi).
-  const std::vector<int>& near = w.wall_reach[wall_index].near;
+  const World::WallReach& reach = w.wall_reach[wall_index];
+  const std::vector<int>& near = reach.near;
   const auto first = std::lower_bound(near.begin(), near.end(), lo);
   const auto last = std::lower_bound(first, near.end(), hi);
   {
@@ -121,10 +122,11 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
         const int i = *it;
         double* h = hist + static_cast<std::ptrdiff_t>(i) * kSlots * kSlot;
         walls::WallGeometry g[kSlots];
-        const auto k = static_cast<std::size_t>(it - near.begin());
-        const std::vector<int>& start = w.wall_reach[wall_index].triangle_start;
-        const std::span<const int> candidates(w.wall_reach[wall_index].triangles.data() + start[k],
-                                              static_cast<std::size_t>(start[k + 1] - start[k]));
+        // Its triangles within reach, listed with it (World::WallReach::triangles).
+        const auto at = static_cast<std::size_t>(it - near.begin());
+        const std::span<const int> candidates(
+            reach.triangles.data() + reach.triangle_start[at],
+            static_cast<std::size_t>(reach.triangle_start[at + 1] - reach.triangle_start[at]));
         const int found = walls::mesh_contacts(*mesh, candidates, p.x[i], p.radius[i], range, g);
         bool used[kSlots] = {};
         int slot_of[kSlots];

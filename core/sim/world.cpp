@@ -167,10 +167,7 @@ void World::refresh_wall_reach() {
     reach.shape = wall.shape;
     reach.range = range;
     reach.valid = true;
-    if (mesh)
-      list_triangles(*mesh, particles, range, margin, reach);
-    else
-      reach.triangle_start.clear();
+    if (mesh) list_triangles(*mesh, particles, range, margin, reach);
   }
 }
 
