@@ -17,6 +17,7 @@
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "rpc/channel.hpp"
+#include "rpc/protocols.hpp"
 #include "server/coordinator.hpp"
 
 namespace {
@@ -49,8 +50,7 @@ int fake_worker(const rpc::ChannelOptions& channel, const std::string& id) {
   auto stub = v1::WorkerService::NewStub(rpc::make_channel(channel));
   int done = 0;
   for (;;) {
-    v1::LeaseRequest lr;
-    lr.set_worker(id);
+    const v1::LeaseRequest lr = rpc::lease_request(id);
     v1::LeaseReply lease;
     if (!stub->Lease(rpc::make_context(channel, 30).get(), lr, &lease).ok()) continue;
     if (!lease.has_job()) return done;

@@ -12,6 +12,7 @@
 #include "core/lab/protocol.hpp"
 #include "core/model/catalog.hpp"
 #include "rpc/effects_convert.hpp"
+#include "rpc/protocols.hpp"
 #include "rpc/result_check.hpp"
 #include "server/admission.hpp"
 #include "server/analysis.hpp"
@@ -475,6 +476,10 @@ grpc::Status WorkerServiceImpl::Lease(grpc::ServerContext* ctx, const v1::LeaseR
   if (auto s = admit(*ctx, config_.tokens, Caller::kWorker, *req); !s.ok()) return s;
   if (const std::string error = worker_text_error(req->worker()); !error.empty())
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
+  if (const std::string error = rpc::protocol_mismatch(req->protocols()); !error.empty()) {
+    spdlog::warn("lease to {} refused: {}", req->worker(), error);
+    return {grpc::StatusCode::FAILED_PRECONDITION, error};
+  }
   reply->set_lease_seconds(store_.limits().lease_seconds);
   reply->set_heartbeat_seconds(config_.heartbeat_seconds);
   reply->set_retry_after_seconds(config_.idle_retry_seconds);

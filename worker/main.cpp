@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
     const auto stats = demcal::worker::run_worker(o, flags);
     std::fflush(nullptr);
     // A given-back job may still be simulating in a detached thread: leave without joining it.
-    std::_Exit(stats.unauthenticated ? 2 : 0);
+    std::_Exit(stats.unauthenticated ? 2 : stats.other_protocol ? 3 : 0);
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
     return 1;

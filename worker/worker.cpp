@@ -21,6 +21,7 @@
 #include "core/lab/stage_cache.hpp"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "rpc/material_convert.hpp"
+#include "rpc/protocols.hpp"
 #include "rpc/result_check.hpp"
 
 namespace demcal::worker {
@@ -292,13 +293,17 @@ class Worker {
  private:
   /// One lease and what follows from it; false when the loop must end.
   bool step() {
-    v1::LeaseRequest lreq;
-    lreq.set_worker(id_);
+    const v1::LeaseRequest lreq = rpc::lease_request(id_);
     v1::LeaseReply lease;
     const auto ls = stub_->Lease(rpc::make_context(opt_.channel, 10).get(), lreq, &lease);
     if (ls.error_code() == grpc::StatusCode::UNAUTHENTICATED) {
       spdlog::error("coordinator refused the token: {}", ls.error_message());
       stats_.unauthenticated = true;
+      return false;
+    }
+    if (ls.error_code() == grpc::StatusCode::FAILED_PRECONDITION) {
+      spdlog::error("coordinator refused this build: {}", ls.error_message());
+      stats_.other_protocol = true;
       return false;
     }
     if (!ls.ok()) {

@@ -20,6 +20,7 @@
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "rpc/channel.hpp"
+#include "rpc/protocols.hpp"
 #include "tests/service/process.hpp"
 
 namespace demcal::test {
@@ -184,9 +185,7 @@ class Service : public ::testing::Test {
 
   /// The coordinator's answer to a Lease of `worker` (no job in it when none is to be run).
   void lease_as(const std::string& worker, v1::LeaseReply& lease) {
-    v1::LeaseRequest lr;
-    lr.set_worker(worker);
-    const auto status = workers_stub_->Lease(ctx().get(), lr, &lease);
+    const auto status = workers_stub_->Lease(ctx().get(), rpc::lease_request(worker), &lease);
     ASSERT_TRUE(status.ok()) << status.error_message();
   }
 

@@ -122,8 +122,7 @@ TEST_F(Service, AWorkerTokenCannotSubmitOrCancelAndAClientTokenCannotLeaseOrComp
   EXPECT_EQ(
       campaigns_as(worker)->Cancel(rpc::make_context(worker, 10).get(), cancel, &c).error_code(),
       grpc::StatusCode::PERMISSION_DENIED);
-  v1::LeaseRequest lr;
-  lr.set_worker("w");
+  const v1::LeaseRequest lr = rpc::lease_request("w");
   v1::LeaseReply lease;
   ASSERT_TRUE(workers_as(worker)->Lease(rpc::make_context(worker, 10).get(), lr, &lease).ok());
   ASSERT_TRUE(lease.has_job());

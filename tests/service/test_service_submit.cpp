@@ -288,8 +288,7 @@ TEST_F(Service, OversizedSpecsAndWorkerTextsAreRefusedNamingTheFieldAndNothingIs
   // A worker's id and its failure reason are bounded too; a refused Fail leaves the lease as it
   // was.
   ASSERT_TRUE(submit(tiny_spec(30)).ok());
-  v1::LeaseRequest long_id;
-  long_id.set_worker(std::string(257, 'w'));
+  const v1::LeaseRequest long_id = rpc::lease_request(std::string(257, 'w'));
   v1::LeaseReply refused;
   auto st = workers_stub_->Lease(ctx().get(), long_id, &refused);
   EXPECT_EQ(st.error_code(), grpc::StatusCode::INVALID_ARGUMENT);

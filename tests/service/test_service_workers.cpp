@@ -19,6 +19,7 @@
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
 #include "core/lab/lab_run.hpp"
+#include "core/lab/protocol.hpp"
 #include "demcal/v1/campaign.grpc.pb.h"
 #include "demcal/v1/worker.grpc.pb.h"
 #include "rpc/channel.hpp"
@@ -383,6 +384,37 @@ TEST_F(Service, AResultWithAMetricItsTestDoesNotReportIsRefused) {
   EXPECT_TRUE(st.ok()) << st.error_message();
 }
 
+// A worker of another build (other lab protocol versions, or none named) is refused its lease:
+// its results would be stored under run keys that claim this build's protocol.
+TEST_F(Service, AWorkerOfOtherLabProtocolVersionsIsRefusedItsLease) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  v1::LeaseRequest older = rpc::lease_request("old");
+  (*older.mutable_protocols())["shear_cell"] -= 1;
+  v1::LeaseReply lease;
+  auto st = workers_stub_->Lease(ctx().get(), older, &lease);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_NE(st.error_message().find("protocols.shear_cell: the worker simulates it under lab "
+                                    "protocol version " +
+                                    std::to_string(lab::protocol_version("shear_cell") - 1) +
+                                    ", this coordinator keys its runs under " +
+                                    std::to_string(lab::protocol_version("shear_cell"))),
+            std::string::npos)
+      << st.error_message();
+  v1::LeaseRequest unnamed;
+  unnamed.set_worker("older");
+  st = workers_stub_->Lease(ctx().get(), unnamed, &lease);
+  EXPECT_EQ(st.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_NE(st.error_message().find("names no protocol version for lab test"), std::string::npos)
+      << st.error_message();
+  EXPECT_FALSE(lease.has_job());
+  // Nothing was leased: the job goes to a worker of this build.
+  ASSERT_NO_FATAL_FAILURE(lease_as("this", lease));
+  ASSERT_TRUE(lease.has_job());
+  EXPECT_EQ(lease.job().attempt(), 1);
+}
+
 TEST_F(Service, WorkersRacingNeverShareAJob) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
@@ -394,8 +426,7 @@ TEST_F(Service, WorkersRacingNeverShareAJob) {
     racers.emplace_back([&, t] {
       auto stub = v1::WorkerService::NewStub(rpc::make_channel(channel_));
       for (int k = 0; k < 4; ++k) {
-        v1::LeaseRequest lr;
-        lr.set_worker("racer" + std::to_string(t));
+        const v1::LeaseRequest lr = rpc::lease_request("racer" + std::to_string(t));
         v1::LeaseReply r;
         if (stub->Lease(rpc::make_context(channel_, 10).get(), lr, &r).ok() && r.has_job()) {
           std::lock_guard lock(m);

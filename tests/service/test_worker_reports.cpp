@@ -1,7 +1,8 @@
 // How a worker reports a finished job to a coordinator that does not take it at once: a result
 // refused as invalid fails the job (not retried) with the coordinator's message, and heartbeats
-// keep the lease while a report is retried. The coordinator is a fake WorkerService in process
-// on loopback that leases one small packing job and answers Complete as each test says; the
+// keep the lease while a report is retried; and how it leases: naming its lab protocol versions,
+// and stopping when the coordinator refuses them. The coordinator is a fake WorkerService in
+// process on loopback that leases one small packing job and answers Complete as each test says; the
 // worker is the real one (run_worker), the job is simulated for real.
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 #include <thread>
 
 #include "demcal/v1/worker.grpc.pb.h"
+#include "rpc/protocols.hpp"
 #include "worker/worker.hpp"
 
 namespace demcal::test {
@@ -48,8 +50,17 @@ class FakeCoordinator final : public v1::WorkerService::Service {
   explicit FakeCoordinator(std::function<grpc::Status()> answer_complete)
       : answer_complete_(std::move(answer_complete)) {}
 
-  grpc::Status Lease(grpc::ServerContext*, const v1::LeaseRequest*,
+  /// Every Lease is answered with `status` (and no job when it is not OK).
+  void refuse_leases(grpc::Status status) { lease_status_ = std::move(status); }
+
+  grpc::Status Lease(grpc::ServerContext*, const v1::LeaseRequest* req,
                      v1::LeaseReply* reply) override {
+    {
+      std::lock_guard lock(mutex_);
+      ++leases_;
+      protocol_mismatch_ = rpc::protocol_mismatch(req->protocols());
+    }
+    if (!lease_status_.ok()) return lease_status_;
     reply->set_lease_seconds(30);
     reply->set_heartbeat_seconds(0.1);
     reply->set_retry_after_seconds(0.05);
@@ -82,6 +93,15 @@ class FakeCoordinator final : public v1::WorkerService::Service {
     return grpc::Status::OK;
   }
 
+  int leases() {
+    std::lock_guard lock(mutex_);
+    return leases_;
+  }
+  /// rpc::protocol_mismatch of the latest lease request's versions against this build's.
+  std::string protocol_mismatch() {
+    std::lock_guard lock(mutex_);
+    return protocol_mismatch_;
+  }
   int completes() {
     std::lock_guard lock(mutex_);
     return completes_;
@@ -97,9 +117,11 @@ class FakeCoordinator final : public v1::WorkerService::Service {
 
  private:
   std::function<grpc::Status()> answer_complete_;
+  grpc::Status lease_status_ = grpc::Status::OK;
   std::atomic<bool> leased_{false};
   std::mutex mutex_;
-  int heartbeats_ = 0, heartbeats_after_first_complete_ = 0, completes_ = 0;
+  std::string protocol_mismatch_ = "no lease asked for";
+  int leases_ = 0, heartbeats_ = 0, heartbeats_after_first_complete_ = 0, completes_ = 0;
   std::vector<v1::FailRequest> fails_;
 };
 
@@ -165,6 +187,25 @@ TEST(WorkerReports, HeartbeatsGoOnWhileAReportIsRetried) {
   EXPECT_GT(fake.completes(), 1);
   EXPECT_GE(fake.heartbeats_after_first_complete(), 3);
   EXPECT_TRUE(fake.fails().empty());
+}
+
+TEST(WorkerReports, AWorkerLeasesNamingItsProtocolVersionsAndStopsWhenTheCoordinatorRunsOthers) {
+  FakeCoordinator runs([] { return grpc::Status::OK; });
+  const auto done = run_worker_against(runs, 20);
+  EXPECT_EQ(done.completed, 1);
+  EXPECT_EQ(runs.protocol_mismatch(), "") << "the worker's lease named other versions";
+
+  // A coordinator of another build refuses the lease: the worker leaves at once (its exit status
+  // 3), without retrying and without running anything.
+  FakeCoordinator other([] { return grpc::Status::OK; });
+  other.refuse_leases({grpc::StatusCode::FAILED_PRECONDITION,
+                       "protocols.shear_cell: the worker simulates it under lab protocol "
+                       "version 3, this coordinator keys its runs under 4"});
+  const auto refused = run_worker_against(other, 20);
+  EXPECT_TRUE(refused.other_protocol);
+  EXPECT_EQ(other.leases(), 1) << "a refused build asked again";
+  EXPECT_EQ(refused.completed + refused.failed, 0);
+  EXPECT_EQ(other.completes(), 0);
 }
 
 }  // namespace
