@@ -14,10 +14,10 @@ v1::LeaseRequest lease_request(const std::string& worker) {
 }
 
 std::string protocol_mismatch(const google::protobuf::Map<std::string, std::int32_t>& theirs) {
+  constexpr const char* advice = ": run a worker of the coordinator's build";
   for (const lab::LabTestInfo& info : lab::lab_catalog()) {
     const int ours = lab::protocol_version(info.name);
     const auto it = theirs.find(info.name);
-    const std::string advice = ": run a worker of the coordinator's build";
     if (it == theirs.end())
       return "protocols: the worker names no protocol version for lab test " + info.name +
              " (this coordinator runs " + std::to_string(ours) + ")" + advice;

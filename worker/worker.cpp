@@ -270,6 +270,7 @@ class Worker {
       : opt_(opt),
         flags_(flags),
         id_(worker_id(opt)),
+        lease_request_(rpc::lease_request(id_)),
         stub_(v1::WorkerService::NewStub(rpc::make_channel(opt.channel))),
         jitter_(std::hash<std::string>{}(id_)),
         stage_cache_(opt.stage_cache_dir.empty()
@@ -293,9 +294,8 @@ class Worker {
  private:
   /// One lease and what follows from it; false when the loop must end.
   bool step() {
-    const v1::LeaseRequest lreq = rpc::lease_request(id_);
     v1::LeaseReply lease;
-    const auto ls = stub_->Lease(rpc::make_context(opt_.channel, 10).get(), lreq, &lease);
+    const auto ls = stub_->Lease(rpc::make_context(opt_.channel, 10).get(), lease_request_, &lease);
     if (ls.error_code() == grpc::StatusCode::UNAUTHENTICATED) {
       spdlog::error("coordinator refused the token: {}", ls.error_message());
       stats_.unauthenticated = true;
@@ -500,6 +500,8 @@ class Worker {
   const WorkerOptions& opt_;
   StopFlags& flags_;
   const std::string id_;
+  /// The same every lease: the id and the lab protocol versions.
+  const v1::LeaseRequest lease_request_;
   std::unique_ptr<v1::WorkerService::Stub> stub_;
   std::mt19937_64 jitter_;
   std::shared_ptr<const lab::StageCache> stage_cache_;

@@ -43,7 +43,8 @@ struct WorkerStats {
   int abandoned = 0;     ///< simulations stopped because the lease was gone
   int refused_jobs = 0;  ///< jobs over this worker's limits, failed back unrun
   bool unauthenticated = false;
-  bool other_protocol = false;  ///< the coordinator runs other lab protocol versions than this build
+  /// The coordinator runs other lab protocol versions than this build.
+  bool other_protocol = false;
 };
 
 /// Runs until stopped (or max_jobs / idle_exit). A job given back on abort leaves its
