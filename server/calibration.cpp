@@ -217,12 +217,18 @@ v1::CalibrationRound round_message(const Loaded& l, std::size_t i) {
   return m;
 }
 
-/// Per metric: target, prediction, reach, tolerance, and the latest simulated value.
-void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
-                 const calib::CalibrationResult* proposal) {
+/// The latest round whose point has been simulated, or none.
+const calib::VerifiedRound* latest_simulated(const Loaded& l) {
   const calib::VerifiedRound* latest = nullptr;
   for (const auto& r : l.state.rounds)
     if (r.simulated) latest = &r;
+  return latest;
+}
+
+/// Per metric: target, prediction, reach, tolerance, and the value simulated at `shown` (a
+/// verified round: the calibrated set's own once there is one, else the latest).
+void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
+                 const calib::CalibrationResult* proposal, const calib::VerifiedRound* shown) {
   for (std::size_t m = 0; m < l.state.targets.size(); ++m) {
     const auto& t = l.state.targets[m];
     auto* o = reply.add_metrics();
@@ -244,8 +250,8 @@ void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
     } else if (!l.state.rounds.empty()) {
       o->set_predicted(l.state.rounds.back().predicted(Eigen::Index(m)));
     }
-    if (latest && std::isfinite((*latest->simulated)(Eigen::Index(m)))) {
-      const double sim = (*latest->simulated)(Eigen::Index(m));
+    if (shown && shown->simulated && std::isfinite((*shown->simulated)(Eigen::Index(m)))) {
+      const double sim = (*shown->simulated)(Eigen::Index(m));
       o->set_simulated_available(true);
       o->set_simulated(sim);
       o->set_within(tol > 0.0 && std::abs(sim - t.target) <= tol);
@@ -406,18 +412,18 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
     reply.set_simulations(l.state.jobs_used);
     reply.set_conclusion(running_conclusion(l));
     if (!l.state.rounds.empty()) set_proposed(reply, l, l.state.rounds.back().natural);
-    add_metrics(reply, l, nullptr);
+    add_metrics(reply, l, nullptr, latest_simulated(l));
     if (l.plan.fidelity) add_fidelity(reply, l);
     return reply;
   }
   const calib::SequentialDecision d = calib::next_step(l.state, l.options);
   reply.set_stage(d.stage);
   reply.set_objective(d.proposal.objective);
-  add_metrics(reply, l, &d.proposal);
   if (d.within || d.best_round >= 0) {
-    // The calibrated set is a verified one, with what was predicted there: the round within
-    // tolerance, or, once the calibration has ended without one, its best round.
+    // The calibrated set is a verified one, with what was predicted and simulated there: the
+    // round within tolerance, or, once the calibration has ended without one, its best round.
     const auto& accepted = l.state.rounds[std::size_t(d.within ? d.accepted_round : d.best_round)];
+    add_metrics(reply, l, &d.proposal, &accepted);
     set_proposed(reply, l, accepted.natural);
     for (int m = 0; m < reply.metrics_size(); ++m) {
       auto* o = reply.mutable_metrics(m);
@@ -425,6 +431,7 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
       o->set_relative_error((o->predicted() - o->target()) / std::abs(o->target()));
     }
   } else {
+    add_metrics(reply, l, &d.proposal, latest_simulated(l));
     set_proposed(reply, l, d.proposal.natural);
   }
   add_intervals(reply, l, d.proposal);

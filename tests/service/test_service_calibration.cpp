@@ -1,8 +1,8 @@
 // Service tests with real processes, real gRPC on loopback and real SQLite files (the fixture:
 // service_fixture.hpp). Calibrate and Diagnose over gRPC: refused on a cancelled campaign, the
 // coarse_graining runs, centre points and curvature, what the data fix only in combination,
-// Gaussian-process batches, and a multi-fidelity campaign. Leases and heartbeats are short (flags);
-// every wait is bounded.
+// the calibrated set shown with its own round's values, Gaussian-process batches, and a
+// multi-fidelity campaign. Leases and heartbeats are short (flags); every wait is bounded.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -252,6 +252,52 @@ TEST_F(Service, ACalibrationStatesTheFactorsTheDataFixOnlyInCombination) {
   EXPECT_LT(t.at("a_from").get<double>(), t.at("a_to").get<double>());
   EXPECT_GT(t.at("b_from").get<double>(), t.at("b_to").get<double>());
   EXPECT_NE(t.at("statement").get<std::string>().find("trade off"), std::string::npos);
+}
+
+TEST_F(Service, TheCalibratedSetIsShownWithTheValuesSimulatedAtItsOwnRound) {
+  // Results through the real worker protocol, no physics: the design's solid fraction rises with
+  // mu_s and meets 0.6 +- 0.02 inside the box; the two verification rounds miss it, the first by
+  // less (0.65) than the second (0.75). The calibration ends without a match; its calibrated set
+  // is round 1, shown with what round 1 predicted and simulated, not with round 2's value.
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30, 0, "", "calibration: {rounds: 2, stages: 1}\n"), &id).ok());
+  for (int k = 0; k < 4; ++k)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+      const double a = (job.parameters().at("particle_law.tangential.mu_s") - 0.3) / 0.2;
+      (*c.mutable_metrics())["solid_fraction"] = 0.6 + 0.1 * a;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+    }));
+  v1::CalibrateRequest verify;
+  verify.set_id(id);
+  verify.set_verify(true);
+  for (const double simulated : {0.65, 0.75}) {
+    v1::CalibrateReply queued;
+    ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), verify, &queued).ok());
+    ASSERT_EQ(queued.verification_jobs_size(), 1) << queued.conclusion();
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec&, v1::CompleteRequest& c) {
+      (*c.mutable_metrics())["solid_fraction"] = simulated;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+    }));
+  }
+  v1::CalibrateReply done;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), verify, &done).ok());
+  EXPECT_EQ(done.verification_state(), "done") << done.conclusion();
+  EXPECT_EQ(done.conclusion().rfind("not within uncertainty after 2 round(s)", 0), 0u)
+      << done.conclusion();
+  ASSERT_EQ(done.rounds_size(), 2);
+  ASSERT_EQ(done.rounds(1).simulated_size(), 1);
+  EXPECT_EQ(done.rounds(1).simulated(0), 0.75);
+  const auto& best = done.rounds(0);
+  ASSERT_EQ(done.proposed_values_size(), best.proposed_values_size());
+  for (int f = 0; f < best.proposed_values_size(); ++f)
+    EXPECT_EQ(done.proposed_values(f), best.proposed_values(f)) << f;
+  ASSERT_EQ(done.metrics_size(), 1);
+  const auto& m = done.metrics(0);
+  EXPECT_TRUE(m.simulated_available());
+  EXPECT_EQ(m.simulated(), 0.65);
+  EXPECT_FALSE(m.within());
+  EXPECT_EQ(m.predicted(), best.predicted(0));
 }
 
 TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {
