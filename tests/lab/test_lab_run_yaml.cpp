@@ -1,8 +1,11 @@
 // The YAML of a material and of a lab run written by material_yaml() / lab_run_yaml() reads back
 // with the lab-run reader to the same model and run, for every part of a material the writer
 // covers: both laws, a log-normal distribution, size scale, scaling, a clump shape, a
-// preparation and the real median radius.
+// preparation and the real median radius. The lab-run specs committed beside seed 000's tables
+// (docs/data/seed000) read as runs of the test each is named after.
 #include <gtest/gtest.h>
+
+#include <filesystem>
 
 #include "core/io/yaml_node.hpp"
 #include "core/lab/lab_run_yaml.hpp"
@@ -56,6 +59,22 @@ TEST(LabRunYaml, ALabRunReadsBackToTheSameRun) {
   EXPECT_EQ(back.options.seed, run.options.seed);
   EXPECT_EQ(back.options.threads, run.options.threads);
   EXPECT_EQ(material_identity(back.material), material_identity(run.material)) << yaml;
+}
+
+TEST(LabRunYaml, TheCommittedSeed000LabSpecsReadAsRunsOfTheirTest) {
+  namespace fs = std::filesystem;
+  int specs = 0;
+  for (const auto& e :
+       fs::recursive_directory_iterator(fs::path(DEMCAL_SOURCE_DIR) / "docs/data/seed000")) {
+    const std::string test = e.path().stem().string();
+    if (e.path().extension() != ".yaml" || test == "material") continue;
+    SCOPED_TRACE(e.path().string());
+    const LabRunSpec run = read_lab_run(io::YamlNode::load_file(e.path().string()));
+    EXPECT_EQ(run.test, test);
+    EXPECT_NO_THROW(run.material.validate());
+    ++specs;
+  }
+  EXPECT_GE(specs, 6);  // LH100's three tests, in its final box and in Table 8's
 }
 
 }  // namespace
