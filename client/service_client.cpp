@@ -290,16 +290,20 @@ void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std
   for (int i = 0; i < c.factor_paths_size(); ++i)
     out << "  " << std::left << std::setw(40) << c.factor_paths(i) << std::right << " = "
         << fmt(c.proposed_values(i), 6) << "\n";
+  // Each "dev %" follows its value: the relative deviation from the measurement.
   out << "\n  " << std::left << std::setw(36) << "metric" << std::right << std::setw(12)
-      << "measured" << std::setw(12) << "predicted" << std::setw(12) << "simulated" << std::setw(10)
-      << "dev %" << std::setw(11) << "tolerance"
+      << "measured" << std::setw(12) << "predicted" << std::setw(8) << "dev %" << std::setw(12)
+      << "simulated" << std::setw(8) << "dev %" << std::setw(11) << "tolerance"
       << "  within  reach [min, max]\n";
   for (const auto& m : c.metrics()) {
+    const double scale = m.target() != 0.0 ? 100.0 / std::abs(m.target()) : std::nan("");
     out << "  " << std::left << std::setw(36) << m.metric() << std::right << std::setw(12)
-        << fmt(m.target()) << std::setw(12) << fmt(m.predicted()) << std::setw(12)
-        << (m.simulated_available() ? fmt(m.simulated()) : "-") << std::setw(10)
-        << fmt(100 * m.relative_error(), 3) << std::setw(11) << fmt(m.tolerance(), 3) << "  "
-        << std::setw(6) << (m.simulated_available() ? (m.within() ? "yes" : "no") : "-") << "  ["
+        << fmt(m.target()) << std::setw(12) << fmt(m.predicted()) << std::setw(8)
+        << fmt(100 * m.relative_error(), 3) << std::setw(12)
+        << (m.simulated_available() ? fmt(m.simulated()) : "-") << std::setw(8)
+        << (m.simulated_available() ? fmt(scale * (m.simulated() - m.target()), 3) : "-")
+        << std::setw(11) << fmt(m.tolerance(), 3) << "  " << std::setw(6)
+        << (m.simulated_available() ? (m.within() ? "yes" : "no") : "-") << "  ["
         << fmt(m.envelope_min()) << ", " << fmt(m.envelope_max()) << "]\n";
     if (!m.statement().empty()) out << "      " << m.statement() << "\n";
   }

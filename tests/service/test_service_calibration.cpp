@@ -14,6 +14,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "client/service_client.hpp"
@@ -298,6 +299,22 @@ TEST_F(Service, TheCalibratedSetIsShownWithTheValuesSimulatedAtItsOwnRound) {
   EXPECT_EQ(m.simulated(), 0.65);
   EXPECT_FALSE(m.within());
   EXPECT_EQ(m.predicted(), best.predicted(0));
+  // The table prints each value's deviation from the measurement after it: the simulated 0.65
+  // against 0.6 is +8.33 %.
+  const std::string table =
+      cli_text(dir_, "calibrate_table", {"calibrate", std::to_string(id)}, channel_);
+  std::istringstream lines(table);
+  std::string line;
+  std::vector<std::string> row;
+  while (std::getline(lines, line))
+    if (line.rfind("  packing.solid_fraction ", 0) == 0) {
+      std::istringstream words(line);
+      for (std::string w; words >> w;) row.push_back(w);
+    }
+  ASSERT_GE(row.size(), 6u) << table;
+  EXPECT_EQ(row[1], "0.6");
+  EXPECT_EQ(row[4], "0.65");
+  EXPECT_EQ(row[5], "8.33");
 }
 
 TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {
