@@ -252,24 +252,25 @@ class Service : public ::testing::Test {
   std::unique_ptr<v1::WorkerService::Stub> workers_stub_;
 };
 
-/// Runs the CLI against the test's coordinator; returns its standard output.
-inline std::string cli_text(const std::string& dir, const std::string& name,
+/// Runs the CLI against the test's coordinator; returns its standard output, which stays in
+/// `dir`/`file` (its standard error beside it, `file`.err).
+inline std::string cli_text(const std::string& dir, const std::string& file,
                             const std::vector<std::string>& args, const rpc::ChannelOptions& ch) {
   std::vector<std::string> argv{DEMCAL_CLI_BIN};
   argv.insert(argv.end(), args.begin(), args.end());
   for (const std::string a : {"--coordinator", ch.address.c_str(), "--token", kToken.c_str()})
     argv.push_back(a);
-  const std::string out = dir + "/" + name + ".out", err = dir + "/" + name + ".err";
-  Process p(argv, out, err);
-  EXPECT_EQ(p.wait_exit(150), 0) << name << ": " << p.log();
+  Process p(argv, dir + "/" + file, dir + "/" + file + ".err");
+  EXPECT_EQ(p.wait_exit(150), 0) << file << ": " << p.log();
   return p.log();
 }
 
-/// Runs the CLI against the test's coordinator; returns its standard output parsed as JSON.
+/// Runs the CLI against the test's coordinator; returns its standard output (kept in
+/// `dir`/`name`.json) parsed as JSON.
 inline nlohmann::json cli_json(const std::string& dir, const std::string& name,
                                const std::vector<std::string>& args,
                                const rpc::ChannelOptions& ch) {
-  const std::string out = cli_text(dir, name, args, ch);
+  const std::string out = cli_text(dir, name + ".json", args, ch);
   try {
     return nlohmann::json::parse(out);
   } catch (const std::exception& e) {

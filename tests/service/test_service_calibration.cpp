@@ -302,7 +302,7 @@ TEST_F(Service, TheCalibratedSetIsShownWithTheValuesSimulatedAtItsOwnRound) {
   // The table prints each value's deviation from the measurement after it: the simulated 0.65
   // against 0.6 is +8.33 %.
   const std::string table =
-      cli_text(dir_, "calibrate_table", {"calibrate", std::to_string(id)}, channel_);
+      cli_text(dir_, "calibrate_table.txt", {"calibrate", std::to_string(id)}, channel_);
   std::istringstream lines(table);
   std::string line;
   std::vector<std::string> row;
