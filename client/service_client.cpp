@@ -12,6 +12,7 @@
 
 #include "client/format.hpp"
 #include "core/common/error.hpp"
+#include "core/common/relative_error.hpp"
 
 namespace demcal::cli {
 namespace {
@@ -296,12 +297,11 @@ void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std
       << "simulated" << std::setw(8) << "dev %" << std::setw(11) << "tolerance"
       << "  within  reach [min, max]\n";
   for (const auto& m : c.metrics()) {
-    const double scale = m.target() != 0.0 ? 100.0 / std::abs(m.target()) : std::nan("");
     out << "  " << std::left << std::setw(36) << m.metric() << std::right << std::setw(12)
         << fmt(m.target()) << std::setw(12) << fmt(m.predicted()) << std::setw(8)
         << fmt(100 * m.relative_error(), 3) << std::setw(12)
         << (m.simulated_available() ? fmt(m.simulated()) : "-") << std::setw(8)
-        << (m.simulated_available() ? fmt(scale * (m.simulated() - m.target()), 3) : "-")
+        << (m.simulated_available() ? fmt(100 * relative_error(m.simulated(), m.target()), 3) : "-")
         << std::setw(11) << fmt(m.tolerance(), 3) << "  " << std::setw(6)
         << (m.simulated_available() ? (m.within() ? "yes" : "no") : "-") << "  ["
         << fmt(m.envelope_min()) << ", " << fmt(m.envelope_max()) << "]\n";

@@ -9,6 +9,7 @@
 
 #include "core/calib/multi_fidelity.hpp"
 #include "core/common/error.hpp"
+#include "core/common/relative_error.hpp"
 #include "server/analysis.hpp"
 #include "server/convert.hpp"
 #include "server/plan.hpp"
@@ -428,7 +429,7 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
     for (int m = 0; m < reply.metrics_size(); ++m) {
       auto* o = reply.mutable_metrics(m);
       o->set_predicted(accepted.predicted(m));
-      o->set_relative_error((o->predicted() - o->target()) / std::abs(o->target()));
+      o->set_relative_error(relative_error(o->predicted(), o->target()));
     }
   } else {
     add_metrics(reply, l, &d.proposal, latest_simulated(l));

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/common/error.hpp"
+#include "core/common/relative_error.hpp"
 #include "core/common/rng.hpp"
 #include "core/doe/design.hpp"
 
@@ -389,8 +390,7 @@ CalibrationResult calibrate(const CalibrationProblem& problem, const Calibration
     o.name = m.name;
     o.target = m.target;
     o.predicted = predict(m, out.coded);
-    o.relative_error =
-        m.target != 0.0 ? (o.predicted - m.target) / std::abs(m.target) : std::nan("");
+    o.relative_error = relative_error(o.predicted, m.target);
     o.envelope = m.gp ? searched_envelope([&](const Eigen::VectorXd& x) { return predict(m, x); },
                                           k, options)
                       : reachable_envelope(m.model, options);

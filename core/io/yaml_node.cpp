@@ -27,10 +27,7 @@ YamlNode YamlNode::load_string(const std::string& text, const std::string& name)
 
 std::string YamlNode::where() const {
   std::string w = file_;
-  if (node_.IsDefined() && node_.Mark().line >= 0) {
-    w += ':';  // appended apart: GCC 12 warns falsely (-Wrestrict) on ":" + std::to_string(...)
-    w += std::to_string(node_.Mark().line + 1);
-  }
+  if (node_.IsDefined() && node_.Mark().line >= 0) w += ":" + std::to_string(node_.Mark().line + 1);
   if (!path_.empty()) w += ": " + path_;
   return w;
 }
