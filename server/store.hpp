@@ -64,7 +64,7 @@ struct NewJob {
   std::string test;
   std::string kind = "design";  ///< design | verify | stage:<n> | diagnose:<group>
   std::string payload;          ///< JobSpec as JSON (without id and attempt)
-  RunKey run_key;
+  RunKey run_key = {};
   /// The test (instance name) of the same campaign, kind and row whose job this one is leased
   /// after, once that job has ended; empty: none.
   std::string waits_for = {};

@@ -34,7 +34,7 @@ struct MetricTarget {
   /// campaign, the correction of low-level runs to the high level (multi_fidelity.hpp).
   double correction_sd = 0.0;
   /// When set, the surrogate in place of `model`: a Gaussian process over the same coded box.
-  std::shared_ptr<const GaussianProcess> gp;
+  std::shared_ptr<const GaussianProcess> gp = nullptr;
 };
 
 /// The surrogate's prediction at a coded point (the GP's mean, else the polynomial).

@@ -40,7 +40,7 @@ struct Plan {
   bool by_default = true;  ///< tested without being listed in `candidates`
   /// coarse_graining: the cohesive parameters its runs rescale to their radius (path -> value at
   /// the base runs' size scale `size_scale`); empty for the others.
-  std::map<std::string, double> bond_scaled;
+  std::map<std::string, double> bond_scaled = {};
   double size_scale = 1.0;
 };
 
@@ -500,7 +500,7 @@ struct VerifiedPoint {
   std::map<std::string, double> proposed, simulated;
   double predicted_rms = kPending, verified_rms = kPending, holdout_rms = kPending;
   bool reaches_all = false;
-  std::map<std::string, double> rescaled;  ///< the plan's rescaled parameters at `proposed`
+  std::map<std::string, double> rescaled = {};  ///< the plan's rescaled parameters at `proposed`
 };
 
 /// The candidate's outcome is its best verified round (lowest verified error on the calibrated

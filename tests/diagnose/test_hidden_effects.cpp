@@ -223,8 +223,9 @@ TEST(HiddenEffects, DiagnosisNamesTheHiddenCause) {
     const double ar = best["proposed"]["shape.aspect_ratio"].get<double>();
     EXPECT_NEAR(ar, truth.aspect_ratio, kAspectTolerance);
   }
-  if (truth.cause == "clusters")
+  if (truth.cause == "clusters") {
     EXPECT_NEAR(best["proposed"]["shape.spread"].get<double>(), truth.spread, kSpreadTolerance);
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -46,8 +46,9 @@ TEST(NestedFraction, HalvesTheLactoseCalibrationDesignToAResolutionThreeHalf) {
       if (s > 0) half.push_back(r);
     }
     const auto b = aliasing_of(d, half);
-    if (b.resolution && *b.resolution == 3)
+    if (b.resolution && *b.resolution == 3) {
       EXPECT_GE(b.word_length_pattern[0], a.word_length_pattern[0]) << word_name(w);
+    }
   }
 }
 

@@ -72,10 +72,12 @@ TEST(Admission, GrowthOfClumpsIsRefusedByEveryTestThatGrows) {
   MaterialModel rods = spheres();
   rods.preparation.method = PreparationMethod::kGrowth;
   rods.shape.kind = particles::ShapeKind::kRod;
-  for (const auto& t : lab_catalog())
-    if (accepts_preparation(t.name, PreparationMethod::kGrowth))
+  for (const auto& t : lab_catalog()) {
+    if (accepts_preparation(t.name, PreparationMethod::kGrowth)) {
       EXPECT_EQ(where_of([&] { admit_lab_test(t.name, rods, {}); }), "material.preparation.method")
           << t.name;
+    }
+  }
 }
 
 TEST(Admission, TheParticleCountIsTheSettingOrWhatTheDrumHolds) {

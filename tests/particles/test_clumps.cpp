@@ -237,7 +237,9 @@ TEST(ParticlesClumps, ClusterSpreadShrinksItToItsLargestSphere) {
     between |= near.size() > 1 && near.size() < 5;
     for (std::size_t k = 0; k < near.size(); ++k)
       for (std::size_t j = 0; j < near.size(); ++j)
-        if (j != k) EXPECT_GT(norm(near[k] - near[j]) + near_radii[k], near_radii[j]) << k << j;
+        if (j != k) {
+          EXPECT_GT(norm(near[k] - near[j]) + near_radii[k], near_radii[j]) << k << j;
+        }
   }
   EXPECT_TRUE(between);
   EXPECT_EQ(last, 1u);

@@ -357,9 +357,9 @@ TEST(Store, AJobWaitingForAnotherOfItsRowIsLeasedOnceThatOneHasEnded) {
   // Row 1: the tensile job (listed first) waits for the compression; row 2 likewise; a verify
   // job of row 1 waits for nothing of the design.
   const std::vector<NewJob> jobs = {
-      {1, 1, "tensile", "design", "{}", {}, "compression"},
+      {1, 1, "tensile", "design", "{}", RunKey{}, "compression"},
       {1, 1, "compression", "design", "{}"},
-      {2, 2, "tensile", "design", "{}", {}, "compression"},
+      {2, 2, "tensile", "design", "{}", RunKey{}, "compression"},
       {2, 2, "compression", "design", "{}"},
   };
   const auto id = s.create_campaign("c", "{}", "{}", jobs, 0.0);
