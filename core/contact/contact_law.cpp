@@ -92,6 +92,15 @@ double ContactLaw::reached_stiffness(double r_eff, double delta_max) const {
       normal);
 }
 
+double ContactLaw::attraction_energy(double r_eff) const {
+  return std::visit(
+      [&](const auto& n, const auto& c) {
+        const double f = c.contact_force(r_eff);
+        return c.approach_work(r_eff) + (f > 0.0 ? f * n.overlap_at(f, r_eff) : 0.0);
+      },
+      normal, cohesion);
+}
+
 ContactLaw ContactLaw::from_spec(const ContactLawSpec& spec, const std::string& where) {
   return {make_model<NormalModel>(spec.normal, where + ".normal"),
           make_model<CohesionModel>(spec.cohesion, where + ".cohesion"),

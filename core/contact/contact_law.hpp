@@ -53,6 +53,12 @@ struct ContactLaw {
   /// max_stiffness() for a normal model whose un-/reloading stiffness grows with the overlap
   /// (Luding); max_stiffness() for the others.
   double reached_stiffness(double r_eff, double delta_max) const;
+  /// An upper bound of the energy (J) the law's attraction sets free on a pair of effective radius
+  /// r_eff that comes from its range into contact: the cohesion's work up to contact, plus at most
+  /// its contact force F times the overlap at which the fresh contact's repulsion carries F (the
+  /// depth of the well the attraction pulls the pair into is below F times that overlap). Zero
+  /// without a cohesion model.
+  double attraction_energy(double r_eff) const;
   /// Builds a law from its spec; errors name the field path below `where`.
   static ContactLaw from_spec(const ContactLawSpec& spec, const std::string& where);
 };

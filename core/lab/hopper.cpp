@@ -111,7 +111,8 @@ Hopper build_hopper(const MaterialModel& material, const HopperSettings& s,
   hp.limits.lo = {-hp.top - hp.bin, -1e3, -(hp.h + hp.bin) * 4.0 - 1.0};
   hp.limits.hi = {hp.top + hp.bin, 1e3, 2.0 * (hp.h + hp.bin)};
   hp.limits.max_kinetic_energy =
-      1e3 * w.particles.total_mass() * std::max(norm(w.gravity), 1.0) * (hp.h + hp.bin);
+      1e3 * w.particles.total_mass() * std::max(norm(w.gravity), 1.0) * (hp.h + hp.bin) +
+      sim::attraction_energy_bound(w);
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.5;
   const PreparedBed built =

@@ -163,7 +163,8 @@ LabOutput RotatingDrumTest::run(const MaterialModel& material, const Settings& v
     out.add_phase(timed_fill(w, req, rng, s.time_step_safety, kRealApparatus), {});
     limits.lo = {-1.5 * radius, -1.5 * radius, -radius};
     limits.hi = {1.5 * radius, 1.5 * radius, depth + radius};
-    limits.max_kinetic_energy = 1e3 * w.particles.total_mass() * 9.81 * 2.0 * radius;
+    limits.max_kinetic_energy =
+        1e3 * w.particles.total_mass() * 9.81 * 2.0 * radius + sim::attraction_energy_bound(w);
     BedSpec settle_spec;
     settle_spec.max_settle_time = 1.0;
     out.add_phase(settle(w, settle_spec, limits, kRealApparatus), {});
@@ -178,7 +179,8 @@ LabOutput RotatingDrumTest::run(const MaterialModel& material, const Settings& v
   auto set_speed = [&](double rpm) {
     const double omega = rpm * speed_factor * 2.0 * M_PI / 60.0;
     limits.max_kinetic_energy =
-        1e3 * w.particles.total_mass() * (9.81 * 2.0 * radius + omega * omega * radius * radius);
+        1e3 * w.particles.total_mass() * (9.81 * 2.0 * radius + omega * omega * radius * radius) +
+        sim::attraction_energy_bound(w);
     for (auto& wall : w.walls) wall.omega = {0, 0, omega};
     return omega;
   };

@@ -1,5 +1,6 @@
 #include "core/sim/health.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -33,6 +34,21 @@ void check_health(const World& w, const HealthLimits& limits) {
                   limits.max_kinetic_energy, w.time);
     throw SimulationFailure(SimulationFailure::Reason::kEnergyExplosion, msg);
   }
+}
+
+double attraction_energy_bound(const World& w) {
+  const auto& p = w.particles;
+  if (p.size() == 0) return 0.0;
+  const double r_max = *std::max_element(p.radius.begin(), p.radius.end());
+  double pair = 0.0, wall = 0.0;
+  for (int a = 0; a < w.materials(); ++a) {
+    for (int b = 0; b < w.materials(); ++b)
+      pair = std::max(pair, w.pair_law(a, b).attraction_energy(r_max));
+    // A particle-wall contact's effective radius is 2 R* = 2 r.
+    for (const auto& wall_k : w.walls)
+      wall = std::max(wall, w.wall_law(wall_k.material, a).attraction_energy(2.0 * r_max));
+  }
+  return static_cast<double>(p.size()) * (6.0 * pair + wall);
 }
 
 }  // namespace demcal::sim

@@ -15,4 +15,12 @@ struct HealthLimits {
 
 void check_health(const World& world, const HealthLimits& limits);
 
+/// An upper bound of the kinetic energy the attraction of the world's laws can set free (J), for
+/// the energy limit of a cohesive bed, where it can far exceed the bed's potential energy (small
+/// particles with a large Hamaker constant snap together at metres per second): every particle
+/// with six pairs (coordination 12, each pair shared by two) and one wall contact, each pulled
+/// from its law's range into the deepest well (ContactLaw::attraction_energy) at the largest
+/// particle radius. Zero when no law attracts.
+double attraction_energy_bound(const World& world);
+
 }  // namespace demcal::sim

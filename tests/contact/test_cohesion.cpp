@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/contact/contact_law.hpp"
 
@@ -80,6 +84,52 @@ TEST(ContactLaw, SpecErrorsNameTheField) {
   spec.normal = {"luding", {{"k1", 1e4}, {"youngs_modulus", 1e7}}};
   EXPECT_THROW(ContactLaw::from_spec(spec, "law"), InputError)
       << "k1 and Y are alternatives (eq. 3)";
+}
+
+// The energy bound of ContactLaw::attraction_energy against the law's own forces: the work of the
+// attraction from D_max to D_min, summed along the surface distance, and the well of each normal
+// model, whose bottom (net normal force zero on a fresh contact at rest) is at the overlap the
+// bound multiplies the contact force by.
+TEST(VanDerWaals, AttractionEnergyIsTheApproachWorkPlusTheWellOfTheNormalLaw) {
+  const double a = 1e-19, r_eff = 1e-5, d_min = 4e-10, d_max = 1e-7;
+  const double f_contact = a * r_eff / (6.0 * d_min * d_min);
+  double history[8] = {};
+  // The approach work, by the trapezoidal rule over a geometric grid of surface distances.
+  const ContactLaw linear = vdw_law("linear", {{"kn", 10.0}, {"clip_attraction", 0}});
+  double work = 0.0;
+  constexpr int kSteps = 20000;
+  for (int k = 0; k < kSteps; ++k) {
+    const double d0 = d_min * std::pow(d_max / d_min, double(k) / kSteps);
+    const double d1 = d_min * std::pow(d_max / d_min, double(k + 1) / kSteps);
+    work += 0.5 *
+            (-evaluate(linear, pair_at(-d0), history).fn -
+             evaluate(linear, pair_at(-d1 * (1.0 - 1e-12)), history).fn) *
+            (d1 - d0);
+  }
+  EXPECT_NEAR(work, a * r_eff / 6.0 * (1.0 / d_min - 1.0 / d_max), 1e-6 * work);
+
+  const std::vector<std::pair<std::string, std::map<std::string, double>>> normals = {
+      {"linear", {{"kn", 10.0}, {"clip_attraction", 0}}},
+      {"hertz", {{"youngs_modulus", 1e7}, {"poisson_ratio", 0.3}, {"restitution", 0.5}}},
+      {"luding", {{"k1", 10.0}, {"k2_ratio", 5.0}, {"phi_f", 0.05}, {"restitution", 0.5}}}};
+  for (const auto& [model, params] : normals) {
+    const ContactLaw law = vdw_law(model, params);
+    const double well = law.attraction_energy(r_eff) - work;
+    ASSERT_GT(well, 0.0) << model;
+    const double overlap = well / f_contact;
+    double fresh[8] = {};
+    EXPECT_NEAR(evaluate(law, pair_at(overlap), fresh).fn, 0.0, 1e-9 * f_contact) << model;
+  }
+  // Linear: the well's bound is F^2 / kn exactly.
+  EXPECT_NEAR(linear.attraction_energy(r_eff), work + f_contact * f_contact / 10.0,
+              1e-6 * linear.attraction_energy(r_eff));
+}
+
+TEST(ContactLaw, WithoutCohesionNothingAttracts) {
+  ContactLawSpec spec;
+  spec.normal = {"linear", {{"kn", 10.0}}};
+  spec.tangential = {"history", {{"mu_s", 0.5}}};
+  EXPECT_EQ(ContactLaw::from_spec(spec, "law").attraction_energy(1e-5), 0.0);
 }
 
 }  // namespace

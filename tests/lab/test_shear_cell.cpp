@@ -128,9 +128,10 @@ TEST(LabShearCell, InterceptRisesWithHamakerConstant) {
 // The head goes into a settled bed without blowing it up. Placed in the bed's top at once, its
 // vanes cut the particles under them up to 0.9 radii deep; in a bed of 60 cohesive particles of
 // 0.1 mm (seed 000's LH220 at coarse-graining factor 10, the row of its calibration design that
-// failed, no rolling resistance) that energy is 47 times the health check's limit, and the run
-// failed with energy_explosion at t = 0.033 s, as soon as the head was placed. Lowered at the tip
-// speed, the run reaches the pre-shear, where the test stops it.
+// failed, no rolling resistance) that energy was 47 times the health check's limit of the time
+// (the bed's potential energy alone; the limit now adds what the cohesion can set free), and the
+// run failed with energy_explosion at t = 0.033 s, as soon as the head was placed. Lowered at the
+// tip speed, the run reaches the pre-shear, where the test stops it.
 TEST(LabShearCell, TheHeadIsLoweredIntoACohesiveBedOfSmallParticlesWithoutBlowingItUp) {
   const LabRunSpec run = read_lab_run(io::YamlNode::load_string(R"(
 test: shear_cell

@@ -13,6 +13,8 @@ struct None {
   void finalize(const std::string&) {}
   double range() const { return 0.0; }
   double force(const PairInput&) const { return 0.0; }
+  double contact_force(double /*r_eff*/) const { return 0.0; }
+  double approach_work(double /*r_eff*/) const { return 0.0; }
 };
 
 }  // namespace demcal::contact::cohesion

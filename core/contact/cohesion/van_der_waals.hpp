@@ -41,6 +41,13 @@ struct VanDerWaals {
     const double dd = d < d_min ? d_min : d;
     return hamaker * 2.0 * in.r_star / (6.0 * dd * dd);
   }
+  /// The attraction at contact and in every overlap: A_H r_eff / (6 D_min^2) (N).
+  double contact_force(double r_eff) const { return hamaker * r_eff / (6.0 * d_min * d_min); }
+  /// The work the attraction does on a pair coming from D_max to D_min (J):
+  /// integral of A_H r_eff / (6 D^2) dD = A_H r_eff / 6 (1 / D_min - 1 / D_max).
+  double approach_work(double r_eff) const {
+    return hamaker * r_eff / 6.0 * (1.0 / d_min - 1.0 / d_max);
+  }
 };
 
 }  // namespace demcal::contact::cohesion

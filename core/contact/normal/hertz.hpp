@@ -47,6 +47,12 @@ struct Hertz {
     return 2.0 * y_star * std::sqrt(0.5 * r_eff * 0.01 * r_eff);
   }
 
+  /// The overlap at which the elastic force 4/3 Y* sqrt(R*) delta^(3/2) is `force` (N), R* = r_eff
+  /// / 2.
+  double overlap_at(double force, double r_eff) const {
+    return std::cbrt(std::pow(3.0 * force / (4.0 * y_star * std::sqrt(0.5 * r_eff)), 2.0));
+  }
+
   // Derived by finalize(): Y*, G*, and -2 sqrt(5/6) beta sqrt(2 Y*) so that
   // gamma_n = damping_factor sqrt(sqrt(R* delta) m*).
   double y_star = 0.0, g_star = 0.0, damping_factor = 0.0;

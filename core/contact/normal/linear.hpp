@@ -35,6 +35,8 @@ struct Linear {
     if (!is_set(kn)) throw InputError(where + ".kn", "required");
   }
   double max_stiffness(double /*r_eff*/) const { return kn; }
+  /// The overlap at which a fresh contact's spring carries `force` (N): force / kn.
+  double overlap_at(double force, double /*r_eff*/) const { return force / kn; }
 
   NormalResult force(const PairInput& in, double* /*history*/) const {
     NormalResult r;

@@ -86,6 +86,8 @@ struct Luding {
     const double k2 = kl + (k2_ratio - 1.0) * kl * std::min(1.0, delta_max / delta_lim);
     return std::max(k2, kc_ratio * kl);
   }
+  /// The overlap at which a fresh contact's loading branch carries `force` (N): force / k1.
+  double overlap_at(double force, double r_eff) const { return force / loading_stiffness(r_eff); }
   double damping(double m_star, double k) const {
     if (restitution >= 1.0) return 0.0;
     return std::sqrt(4.0 * m_star * k / eq7_denominator_);
