@@ -102,11 +102,13 @@ v1::Progress progress_message(const CampaignRow& row, const Counts& c, double no
   const double end = row.finished > 0 ? row.finished : now;
   const double elapsed = std::max(0.0, end - row.created);
   p.set_elapsed_seconds(elapsed);
-  const auto finished = c.done + c.failed;
+  // The rate of the jobs simulated here: a result taken from an earlier run (a journal's, another
+  // campaign's) took no time, and a campaign resumed from its journal takes many at once.
+  const auto simulated = c.done - c.reused + c.failed;
   const auto remaining = c.queued + c.leased;
-  p.set_eta_seconds(remaining == 0 ? 0.0
-                    : finished > 0 ? elapsed / double(finished) * double(remaining)
-                                   : -1.0);
+  p.set_eta_seconds(remaining == 0  ? 0.0
+                    : simulated > 0 ? elapsed / double(simulated) * double(remaining)
+                                    : -1.0);
   return p;
 }
 

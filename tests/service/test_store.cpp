@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "server/convert.hpp"
 #include "server/store.hpp"
 
 namespace demcal::server {
@@ -688,6 +689,23 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   std::filesystem::remove(path);
   std::filesystem::remove(path.string() + "-wal");
   std::filesystem::remove(path.string() + "-shm");
+}
+
+// The ETA of a campaign resumed from its journal: 30 of its 51 jobs taken at once, one simulated
+// in the 10 minutes since, 20 to go: 200 minutes, not the 6.5 the 31 finished jobs would say.
+TEST(Progress, TheEtaIsRatedOnTheJobsSimulatedNotOnTheResultsTaken) {
+  CampaignRow row;
+  row.created = 1000.0;
+  Counts c;
+  c.done = 31;
+  c.reused = 30;
+  c.leased = 2;
+  c.queued = 18;
+  EXPECT_DOUBLE_EQ(progress_message(row, c, 1600.0).eta_seconds(), 600.0 * 20);
+  c.done = c.reused;  // nothing simulated yet: no rate, no estimate
+  EXPECT_EQ(progress_message(row, c, 1600.0).eta_seconds(), -1.0);
+  c.queued = c.leased = 0;
+  EXPECT_EQ(progress_message(row, c, 1600.0).eta_seconds(), 0.0);
 }
 
 }  // namespace
