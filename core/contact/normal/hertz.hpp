@@ -47,10 +47,11 @@ struct Hertz {
     return 2.0 * y_star * std::sqrt(0.5 * r_eff * 0.01 * r_eff);
   }
 
-  /// The overlap at which the elastic force 4/3 Y* sqrt(R*) delta^(3/2) is `force` (N), R* = r_eff
-  /// / 2.
+  /// The overlap at which the elastic force 4/3 Y* sqrt(R*) delta^(3/2), R* = r_eff / 2, is
+  /// `force` (N).
   double overlap_at(double force, double r_eff) const {
-    return std::cbrt(std::pow(3.0 * force / (4.0 * y_star * std::sqrt(0.5 * r_eff)), 2.0));
+    const double x = 3.0 * force / (4.0 * y_star * std::sqrt(0.5 * r_eff));
+    return std::cbrt(x * x);
   }
 
   // Derived by finalize(): Y*, G*, and -2 sqrt(5/6) beta sqrt(2 Y*) so that
