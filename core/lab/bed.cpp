@@ -176,12 +176,10 @@ sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
 
 sim::HealthLimits die_limits(const sim::World& world, double die_radius, double height) {
   sim::HealthLimits h;
-  // Far more than the potential energy of the whole bed falling through the die, plus what its
-  // cohesion can set free: a bed whose kinetic energy exceeds it has been blown up by a too-stiff
-  // contact or a runaway wall.
-  h.max_kinetic_energy = 1e3 * world.particles.total_mass() * std::max(norm(world.gravity), 1.0) *
-                             (height + die_radius) +
-                         sim::attraction_energy_bound(world);
+  // The whole bed falling through the die.
+  h.max_kinetic_energy = sim::kinetic_energy_limit(
+      world,
+      world.particles.total_mass() * std::max(norm(world.gravity), 1.0) * (height + die_radius));
   h.lo = {-2.0 * die_radius, -2.0 * die_radius, -0.5 * die_radius};
   h.hi = {2.0 * die_radius, 2.0 * die_radius, 2.0 * height + 2.0 * die_radius};
   return h;

@@ -110,9 +110,8 @@ Hopper build_hopper(const MaterialModel& material, const HopperSettings& s,
   const PhaseCost filled = timed_fill(w, req, rng, s.time_step_safety, material.factors().time);
   hp.limits.lo = {-hp.top - hp.bin, -1e3, -(hp.h + hp.bin) * 4.0 - 1.0};
   hp.limits.hi = {hp.top + hp.bin, 1e3, 2.0 * (hp.h + hp.bin)};
-  hp.limits.max_kinetic_energy =
-      1e3 * w.particles.total_mass() * std::max(norm(w.gravity), 1.0) * (hp.h + hp.bin) +
-      sim::attraction_energy_bound(w);
+  hp.limits.max_kinetic_energy = sim::kinetic_energy_limit(
+      w, w.particles.total_mass() * std::max(norm(w.gravity), 1.0) * (hp.h + hp.bin));
   BedSpec settle_spec;
   settle_spec.max_settle_time = 1.5;
   const PreparedBed built =

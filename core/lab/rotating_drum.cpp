@@ -164,7 +164,7 @@ LabOutput RotatingDrumTest::run(const MaterialModel& material, const Settings& v
     limits.lo = {-1.5 * radius, -1.5 * radius, -radius};
     limits.hi = {1.5 * radius, 1.5 * radius, depth + radius};
     limits.max_kinetic_energy =
-        1e3 * w.particles.total_mass() * 9.81 * 2.0 * radius + sim::attraction_energy_bound(w);
+        sim::kinetic_energy_limit(w, w.particles.total_mass() * 9.81 * 2.0 * radius);
     BedSpec settle_spec;
     settle_spec.max_settle_time = 1.0;
     out.add_phase(settle(w, settle_spec, limits, kRealApparatus), {});
@@ -178,9 +178,8 @@ LabOutput RotatingDrumTest::run(const MaterialModel& material, const Settings& v
       (s.froude_scaling > 0.5 ? std::sqrt(kSeedDrumDiameter / (2.0 * radius)) : 1.0);
   auto set_speed = [&](double rpm) {
     const double omega = rpm * speed_factor * 2.0 * M_PI / 60.0;
-    limits.max_kinetic_energy =
-        1e3 * w.particles.total_mass() * (9.81 * 2.0 * radius + omega * omega * radius * radius) +
-        sim::attraction_energy_bound(w);
+    limits.max_kinetic_energy = sim::kinetic_energy_limit(
+        w, w.particles.total_mass() * (9.81 * 2.0 * radius + omega * omega * radius * radius));
     for (auto& wall : w.walls) wall.omega = {0, 0, omega};
     return omega;
   };

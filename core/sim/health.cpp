@@ -51,4 +51,8 @@ double attraction_energy_bound(const World& w) {
   return static_cast<double>(p.size()) * (6.0 * pair + wall);
 }
 
+double kinetic_energy_limit(const World& world, double potential_energy) {
+  return 1e3 * potential_energy + attraction_energy_bound(world);
+}
+
 }  // namespace demcal::sim

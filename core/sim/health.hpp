@@ -23,4 +23,10 @@ void check_health(const World& world, const HealthLimits& limits);
 /// particle radius. Zero when no law attracts.
 double attraction_energy_bound(const World& world);
 
+/// The lab tests' limit on a bed's kinetic energy (J): 1,000 times the potential energy
+/// `potential_energy` its test can set free (the bed falling through its vessel, a drum's
+/// rotation), plus attraction_energy_bound(world). A bed above it has been blown up by a too-stiff
+/// contact or a runaway wall.
+double kinetic_energy_limit(const World& world, double potential_energy);
+
 }  // namespace demcal::sim
