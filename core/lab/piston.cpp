@@ -98,7 +98,7 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
                        double area, double target, const ServoSettings& s,
                        const sim::HealthLimits& limits,
                        const std::function<void(const sim::World&, double)>& record,
-                       int record_every) {
+                       int record_every, double stiffness_step) {
   walls::StressServo servo;
   servo.axis = axis;
   servo.area = area;
@@ -127,7 +127,8 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
     const double stress = stress_of(w);
     walls::Wall probe;
     probe.force = w.walls[measured].force * sign;
-    servo.update(probe, w.dt);
+    probe.stiffness = w.walls[measured].stiffness;
+    servo.update(probe, w.dt, stiffness_step);
     const bool at_limit = axial_position(w.walls[driven]) * axis.z <= s.retreat_limit;
     w.walls[driven].velocity =
         at_limit && dot(probe.velocity, axis) < 0.0 ? Vec3{} : probe.velocity;

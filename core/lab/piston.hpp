@@ -52,12 +52,15 @@ struct ServoPhase {
 /// Drives `driven` (a wall index) by a StressServo until the compressive stress read from wall
 /// `measured` holds `target` for hold_time (or max_time passes). `axis` (+z or -z) is the direction
 /// in which the driven wall compresses the bed; `servo.retreat_limit` is a coordinate along it.
-/// `record(world, stress)` is called every `record_every` steps if given.
+/// `record(world, stress)` is called every `record_every` steps if given. `stiffness_step` > 0
+/// bounds the controller's step by the measured wall's contact stiffness
+/// (walls::StressServo::update); kept apart from ServoSettings, whose bytes the records of
+/// conditioned beds hold.
 ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measured, Vec3 axis,
                        double area, double target, const ServoSettings& servo,
                        const sim::HealthLimits& limits,
                        const std::function<void(const sim::World&, double stress)>& record = {},
-                       int record_every = 50);
+                       int record_every = 50, double stiffness_step = 0.0);
 
 /// Servo settings from the exposed values: automatic speed limit (the inertial number
 /// I = v/h d sqrt(rho/sigma) at `stress_max`), gains, tolerance, hold and time limits, and the

@@ -132,8 +132,12 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   if (next <= unload_stage) {
     ServoSettings ps = servo;
     ps.tolerance = std::max(servo.tolerance * s.unload_stress, 2e-3 * s.consolidation_stress) * fs;
+    // The adhesive piston's contacts are far stiffer than the bed the servo's speed limit was
+    // chosen for: at that speed one step swings the stress past the target and back, so the
+    // controller's steps are bounded by the piston's contact stiffness (Chareyre's rule,
+    // core/walls/servo.hpp), half the step that would close the error.
     const ServoPhase r = servo_phase(w, c.bed.piston, c.bed.piston, {0, 0, -1}, c.bed.area,
-                                     s.unload_stress * fs, ps, c.bed.limits);
+                                     s.unload_stress * fs, ps, c.bed.limits, {}, 50, 0.5);
     add_servo_phase(out, r, "unload", {"tensile_strength"});
     unloaded_z = r.position;
     if (options.progress) options.progress(0.85);

@@ -43,6 +43,7 @@ struct Rates {
 /// A force and a torque, e.g. the particles' push on a wall.
 struct Wrench {
   Vec3 force, torque;
+  double stiffness = 0.0;  ///< sum of the contacts' normal stiffnesses (walls::Wall::stiffness)
 };
 
 /// Adds the contact forces of wall `wall_index` to the particles [lo, hi) and their reaction to
@@ -70,6 +71,7 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
   const auto last = std::lower_bound(first, near.end(), hi);
   {
     Vec3 wf{}, wt{};
+    double ks = 0.0;
     auto apply = [&](int i, const walls::WallGeometry& g, double* h) {
       contact::PairInput in;
       in.n = g.n;
@@ -90,6 +92,7 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
       p.torque[i] += out.torque_i;
       wf -= out.force;
       wt += cross(g.point - wall.pivot, -out.force) + out.torque_j;
+      ks += out.stiffness;
     };
     if (!mesh) {
       // Plane, cylinder, disk: at most one contact per particle, one history per particle; the
@@ -167,7 +170,7 @@ void wall_kernel(World& w, std::size_t wall_index, int lo, int hi, Wrench& on_wa
         }
       }
     }
-    on_wall = {wf, wt};
+    on_wall = {wf, wt, ks};
   }
 }
 
@@ -179,13 +182,15 @@ void add_wall_forces(World& w, std::size_t k, int lo, int hi, Wrench& on_wall, R
                  });
 }
 
-/// The wall's force and torque: the threads' parts in thread order.
+/// The wall's force, torque and contact stiffness: the threads' parts in thread order.
 void sum_wall_wrench(walls::Wall& wall, const std::vector<Wrench>& parts) {
   wall.force = {};
   wall.torque = {};
+  wall.stiffness = 0.0;
   for (const Wrench& part : parts) {
     wall.force += part.force;
     wall.torque += part.torque;
+    wall.stiffness += part.stiffness;
   }
 }
 
@@ -292,7 +297,10 @@ void force_region(World& w, const OwnedRangeTask& after, const N&, const C&, con
 
 void compute_forces(World& world, const OwnedRangeTask& after) {
   if (world.particles.size() == 0) {
-    for (auto& wall : world.walls) wall.force = wall.torque = {};
+    for (auto& wall : world.walls) {
+      wall.force = wall.torque = {};
+      wall.stiffness = 0.0;
+    }
     world.contact_rate2 = world.contact_stable_rate2 = 0.0;
     return;
   }

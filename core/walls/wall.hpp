@@ -54,6 +54,11 @@ struct Wall {
   Vec3 force;         ///< force of the particles on the wall in the last step (N)
   Vec3 torque;        ///< their torque about `pivot` (N m)
   Vec3 displacement;  ///< total translation since the start (m)
+  /// Sum of the normal stiffnesses of its particle contacts in the last step (N/m; each contact's
+  /// contact::PairOutput::stiffness, the stiffness its step bound uses: for a Luding contact the
+  /// un-/reloading k2* of its largest overlap, an upper bound of its slope on every branch). The
+  /// attraction across a gap adds none. Set by every force computation, so no record keeps it.
+  double stiffness = 0.0;
 
   /// Velocity of the wall's material point at p.
   Vec3 velocity_at(const Vec3& p) const { return velocity + cross(omega, p - pivot); }

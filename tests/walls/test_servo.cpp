@@ -1,7 +1,11 @@
-// StressServo: a piston driven to a target stress on a settled bed holds that stress.
+// StressServo: a piston driven to a target stress on a settled bed holds that stress; on a
+// contact far stiffer than its speed limit allows for, the speed limit alone flips it between its
+// limits, and the bound by the wall's contact stiffness (Chareyre's rule) brings it to the target
+// without crossing it.
 #include <gtest/gtest.h>
 
 #include "core/lab/bed.hpp"
+#include "core/sim/step.hpp"
 #include "core/walls/servo.hpp"
 
 namespace demcal {
@@ -55,6 +59,75 @@ TEST(StressServo, PistonReachesAndHoldsTheTargetStress) {
   // The particles push the bottom down with the piston load plus their weight, less what the die
   // wall takes by friction.
   EXPECT_LT(w.walls[0].force.z, -0.5 * servo.target * servo.area);
+}
+
+/// A piston pressing on one sphere held in place (kinematic) through an undamped linear contact of
+/// stiffness kn: the piston's stress is kn x overlap / area, and its contact stiffness is kn.
+struct StiffContact {
+  static constexpr double kn = 1e3, radius = 1e-3, area = 1e-5;
+  sim::World w;
+  StiffContact() {
+    contact::ContactLawSpec law;
+    law.normal = {"linear", {{"kn", kn}}};
+    law.tangential = {"history", {{"mu_s", 0.0}}};
+    w.set_pair_law(0, 0, contact::ContactLaw::from_spec(law, "law"));
+    w.set_wall_law(0, 0, contact::ContactLaw::from_spec(law, "wall law"));
+    const std::size_t i = w.particles.add_sphere({0, 0, 0}, radius, 2500, 0);
+    w.particles.set_motion(i, particles::Motion::kKinematic);
+    w.gravity = {};
+    w.walls.push_back(
+        walls::make_wall("piston", walls::Disk{{0, 0, radius - 1e-8}, {0, 0, -1}, 5e-3}));
+    w.dt = 1e-6;
+  }
+  /// The servo: a target of 100 Pa (an overlap of 1 um) and a speed limit that moves the piston by
+  /// that whole overlap in one step.
+  walls::StressServo servo() const {
+    walls::StressServo s;
+    s.area = area;
+    s.target = 100.0;
+    s.max_speed = 1.0;
+    s.kp = 1.0;
+    return s;
+  }
+};
+
+TEST(StressServo, TheWallsStiffnessIsTheSumOfItsContactsStiffnesses) {
+  StiffContact c;
+  sim::step(c.w);
+  EXPECT_DOUBLE_EQ(c.w.walls[0].stiffness, StiffContact::kn);
+  EXPECT_NEAR(c.w.walls[0].force.z, StiffContact::kn * 1e-8, 1e-15);
+  c.w.walls[0].velocity = {0, 0, 1.0};  // away from the sphere: the contact opens
+  sim::run(c.w, 2);
+  EXPECT_EQ(c.w.walls[0].stiffness, 0.0);
+}
+
+TEST(StressServo, OnAStiffContactTheSpeedLimitAloneFlipsBetweenItsLimits) {
+  StiffContact c;
+  walls::StressServo servo = c.servo();
+  int crossings = 0;
+  double last_error = servo.target;
+  for (int k = 0; k < 200; ++k) {
+    sim::step(c.w);
+    const double error = servo.target - servo.stress(c.w.walls[0]);
+    if (k > 100 && error * last_error < 0.0) ++crossings;
+    last_error = error;
+    servo.update(c.w.walls[0], c.w.dt);
+  }
+  EXPECT_GT(crossings, 90) << "the stress crosses the target at almost every step";
+}
+
+TEST(StressServo, BoundedByTheContactStiffnessItReachesTheTargetWithoutCrossingIt) {
+  StiffContact c;
+  walls::StressServo servo = c.servo();
+  double error = servo.target;
+  for (int k = 0; k < 60; ++k) {
+    sim::step(c.w);
+    error = servo.target - servo.stress(c.w.walls[0]);
+    ASSERT_GE(error, 0.0) << "step " << k << ": the stress crossed the target";
+    servo.update(c.w.walls[0], c.w.dt, 0.5);
+  }
+  // Each step closes half the error (the contact is linear and its stiffness is known exactly).
+  EXPECT_LT(error, 1e-12 * servo.target);
 }
 
 }  // namespace
