@@ -100,9 +100,10 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   const std::size_t unload_stage = names.size() - 1;
   LabOutput out;
   Confinement c;
-  double unloaded_z = 0.0;
+  double conditioned_z = 0.0, unloaded_z = 0.0;
   Stages stages(options, names, out, [&](auto& a) {
     a.field(c);
+    a.field(conditioned_z);
     a.field(unloaded_z);
   });
   std::size_t next = 0;
@@ -125,6 +126,8 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
     next = std::max(next, unload_stage);
   }
   sim::World& w = c.bed.world;
+  if (next <= unload_stage)
+    conditioned_z = std::get<walls::Disk>(w.walls[c.bed.piston].shape).centre.z;
   w.change_wall_law(kWallPiston, 0, adhesive_law);
   w.change_wall_law(kWallBottom, 0, adhesive_law);
   w.change_wall_law(kWallDie, 0, die_law);
@@ -202,9 +205,9 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   out.metrics["tensile_strength"] = (peak - stuck_stress) / fs / 1e3;  // kPa, real
   out.series["tensile"] = std::move(series);
   out.series["fracture"] = Series{
-      {"peak_stress_kPa", "peak_strain", "stuck_weight_stress_kPa", "consolidated_height_m",
+      {"peak_stress_kPa", "peak_strain", "stuck_weight_stress_kPa", "conditioned_height_m",
        "unloaded_height_m", "consolidation_reached", "wall_hamaker_factor", "wall_k2_factor"},
-      {{peak / fs / 1e3, peak_strain, stuck_stress / fs / 1e3, c.done.h1, unloaded_z,
+      {{peak / fs / 1e3, peak_strain, stuck_stress / fs / 1e3, conditioned_z, unloaded_z,
         c.reached ? 1.0 : 0.0, f_ah, f_k2}}};
   out.cost.close(w);
   return out;

@@ -71,6 +71,8 @@ TEST(Tensile, StartsFromTheBedAConfinedCompressionConditionedToTheBit) {
   // The same bits as the run that conditioned its own bed, for a fraction of its steps.
   EXPECT_EQ(reused.metrics.at("tensile_strength"), alone.metrics.at("tensile_strength"));
   EXPECT_EQ(reused.series.at("tensile").rows, alone.series.at("tensile").rows);
+  // The fracture record too, the conditioned bed's height included.
+  EXPECT_EQ(reused.series.at("fracture").rows, alone.series.at("fracture").rows);
   EXPECT_LT(steps_of(reused), steps_of(alone) / 2);
   ASSERT_FALSE(reused.notes.empty());
   EXPECT_NE(reused.notes.back().find("stage cache"), std::string::npos);
