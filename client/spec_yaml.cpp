@@ -174,8 +174,8 @@ std::pair<std::string, std::string> split_status(const std::string& text) {
   return {"", text};
 }
 
-/// The material and each test's own wall law as the material's one reader reads them
-/// (core/io/material_yaml.hpp: errors with file, line and field), in their proto form: the
+/// The material and each test's own wall law and preparation as the material's one reader reads
+/// them (core/io/material_yaml.hpp: errors with file, line and field), in their proto form: the
 /// generic conversion of those blocks is replaced.
 void read_material_blocks(const std::string& yaml, const std::string& name, Json& json) {
   const io::YamlNode root = io::YamlNode::load_string(yaml, name);
@@ -185,10 +185,14 @@ void read_material_blocks(const std::string& yaml, const std::string& name, Json
   const auto tests = root.child("tests");
   if (!tests) return;
   const auto items = tests->items();
-  for (std::size_t i = 0; i < items.size(); ++i)
+  for (std::size_t i = 0; i < items.size(); ++i) {
     if (const auto law = items[i].child("wall_law"))
       json["tests"][i]["wall_law"] =
           Json::parse(rpc::message_json(rpc::to_law_message(io::read_contact_law_spec(*law))));
+    if (const auto prep = items[i].child("preparation"))
+      json["tests"][i]["preparation"] =
+          Json::parse(rpc::message_json(rpc::to_preparation_message(io::read_preparation(*prep))));
+  }
 }
 
 }  // namespace

@@ -218,6 +218,14 @@ v1::ContactLaw to_law_message(const contact::ContactLawSpec& law) {
   return out;
 }
 
+v1::Preparation to_preparation_message(const lab::PreparationSpec& preparation) {
+  v1::Preparation p;
+  p.set_method(lab::preparation_method_name(preparation.method));
+  for (const auto& [name, value] : lab::preparation_values(preparation))
+    (*p.mutable_params())[name] = value;
+  return p;
+}
+
 v1::Material to_material_message(const lab::MaterialModel& model) {
   v1::Material m;
   set_law(*m.mutable_particle_law(), model.particle_law);
@@ -230,9 +238,7 @@ v1::Material to_material_message(const lab::MaterialModel& model) {
   m.mutable_shape()->set_kind(particles::shape_kind_name(model.shape.kind));
   for (const auto& [name, value] : particles::shape_values(model.shape))
     (*m.mutable_shape()->mutable_params())[name] = value;
-  m.mutable_preparation()->set_method(lab::preparation_method_name(model.preparation.method));
-  for (const auto& [name, value] : lab::preparation_values(model.preparation))
-    (*m.mutable_preparation()->mutable_params())[name] = value;
+  *m.mutable_preparation() = to_preparation_message(model.preparation);
   m.set_real_median_radius(model.real_median_radius);
   return m;
 }
@@ -244,11 +250,14 @@ v1::CampaignSpec canonical_spec(const v1::CampaignSpec& spec) {
       to_material_message(to_material_model(spec.material(), "spec.material"));
   for (int i = 0; i < out.tests_size(); ++i) {
     auto& test = *out.mutable_tests(i);
-    if (!test.has_wall_law()) continue;
+    if (!test.has_wall_law() && !test.has_preparation()) continue;
     v1::Material own = spec.material();
-    *own.mutable_wall_law() = test.wall_law();
+    if (test.has_wall_law()) *own.mutable_wall_law() = test.wall_law();
+    if (test.has_preparation()) *own.mutable_preparation() = test.preparation();
     const auto where = "spec.tests[" + std::to_string(i) + "]";
-    *test.mutable_wall_law() = to_material_message(to_material_model(own, where)).wall_law();
+    const v1::Material full = to_material_message(to_material_model(own, where));
+    if (test.has_wall_law()) *test.mutable_wall_law() = full.wall_law();
+    if (test.has_preparation()) *test.mutable_preparation() = full.preparation();
   }
   return out;
 }

@@ -23,11 +23,13 @@ v1::Material to_material_message(const lab::MaterialModel& model);
 
 /// The proto form of a contact law (every slot written out).
 v1::ContactLaw to_law_message(const contact::ContactLawSpec& law);
+/// The proto form of a bed preparation (its method and every parameter written out).
+v1::Preparation to_preparation_message(const lab::PreparationSpec& preparation);
 
-/// The spec with its material, and each test instance's own wall law, written out in full as they
-/// read (to_material_message): two specs that read as the same campaign compare equal, also when
-/// one was stored by an earlier build that left the material's defaults out. InputError as
-/// to_material_model.
+/// The spec with its material, and each test instance's own wall law and preparation, written out
+/// in full as they read (to_material_message): two specs that read as the same campaign compare
+/// equal, also when one was stored by an earlier build that left the material's defaults out.
+/// InputError as to_material_model.
 v1::CampaignSpec canonical_spec(const v1::CampaignSpec& spec);
 
 /// The material of a job: its base material with the job's parameters set (factor values and

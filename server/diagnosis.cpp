@@ -48,6 +48,8 @@ void describe_size(const CampaignPlan& plan, diagnose::Problem& p) {
   }
 }
 
+}  // namespace
+
 diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRow>& jobs,
                                std::uint64_t seed) {
   diagnose::Problem p;
@@ -65,8 +67,10 @@ diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRo
   p.fixed = plan.fixed;
   p.cohesion_model = model.particle_law.cohesion.model;
   p.preparation = lab::preparation_method_name(model.preparation.method);
+  // The candidate changes the material's preparation, which an instance's own would override.
   for (const auto& i : plan.instances)
-    p.preparable &= lab::accepts_preparation(i.test, lab::PreparationMethod::kClusters);
+    p.preparable &= lab::accepts_preparation(i.test, lab::PreparationMethod::kClusters) &&
+                    i.material.preparation == model.preparation;
   p.agitation_time_max = lab::default_agitation_time(model);
   for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
   describe_size(plan, p);
@@ -74,6 +78,8 @@ diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRo
   p.options.seed = seed ? seed : 1;
   return p;
 }
+
+namespace {
 
 /// Finished diagnosis rows: a row counts once every test's job of it has ended; a failed job
 /// leaves its test's metrics missing (NaN).

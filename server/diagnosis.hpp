@@ -6,9 +6,17 @@
 
 #include "core/diagnose/diagnosis.hpp"
 #include "demcal/v1/campaign.pb.h"
+#include "server/plan.hpp"
 #include "server/store.hpp"
 
 namespace demcal::server {
+
+/// The stored plan as the diagnosis's problem: its factors, design, the results of `jobs`, the
+/// measurements, and what its material and test instances make of each candidate (the
+/// `preparation` candidate: poured cohesive beds, no test that pours only, no instance with a bed
+/// preparation of its own).
+diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRow>& jobs,
+                               std::uint64_t seed);
 
 /// Advances the diagnosis of a campaign: queues the runs it needs that are not stored yet
 /// (unless `read_only`) and fills the reply. Throws InputError when the campaign cannot be

@@ -101,7 +101,7 @@ void admit_runs(const CampaignPlan& plan, const std::vector<PlannedRun>& runs) {
     const std::string where = "spec.tests[" + std::to_string(run.instance) + "]";
     lab::admit_run(instance.test, instance.material, run.parameters,
                    run.high ? instance.settings_high : instance.settings_low,
-                   {where + ".settings", "spec.material"}, run.std_order);
+                   lab::instance_fields(where, instance.material, plan.material), run.std_order);
   }
 }
 

@@ -94,6 +94,10 @@ std::string material_yaml(const lab::MaterialModel& m) {
   return y.str();
 }
 
+lab::PreparationSpec read_preparation(const YamlNode& node) {
+  return read_kind_block(node, "method", "preparation", lab::make_preparation);
+}
+
 lab::MaterialModel read_material(const YamlNode& n) {
   n.expect_only({"particle_law", "wall_law", "sizes", "size_scale", "density", "scaling", "shape",
                  "preparation", "real_median_radius"});
@@ -111,8 +115,7 @@ lab::MaterialModel read_material(const YamlNode& n) {
   }
   if (auto s = n.child("shape"))
     m.shape = read_kind_block(*s, "kind", "shape", particles::make_shape_spec);
-  if (auto s = n.child("preparation"))
-    m.preparation = read_kind_block(*s, "method", "preparation", lab::make_preparation);
+  if (auto s = n.child("preparation")) m.preparation = read_preparation(*s);
   try {
     m.validate();
   } catch (const InputError& e) {

@@ -20,6 +20,8 @@ namespace demcal::io {
 
 /// The material of a `material:` node; errors name the file, line and field.
 lab::MaterialModel read_material(const YamlNode& node);
+/// A `preparation: {method: ..., <param>: value}` block, errors at the line of the key they name.
+lab::PreparationSpec read_preparation(const YamlNode& node);
 
 /// The YAML that read_material() reads back to the same model, as a `material:` block: both laws
 /// (slots without a model left out), the size distribution, size scale, density, scaling, shape

@@ -23,7 +23,8 @@ std::string first_instance(const std::vector<CampaignInstance>& instances, const
 }
 
 /// Each instance's test in the catalogue and admitted with its settings and material.
-std::vector<ModelledInstance> model_instances(const std::vector<CampaignInstance>& instances) {
+std::vector<ModelledInstance> model_instances(const std::vector<CampaignInstance>& instances,
+                                              const MaterialModel& campaign) {
   std::vector<ModelledInstance> out;
   for (const auto& i : instances) {
     const LabTestInfo* info = nullptr;
@@ -32,7 +33,7 @@ std::vector<ModelledInstance> model_instances(const std::vector<CampaignInstance
     } catch (const InputError& e) {
       throw InputError(i.where + ".test", e.message());
     }
-    admit_lab_test(i.test, i.material, i.settings, {i.where + ".settings", "spec.material"});
+    admit_lab_test(i.test, i.material, i.settings, instance_fields(i.where, i.material, campaign));
     ModelledInstance m{{}, i.settings, i.settings, {}};
     for (const auto& metric : info->metrics) m.metrics.push_back(metric.name);
     if (!info->starts_from.empty())
@@ -175,7 +176,7 @@ Settings at_fidelity_level(const std::string& test, Settings settings,
 }
 
 std::vector<ModelledInstance> model_campaign(const CampaignModel& c) {
-  std::vector<ModelledInstance> out = model_instances(c.instances);
+  std::vector<ModelledInstance> out = model_instances(c.instances, c.material);
   const MaterialModel material = with_fixed(c);
   check_factors(c, material);
   check_fidelity(c, material, out);
@@ -184,9 +185,15 @@ std::vector<ModelledInstance> model_campaign(const CampaignModel& c) {
       const auto& instance = c.instances[i];
       admit_run(instance.test, instance.material, run.parameters,
                 run.high ? out[i].high : out[i].low,
-                {instance.where + ".settings", "spec.material"}, run.row);
+                instance_fields(instance.where, instance.material, c.material), run.row);
     }
   return out;
+}
+
+FieldPaths instance_fields(const std::string& where, const MaterialModel& instance,
+                           const MaterialModel& campaign) {
+  return {where + ".settings",
+          instance.preparation == campaign.preparation ? "spec.material" : where};
 }
 
 void admit_run(const std::string& test, const MaterialModel& material,

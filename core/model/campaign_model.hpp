@@ -21,7 +21,7 @@ struct CampaignInstance {
   std::string name;  ///< what its responses start with ("<name>.<metric>")
   std::string test;  ///< the lab test
   Settings settings;
-  MaterialModel material;  ///< the campaign's, with the instance's own wall law if it has one
+  MaterialModel material;  ///< the campaign's, with the instance's own wall law and preparation
   std::uint64_t seed = 1;  ///< the simulation seed of its first row
   std::string where;       ///< its field, e.g. "spec.tests[2]"
 };
@@ -86,6 +86,12 @@ Settings at_fidelity_level(const std::string& test, Settings settings,
 ///   factor, tie or fixed value sets, valid at both levels;
 /// - every run of every instance admitted at its parameters and level.
 std::vector<ModelledInstance> model_campaign(const CampaignModel& campaign);
+
+/// The fields an instance's admission names: its settings, and for the material the campaign's
+/// (`spec.material`), or the instance's own (`where`) when its bed preparation is its own, so that
+/// a preparation its test cannot build is named where it was written.
+FieldPaths instance_fields(const std::string& where, const MaterialModel& instance,
+                           const MaterialModel& campaign);
 
 /// Admits one run of a test: `material` with `parameters` set, at `settings`; InputError naming
 /// the field, with the design row ("design run 3: ...").

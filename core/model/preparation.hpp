@@ -53,6 +53,8 @@ struct PreparationSpec {
   static constexpr double kGrowthSolidFraction = 0.5;
   static constexpr double kGrowthRate = 1e-3;
 
+  bool operator==(const PreparationSpec&) const = default;
+
   static std::array<contact::ParamInfo<PreparationSpec>, 6> table() {
     using S = PreparationSpec;
     return {{{"agitation_speed", "m/s", 0.0, 1e3, 0.0,

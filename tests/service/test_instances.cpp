@@ -1,7 +1,7 @@
 // Named test instances: one lab test listed several times under its own names (one drum per wall
-// surface, as seed 001 Table 2), each with its own settings and wall law and each a response of
-// its own ("<name>.<metric>"). Checked through the spec parser, the coordinator's planning, and
-// a small campaign run end to end by the embedded `demcal run`.
+// surface, as seed 001 Table 2), each with its own settings, wall law and bed preparation and each
+// a response of its own ("<name>.<metric>"). Checked through the spec parser, the coordinator's
+// planning, and a small campaign run end to end by the embedded `demcal run`.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -14,6 +14,7 @@
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
 #include "server/convert.hpp"
+#include "server/diagnosis.hpp"
 #include "server/plan.hpp"
 #include "tests/service/process.hpp"
 
@@ -268,6 +269,92 @@ measurements:
   sqlite3_close(db);
   EXPECT_GE(tensile, 5) << run.log();  // 4 design rows and at least one verification
   if (!HasFailure()) fs::remove_all(dir);
+}
+
+/// A confined compression of a grown bed beside a shear cell, which pours.
+std::string grown_compression_spec(const std::string& compression_preparation) {
+  return R"(name: grown-compression
+material:
+  particle_law:
+    normal: {model: hertz, youngs_modulus: 5.0e6, restitution: 0.3}
+    tangential: {model: history, mu_s: 0.5}
+  sizes: {monodisperse: {radius: 0.001}}
+  density: 2500
+tests:
+  - test: confined_compression
+    settings: {particles: 100}
+)" + compression_preparation +
+         R"(
+  - {test: shear_cell}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.3, high: 0.7, name: mu_s}
+design: {type: full_factorial}
+)";
+}
+
+TEST(TestInstances, AnInstanceBuildsItsBedItsOwnWay) {
+  const std::string grown = "    preparation: {method: growth, solid_fraction: 0.55}";
+  const auto file = cli::parse_campaign_spec(grown_compression_spec(grown), "g.yaml");
+  ASSERT_TRUE(file.spec.tests(0).has_preparation());
+  EXPECT_EQ(file.spec.tests(0).preparation().method(), "growth");
+  EXPECT_EQ(file.spec.tests(0).preparation().params().at("solid_fraction"), 0.55);
+  EXPECT_FALSE(file.spec.tests(1).has_preparation());
+
+  std::vector<server::NewJob> jobs, poured_jobs;
+  server::plan_campaign(file.spec, jobs);
+  server::plan_campaign(cli::parse_campaign_spec(grown_compression_spec(""), "p.yaml").spec,
+                        poured_jobs);
+  ASSERT_EQ(jobs.size(), 4u);
+  ASSERT_EQ(poured_jobs.size(), jobs.size());
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    v1::JobSpec job;
+    server::from_json(jobs[k].payload, job);
+    const bool compression = job.test() == "confined_compression";
+    EXPECT_EQ(job.material().preparation().method(), compression ? "growth" : "pour");
+    // The shear cell's runs are those of the campaign without the compression's own bed: the
+    // same keys, so a journal of one hands them to the other.
+    EXPECT_EQ(jobs[k].run_key.key == poured_jobs[k].run_key.key, !compression) << job.test();
+  }
+
+  // A preparation the instance's test cannot build is refused where it was written.
+  const std::string grown_cell = R"(
+  - test: shear_cell
+    preparation: {method: growth})";
+  const auto both = cli::parse_campaign_spec(
+      replaced(grown_compression_spec(grown), "\n  - {test: shear_cell}", grown_cell), "b.yaml");
+  std::vector<server::NewJob> refused;
+  try {
+    server::plan_campaign(both.spec, refused);
+    ADD_FAILURE() << "a grown shear cell accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), "spec.tests[1].preparation.method") << e.what();
+  }
+  // The diagnosis's preparation candidate changes the material's preparation, which the
+  // compression's own would override: beside a tensile test (which, unlike the shear cell, can
+  // build its bed from clusters) it applies to the poured campaign only.
+  const std::string tensile = "\n  - {test: tensile, settings: {particles: 100}}";
+  const std::string cohesive =
+      "    tangential: {model: history, mu_s: 0.5}\n    cohesion: "
+      "{model: van_der_waals, hamaker: 1.0e-19, d_max: 1.0e-7}";
+  for (const bool own : {false, true}) {
+    std::string text =
+        replaced(grown_compression_spec(own ? grown : ""), "\n  - {test: shear_cell}", tensile);
+    text = replaced(text, "    tangential: {model: history, mu_s: 0.5}", cohesive);
+    std::vector<server::NewJob> planned;
+    const auto plan = server::plan_campaign(cli::parse_campaign_spec(text, "t.yaml").spec, planned);
+    EXPECT_EQ(server::make_problem(plan, {}, 1).preparable, !own);
+  }
+  // A parameter out of its range is refused with its file, line and path.
+  try {
+    cli::parse_campaign_spec(
+        grown_compression_spec("    preparation: {method: growth, solid_fraction: 0.9}"), "r.yaml");
+    ADD_FAILURE() << "solid_fraction 0.9 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("r.yaml:11: tests[0].preparation.solid_fraction"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("solid_fraction"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
