@@ -70,14 +70,13 @@ std::string instance_name(const v1::LabTest& t) {
   return t.name().empty() ? t.test() : t.name();
 }
 
-/// The material a job of the campaign runs: the spec's material (with the instance's own wall law,
-/// if it has one) and `parameters` (fixed values, factors and tied paths) set on it.
+/// The material a job of the campaign runs: the spec's material (with the instance's own wall law
+/// and bed preparation, if any) and `parameters` (fixed values, factors and tied paths) set on it.
 lab::MaterialModel job_material(const v1::CampaignSpec& spec, const v1::LabTest* instance,
                                 const std::map<std::string, double>& parameters) {
   v1::JobSpec job;
-  *job.mutable_material() = spec.material();
-  if (instance && instance->has_wall_law())
-    *job.mutable_material()->mutable_wall_law() = instance->wall_law();
+  *job.mutable_material() =
+      instance ? rpc::instance_material(spec.material(), *instance) : spec.material();
   job.mutable_parameters()->insert(parameters.begin(), parameters.end());
   return rpc::job_material(job);
 }

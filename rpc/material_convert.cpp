@@ -262,6 +262,13 @@ v1::CampaignSpec canonical_spec(const v1::CampaignSpec& spec) {
   return out;
 }
 
+v1::Material instance_material(const v1::Material& material, const v1::LabTest& test) {
+  v1::Material m = material;
+  if (test.has_wall_law()) *m.mutable_wall_law() = test.wall_law();
+  if (test.has_preparation()) *m.mutable_preparation() = test.preparation();
+  return m;
+}
+
 lab::MaterialModel job_material(const v1::JobSpec& job) {
   return lab::with_run_parameters(
       to_material_model(job.material(), "job.material"),

@@ -32,6 +32,10 @@ v1::Preparation to_preparation_message(const lab::PreparationSpec& preparation);
 /// InputError as to_material_model.
 v1::CampaignSpec canonical_spec(const v1::CampaignSpec& spec);
 
+/// The material a test instance runs with: `material` with the instance's own wall law and bed
+/// preparation, if any.
+v1::Material instance_material(const v1::Material& material, const v1::LabTest& test);
+
 /// The material of a job: its base material with the job's parameters set (factor values and
 /// fixed parameters).
 lab::MaterialModel job_material(const v1::JobSpec& job);

@@ -10,21 +10,12 @@ namespace {
 /// Lab seeds per diagnosis verification at most: each multiplies its verification runs.
 constexpr int kMaxDiagnosisReplicates = 16;
 
-/// The material a test instance runs with: `material` with the instance's own wall law and bed
-/// preparation, if any.
-v1::Material instance_material(const v1::Material& material, const v1::LabTest& t) {
-  v1::Material m = material;
-  if (t.has_wall_law()) *m.mutable_wall_law() = t.wall_law();
-  if (t.has_preparation()) *m.mutable_preparation() = t.preparation();
-  return m;
-}
-
 /// The model of a test instance: the campaign's with the instance's wall law and preparation;
 /// errors in those name the instance's field.
 lab::MaterialModel instance_model(const v1::CampaignSpec& spec, const v1::LabTest& t,
                                   const std::string& where) {
   try {
-    return rpc::to_material_model(instance_material(spec.material(), t), "spec.material");
+    return rpc::to_material_model(rpc::instance_material(spec.material(), t), "spec.material");
   } catch (const InputError& e) {
     for (const auto& [own, field] :
          {std::pair{t.has_wall_law(), "wall_law"}, {t.has_preparation(), "preparation"}}) {
