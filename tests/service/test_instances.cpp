@@ -23,18 +23,22 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Two small drums of 57 spheres (14 x 6 mm, D/d = 7): `drum_ptfe` with a slippery wall law of
-/// its own, `drum_coated` with the material's (the particle law, §4.2 of seed 001).
-std::string drums_spec() {
-  return R"(
-name: drums
-material:
+/// The spheres of the specs below: soft Hertz spheres of 1 mm.
+const std::string kSpheres = R"(material:
   particle_law:
     normal: {model: hertz, youngs_modulus: 5.0e6, restitution: 0.3}
     tangential: {model: history, mu_s: 0.5}
   sizes: {monodisperse: {radius: 0.001}}
   density: 2500
-tests:
+)";
+
+/// Two small drums of 57 spheres (14 x 6 mm, D/d = 7): `drum_ptfe` with a slippery wall law of
+/// its own, `drum_coated` with the material's (the particle law, §4.2 of seed 001).
+std::string drums_spec() {
+  return R"(
+name: drums
+)" + kSpheres +
+         R"(tests:
   - name: drum_ptfe
     test: rotating_drum
     settings: {diameter: 14, length: 6, rpm: 20, angle_time: 0.2, area_time: 0.05}
@@ -273,14 +277,7 @@ measurements:
 
 /// A confined compression of a grown bed beside a shear cell, which pours.
 std::string grown_compression_spec(const std::string& compression_preparation) {
-  return R"(name: grown-compression
-material:
-  particle_law:
-    normal: {model: hertz, youngs_modulus: 5.0e6, restitution: 0.3}
-    tangential: {model: history, mu_s: 0.5}
-  sizes: {monodisperse: {radius: 0.001}}
-  density: 2500
-tests:
+  return "name: grown-compression\n" + kSpheres + R"(tests:
   - test: confined_compression
     settings: {particles: 100}
 )" + compression_preparation +
