@@ -9,6 +9,7 @@
 
 #include "core/common/error.hpp"
 #include "core/diagnose/diagnosis.hpp"
+#include "core/model/campaign_model.hpp"
 #include "core/model/material.hpp"
 #include "core/model/preparation.hpp"
 #include "server/analysis.hpp"
@@ -67,10 +68,12 @@ diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRo
   p.fixed = plan.fixed;
   p.cohesion_model = model.particle_law.cohesion.model;
   p.preparation = lab::preparation_method_name(model.preparation.method);
-  // The candidate changes the material's preparation, which an instance's own would override.
-  for (const auto& i : plan.instances)
-    p.preparable &= lab::accepts_preparation(i.test, lab::PreparationMethod::kClusters) &&
-                    i.material.preparation == model.preparation;
+  // The candidate builds beds from clusters in the instances that take it (their tests build
+  // so, no preparation of their own); the others pour as in the design.
+  const std::map<std::string, std::string> clusters{{"preparation", "clusters"}};
+  p.preparable = std::any_of(plan.instances.begin(), plan.instances.end(), [&](const auto& i) {
+    return !lab::instance_switches(i.test, i.material, model, clusters).empty();
+  });
   p.agitation_time_max = lab::default_agitation_time(model);
   for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
   describe_size(plan, p);

@@ -13,8 +13,8 @@ namespace demcal::server {
 
 /// The stored plan as the diagnosis's problem: its factors, design, the results of `jobs`, the
 /// measurements, and what its material and test instances make of each candidate (the
-/// `preparation` candidate: poured cohesive beds, no test that pours only, no instance with a bed
-/// preparation of its own).
+/// `preparation` candidate: poured cohesive beds and at least one instance that can build its bed
+/// from clusters and has no preparation of its own; the others pour in its runs).
 diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRow>& jobs,
                                std::uint64_t seed);
 

@@ -78,15 +78,40 @@ std::vector<PlannedRun> runs_at(const CampaignPlan& plan,
   return runs;
 }
 
+namespace {
+
+/// A run of an instance that takes none of the diagnosis's switches is the design's run at the
+/// same point when the design has one (its factors at the same levels): the same parameters and
+/// seed, so the store hands its result back instead of simulating it again.
+void share_design_run(const CampaignPlan& plan, PlannedRun& run) {
+  for (const auto& d : design_runs(plan, plan.factors, run.kind, 0, run.high))
+    if (d.instance == run.instance && d.parameters == run.parameters) {
+      run.seed = d.seed;
+      return;
+    }
+}
+
+}  // namespace
+
 std::vector<NewJob> jobs_of(const CampaignPlan& plan, const std::vector<PlannedRun>& runs,
                             const std::map<std::string, std::string>& switches) {
-  // Each instance's material in proto form once, not once a job.
+  // Each instance's switches and material in proto form once, not once a job.
+  std::vector<std::map<std::string, std::string>> taken;
   std::vector<v1::Material> materials;
-  for (const auto& instance : plan.instances)
+  for (const auto& instance : plan.instances) {
+    taken.push_back(
+        lab::instance_switches(instance.test, instance.material, plan.material, switches));
     materials.push_back(rpc::to_material_message(
-        switches.empty() ? instance.material : lab::with_switches(instance.material, switches)));
+        taken.back().empty() ? instance.material
+                             : lab::with_switches(instance.material, taken.back())));
+  }
   std::vector<NewJob> jobs;
-  for (const auto& run : runs) {
+  for (PlannedRun run : runs) {
+    const auto& own = taken[run.instance];
+    if (own.size() != switches.size()) {
+      run.parameters = lab::taken_parameters(run.parameters, switches, own);
+      if (own.empty()) share_design_run(plan, run);
+    }
     const v1::JobSpec job = job_spec(plan, run, materials[run.instance]);
     const auto& instance = plan.instances[run.instance];
     jobs.push_back({run.std_order, run.run_order, instance.name, run.kind, to_json(job),

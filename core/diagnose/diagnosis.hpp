@@ -107,7 +107,8 @@ struct Problem {
   std::string size_kind = "monodisperse";  ///< its size distribution: monodisperse | other
   std::string cohesion_model = "none";     ///< its particle-particle cohesion model
   std::string preparation = "pour";        ///< how its beds are built (material.preparation)
-  /// Every lab test of the campaign builds its bed by the material's preparation.
+  /// A lab test of the campaign can build its bed from clusters (the preparation candidate's
+  /// runs change those tests' beds only).
   bool preparable = true;
   /// preparation: the longest agitation time it runs (s, simulated): the preparation's own
   /// default, 3 largest diameters at the speed sqrt(g d).

@@ -226,4 +226,27 @@ MaterialModel with_switches(MaterialModel m, const std::map<std::string, std::st
   return m;
 }
 
+std::map<std::string, std::string> instance_switches(
+    const std::string& test, const MaterialModel& instance, const MaterialModel& campaign,
+    const std::map<std::string, std::string>& switches) {
+  std::map<std::string, std::string> taken;
+  for (const auto& [what, value] : switches) {
+    const bool skipped =
+        what == "preparation" &&
+        (!accepts_preparation(test, parse_preparation_method(value, "diagnose." + what)) ||
+         !(instance.preparation == campaign.preparation));
+    if (!skipped) taken.emplace(what, value);
+  }
+  return taken;
+}
+
+std::map<std::string, double> taken_parameters(std::map<std::string, double> parameters,
+                                               const std::map<std::string, std::string>& switches,
+                                               const std::map<std::string, std::string>& taken) {
+  for (const auto& [what, value] : switches)
+    if (!taken.contains(what))
+      std::erase_if(parameters, [&](const auto& p) { return p.first.starts_with(what + "."); });
+  return parameters;
+}
+
 }  // namespace demcal::lab

@@ -111,4 +111,18 @@ void admit_run(const std::string& test, const MaterialModel& material,
 MaterialModel with_switches(MaterialModel material,
                             const std::map<std::string, std::string>& switches);
 
+/// The switches a test instance takes (a subset of `switches`): a preparation switch only where
+/// the instance's test builds its beds by that method and the instance has no preparation of its
+/// own (`instance`'s equals the campaign material's); the others always. An instance that does
+/// not take a switch runs as it would without it.
+std::map<std::string, std::string> instance_switches(
+    const std::string& test, const MaterialModel& instance, const MaterialModel& campaign,
+    const std::map<std::string, std::string>& switches);
+
+/// `parameters` without those of the switches an instance did not take (`switches` minus
+/// `taken`): a switch's parameters are the paths under its name ("preparation.agitation_time").
+std::map<std::string, double> taken_parameters(std::map<std::string, double> parameters,
+                                               const std::map<std::string, std::string>& switches,
+                                               const std::map<std::string, std::string>& taken);
+
 }  // namespace demcal::lab

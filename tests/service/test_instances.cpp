@@ -10,9 +10,11 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <tuple>
 
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
+#include "core/model/material.hpp"
 #include "server/convert.hpp"
 #include "server/diagnosis.hpp"
 #include "server/plan.hpp"
@@ -326,21 +328,62 @@ TEST(TestInstances, AnInstanceBuildsItsBedItsOwnWay) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.where(), "spec.tests[1].preparation.method") << e.what();
   }
-  // The diagnosis's preparation candidate changes the material's preparation, which the
-  // compression's own would override: beside a tensile test (which, unlike the shear cell, can
-  // build its bed from clusters) it applies to the poured campaign only.
-  const std::string tensile = "\n  - {test: tensile, settings: {particles: 100}}";
+}
+
+/// The grown-compression spec with cohesive spheres and the shear cell replaced by `others`.
+std::string cohesive_spec(const std::string& compression_preparation, const std::string& others) {
   const std::string cohesive =
       "    tangential: {model: history, mu_s: 0.5}\n    cohesion: "
       "{model: van_der_waals, hamaker: 1.0e-19, d_max: 1.0e-7}";
-  for (const bool own : {false, true}) {
-    std::string text =
-        replaced(grown_compression_spec(own ? grown : ""), "\n  - {test: shear_cell}", tensile);
-    text = replaced(text, "    tangential: {model: history, mu_s: 0.5}", cohesive);
+  return replaced(
+      replaced(grown_compression_spec(compression_preparation), "\n  - {test: shear_cell}", others),
+      "    tangential: {model: history, mu_s: 0.5}", cohesive);
+}
+
+TEST(TestInstances, ThePreparationCandidateBuildsClustersWhereATestCan) {
+  const std::map<std::string, std::string> clusters{{"preparation", "clusters"}};
+  const std::string tensile = "\n  - {test: tensile, settings: {particles: 100}}";
+  const std::string cell = "\n  - {test: shear_cell}";
+  // It changes the material's preparation, which the compression's own would override, and the
+  // shear cell pours only: with a grown compression it applies beside a tensile test (which can
+  // build its bed from clusters) and not beside a shear cell alone.
+  const std::string grown = "    preparation: {method: growth}";
+  for (const auto& [compression, others, applies] :
+       std::vector<std::tuple<std::string, std::string, bool>>{
+           {"", tensile, true}, {grown, tensile, true}, {"", cell, true}, {grown, cell, false}}) {
     std::vector<server::NewJob> planned;
-    const auto plan = server::plan_campaign(cli::parse_campaign_spec(text, "t.yaml").spec, planned);
-    EXPECT_EQ(server::make_problem(plan, {}, 1).preparable, !own);
+    const auto plan = server::plan_campaign(
+        cli::parse_campaign_spec(cohesive_spec(compression, others), "t.yaml").spec, planned);
+    EXPECT_EQ(server::make_problem(plan, {}, 1).preparable, applies) << compression << others;
   }
+  // Its runs beside a shear cell: the compression's bed from clusters at the agitation time; the
+  // shear cell's poured without it, at a point of the design the design's own run (its key).
+  std::vector<server::NewJob> design;
+  const auto plan = server::plan_campaign(
+      cli::parse_campaign_spec(cohesive_spec("", cell), "c.yaml").spec, design);
+  const double agitation = lab::default_agitation_time(plan.material);
+  for (const bool at_design_point : {true, false}) {
+    // The diagnosis's points are the factors' natural values of coded levels, as the design's.
+    const double mu_s = plan.factors[0].factor.to_natural(at_design_point ? -1.0 : 0.5);
+    const auto runs = server::runs_at(
+        plan, {{"particle_law.tangential.mu_s", mu_s}, {"preparation.agitation_time", agitation}},
+        false, 1, job_kind::diagnosis("preparation"), 0);
+    const auto jobs = server::jobs_of(plan, runs, clusters);
+    ASSERT_EQ(jobs.size(), 2u);
+    for (const auto& j : jobs) {
+      v1::JobSpec job;
+      server::from_json(j.payload, job);
+      const bool compression = job.test() == "confined_compression";
+      EXPECT_EQ(job.material().preparation().method(), compression ? "clusters" : "pour");
+      EXPECT_EQ(job.parameters().contains("preparation.agitation_time"), compression);
+      bool shared = false;
+      for (const auto& d : design) shared |= d.run_key.key == j.run_key.key;
+      EXPECT_EQ(shared, !compression && at_design_point) << job.test() << " mu_s " << mu_s;
+    }
+  }
+}
+
+TEST(TestInstances, AnInstancesPreparationOutOfRangeIsRefusedWhereWritten) {
   // A parameter out of its range is refused with its file, line and path.
   try {
     cli::parse_campaign_spec(
