@@ -17,6 +17,7 @@
 #include "core/io/yaml_node.hpp"
 #include "core/lab/lab_run_yaml.hpp"
 #include "core/lab/size_extrapolation.hpp"
+#include "core/model/preparation.hpp"
 #include "tests/common/command.hpp"
 
 namespace {
@@ -449,9 +450,10 @@ phases:
 }
 
 /// The embedded default's `demcal export --format yaml`: a tiny packing campaign (2^2 runs of
-/// 30 spheres, one verification round) is run and calibrated; the exported material block read
-/// back by the lab-run spec reader holds the calibrated values and the fixed one, and the lab run
-/// spec written for the packing test simulates the verified number again, to the bit.
+/// 30 spheres, poured and grown, one verification round) is run and calibrated; the exported
+/// material block read back by the lab-run spec reader holds the calibrated values and the fixed
+/// one, and the lab run spec written for each test instance (the grown one with its own
+/// preparation) simulates the verified number again, to the bit.
 TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
   const fs::path dir = scratch_dir("yaml");
   std::ofstream(dir / "tiny.yaml") << R"(name: tiny
@@ -464,6 +466,10 @@ material:
 tests:
   - test: packing
     settings: {particles: 30}
+  - name: grown
+    test: packing
+    settings: {particles: 30}
+    preparation: {method: growth}
 factors:
   - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
   - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
@@ -471,7 +477,8 @@ fixed:
   wall_law.tangential.mu_s: 0.25
 design: {type: full_factorial}
 measurements:
-  - {metric: solid_fraction, value: 0.6, uncertainty: 0.02}
+  - {test: packing, metric: solid_fraction, value: 0.6, uncertainty: 0.02}
+  - {test: grown, metric: solid_fraction, value: 0.6, uncertainty: 0.02}
 calibration: {rounds: 1, stages: 1}
 )";
   const std::string spec = (dir / "tiny.yaml").string();
@@ -497,16 +504,26 @@ calibration: {rounds: 1, stages: 1}
     EXPECT_EQ(demcal::lab::get_parameter(material, path), value.get<double>()) << path;
   EXPECT_EQ(demcal::lab::get_parameter(material, "wall_law.tangential.mu_s"), 0.25);
 
-  const fs::path lab_spec = dir / "specs" / "packing.yaml";
-  const auto lab = demcal::lab::read_lab_run(demcal::io::YamlNode::load_file(lab_spec.string()));
-  EXPECT_EQ(demcal::lab::material_identity(lab.material), demcal::lab::material_identity(material));
-  const auto rerun = demcal::test::run_command(
-      std::string(DEMCAL_BINARY_DIR) + "/client/demcal lab run " + lab_spec.string() + " --out " +
-      (dir / "rerun").string() + " 2>/dev/null");
-  ASSERT_EQ(rerun.exit_code, 0) << rerun.out;
   const auto& round = calibration["rounds"].back();
-  EXPECT_EQ(nlohmann::json::parse(rerun.out)["metrics"]["solid_fraction"].get<double>(),
-            round["simulated"][0].get<double>());
+  for (const auto& [instance, preparation] :
+       std::vector<std::pair<std::string, std::string>>{{"packing", "pour"}, {"grown", "growth"}}) {
+    const fs::path lab_spec = dir / "specs" / (instance + ".yaml");
+    const auto lab = demcal::lab::read_lab_run(demcal::io::YamlNode::load_file(lab_spec.string()));
+    // The calibrated material with the instance's preparation.
+    auto expected = material;
+    expected.preparation = demcal::lab::make_preparation(preparation, {}, "preparation");
+    EXPECT_EQ(demcal::lab::material_identity(lab.material),
+              demcal::lab::material_identity(expected))
+        << instance;
+    const auto rerun = demcal::test::run_command(
+        std::string(DEMCAL_BINARY_DIR) + "/client/demcal lab run " + lab_spec.string() + " --out " +
+        (dir / ("rerun-" + instance)).string() + " 2>/dev/null");
+    ASSERT_EQ(rerun.exit_code, 0) << rerun.out;
+    const std::size_t at = instance == "packing" ? 0 : 1;  // the measurements' order
+    EXPECT_EQ(nlohmann::json::parse(rerun.out)["metrics"]["solid_fraction"].get<double>(),
+              round["simulated"][at].get<double>())
+        << instance;
+  }
   fs::remove_all(dir);
 }
 
