@@ -29,12 +29,16 @@ double median_radius(const lab::MaterialModel& model) {
   return 0.0;
 }
 
-/// coarse_graining: what the material says of its particles' size against the powder's, and the
-/// cohesive parameters (the cohesion slots' in J) the Bond number holds, at the spec's fixed
-/// values: the particle law's, and the wall law's unless a test instance has a wall law of its
-/// own (whose walls then keep their adhesion: a wall path sets every instance's wall law).
+/// coarse_graining: what the material says of its particles' size against the powder's, at the
+/// design centre (the spec's fixed values, every factor at its centre), and the cohesive
+/// parameters (the cohesion slots' in J) the Bond number holds: the particle law's, and the wall
+/// law's unless a test instance has a wall law of its own (whose walls then keep their adhesion:
+/// a wall path sets every instance's wall law).
 void describe_size(const CampaignPlan& plan, diagnose::Problem& p) {
-  const lab::MaterialModel model = lab::with_run_parameters(plan.material, plan.fixed);
+  std::map<std::string, double> centre;
+  for (const auto& f : plan.factors) centre[f.path] = f.factor.to_natural(0.0);
+  const lab::MaterialModel model =
+      lab::with_run_parameters(plan.material, run_parameters(plan, centre, false));
   p.median_radius = median_radius(model);
   p.real_median_radius = model.real_median_radius;
   p.size_scale = model.size_scale;

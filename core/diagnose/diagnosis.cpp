@@ -160,10 +160,10 @@ Plan preparation_plan(const Problem& p) {
 }
 
 /// coarse_graining applies where the material states the powder's median radius, its own median
-/// radius is larger, and no factor sets a radius.
+/// radius (at the design centre, where a factor sets it) is larger, and no factor sets the size
+/// scale, which is the candidate's own factor.
 bool coarse_grained(const Problem& p) {
   return p.real_median_radius > 0.0 && p.median_radius > p.real_median_radius &&
-         !has_factor(p, "sizes.radius") && !has_factor(p, "sizes.median_radius") &&
          !has_factor(p, kSizeScale);
 }
 
@@ -171,7 +171,9 @@ bool coarse_grained(const Problem& p) {
 /// simulated spheres and scaled them to r_real of 10-20 um, Table 8, where LH220's d50 is
 /// 11-15 um, Table 2; docs/diagnosis.md found the tensile strength to follow Rumpf's F / d^2 at a
 /// given Bond number). The factor multiplies every radius (sizes.scale, log scale) from the real
-/// median over the material's median to the material's size scale, the base runs' end; the
+/// median over the material's median (at the design centre, where a factor sets the radius: the
+/// candidate's runs then span that factor's range times the powder's median over its centre) to
+/// the material's size scale, the base runs' end; the
 /// candidate's runs are at the real median radius and the geometric middle, each with its
 /// cohesion rescaled to the same Bond number (bond_number_hamaker). A run keeps its test's
 /// particle count (every test sizes its die from the particles), so it costs what a base run

@@ -113,10 +113,10 @@ struct Problem {
   /// preparation: the longest agitation time it runs (s, simulated): the preparation's own
   /// default, 3 largest diameters at the speed sqrt(g d).
   double agitation_time_max = 0.0;
-  /// coarse_graining: the material's median radius as its model states it (sizes times
-  /// sizes.scale, m; 0: no one median, as for discrete classes), the powder's measured median
-  /// radius (material.real_median_radius, m; 0: not stated), the size scale the base runs use,
-  /// and the cohesive parameters the Bond number holds (path -> value at that radius, J).
+  /// coarse_graining: the material's median radius as its model states it at the design centre
+  /// (sizes times sizes.scale, m; 0: no one median, as for discrete classes), the powder's measured
+  /// median radius (material.real_median_radius, m; 0: not stated), the size scale the base runs
+  /// use, and the cohesive parameters the Bond number holds (path -> value at that radius, J).
   double median_radius = 0.0;
   double real_median_radius = 0.0;
   double size_scale = 1.0;

@@ -708,10 +708,18 @@ TEST(Diagnosis, CoarseGrainingIsACandidateOnlyForParticlesLargerThanThePowders) 
   p = base;
   p.median_radius = 0.0;  // discrete classes: no one median
   EXPECT_TRUE(groups(p).empty());
-  for (const char* radius : {"sizes.radius", "sizes.median_radius", "sizes.scale"}) {
+  p = base;
+  p.factors[0].path = kScale;  // the size scale is the candidate's own factor
+  EXPECT_TRUE(groups(p).empty());
+  // A radius the design varies: the candidate scales it, from the design centre's radius (the
+  // problem's median) to the powder's, at every row's own radius.
+  for (const char* radius : {"sizes.radius", "sizes.median_radius"}) {
     p = base;
-    p.factors[0].path = radius;  // a radius the design varies
-    EXPECT_TRUE(groups(p).empty()) << radius;
+    p.factors[0].path = radius;
+    const auto scaled = groups(p);
+    ASSERT_EQ(scaled.size(), 5u) << radius;
+    EXPECT_NEAR(scaled[0].parameters.at(kScale), 0.1, 1e-12) << radius;
+    EXPECT_EQ(scaled[0].parameters.at(radius), natural(0, d(0, 0))) << radius;
   }
 }
 
