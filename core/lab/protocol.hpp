@@ -18,10 +18,12 @@ inline constexpr int kProtocolVersion = 2;
 
 /// The tests with a version of their own:
 ///   shear_cell 3: the head is lowered into the settled bed instead of placed in it at once.
+///   shear_cell 4: the consolidation goes on until the floor holds sigma_pre, and the pre-shear
+///     until the flow is steady at sigma_pre (at least pre_shear_travel).
 ///   tensile 3: the unload with the adhesive piston bounds the controller's step by the piston's
 ///     contact stiffness.
 inline constexpr std::array<std::pair<std::string_view, int>, 2> kOwnProtocolVersions = {
-    {{"shear_cell", 3}, {"tensile", 3}}};
+    {{"shear_cell", 4}, {"tensile", 3}}};
 
 /// The protocol version of lab test `test`.
 constexpr int protocol_version(std::string_view test) {

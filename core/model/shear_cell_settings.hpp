@@ -17,18 +17,21 @@ struct ShearCellSettings {
   static constexpr const char* kName = "shear_cell";
   double particles;
   double vanes;
-  double vane_height;         ///< in largest particle diameters
-  double tip_speed;           ///< (m/s) of the vane tips in pre-shear; also the shear steps' limit
-  double pre_shear_travel;    ///< tip travel of the pre-shear, in diameters
-  double consolidation_time;  ///< (s) per servo phase (re-consolidate, reduce)
-  double torque_ramp_time;    ///< (s) for the set torque to reach twice the pre-shear torque
-  double stress_scale;        ///< multiplies every normal stress (for coarse-grained beds)
+  double vane_height;       ///< in largest particle diameters
+  double tip_speed;         ///< (m/s) of the vane tips in pre-shear; also the shear steps' limit
+  double pre_shear_travel;  ///< least tip travel of the pre-shear, in diameters
+  double max_pre_shear_travel;  ///< most tip travel of the pre-shear, in diameters
+  double pre_shear_steadiness;  ///< steady: a third's mean shear stress within this of the last
+  double stress_tolerance;      ///< a mean normal stress within this fraction of the target
+  double consolidation_time;    ///< (s) per servo phase (re-consolidate, reduce)
+  double torque_ramp_time;      ///< (s) for the set torque to reach twice the pre-shear torque
+  double stress_scale;          ///< multiplies every normal stress (for coarse-grained beds)
   double time_step_safety;
   double vessel_friction;  ///< mu_s of the vessel wall (docs/lab-tests.md: 0)
   double floor_friction;   ///< mu_s of the floor (a rough floor holds the bed below the plane)
   double floor_rolling;    ///< CDT mu_r of the floor; 0: the material's wall law's rolling
 
-  static std::array<contact::ParamInfo<ShearCellSettings>, 12> table() {
+  static std::array<contact::ParamInfo<ShearCellSettings>, 15> table() {
     return {
         {{"particles", "-", 20, 1e7, 500, "number of particles", &ShearCellSettings::particles},
          {"vanes", "-", 2, 36, 8, "vanes of the shear head", &ShearCellSettings::vanes},
@@ -38,10 +41,24 @@ struct ShearCellSettings {
           "vane tip speed of the pre-shear (and the speed limit of the torque control)",
           &ShearCellSettings::tip_speed},
          {"pre_shear_travel", "-", 0.5, 100, 5,
-          "vane tip travel of the pre-shear, in largest particle diameters",
+          "least vane tip travel of the pre-shear, in largest particle diameters; its last third "
+          "is the steady flow's window",
           &ShearCellSettings::pre_shear_travel},
+         {"max_pre_shear_travel", "-", 0.5, 1000, 30,
+          "most vane tip travel of the pre-shear before it counts as not steady",
+          &ShearCellSettings::max_pre_shear_travel},
+         {"pre_shear_steadiness", "-", 0.001, 1, 0.05,
+          "steady flow: the mean shear stress of the last window within this fraction of the "
+          "window's before",
+          &ShearCellSettings::pre_shear_steadiness},
+         {"stress_tolerance", "-", 0.001, 0.5, 0.05,
+          "the consolidation's and the pre-shear's mean normal stress within this fraction of "
+          "sigma_pre",
+          &ShearCellSettings::stress_tolerance},
          {"consolidation_time", "s", 0.005, 10, 0.05,
-          "duration of each servo phase (re-consolidate at 3 kPa, reduce to sigma_x)",
+          "duration of each servo phase (re-consolidate at 3 kPa, reduce to sigma_x); the block "
+          "the "
+          "consolidation averages its stress over",
           &ShearCellSettings::consolidation_time},
          {"torque_ramp_time", "s", 0.01, 10, 0.3,
           "time for the set torque of a shear step to reach twice the pre-shear torque",
@@ -60,7 +77,14 @@ struct ShearCellSettings {
           "CDT rolling resistance mu_r of the floor (0: the material's wall law's)",
           &ShearCellSettings::floor_rolling}}};
   }
-  void finalize(const std::string&) {}
+  static std::vector<SettingsRule<ShearCellSettings>> rules() {
+    return {
+        {"max_pre_shear_travel",
+         "must be >= pre_shear_travel",
+         [](const ShearCellSettings& s) { return s.max_pre_shear_travel >= s.pre_shear_travel; },
+         {{"pre_shear_travel", 10.0}, {"max_pre_shear_travel", 5.0}}}};
+  }
+  void finalize(const std::string& where) { check_rules(*this, where); }
 };
 
 /// The shear_cell lab test (seed 000 §2.7.4, Table 3, Fig. 12 and 23): its catalogue entry here,
