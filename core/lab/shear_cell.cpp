@@ -10,12 +10,12 @@
 // a uniform shear stress tau over that disk the torque is
 //   T = int_0^R tau 2 pi r r dr = (2/3) pi R^3 tau,   so   tau = 3 T / (2 pi R^3).
 //
-// Phases: fill and settle; insert head (lowered into the bed); consolidate at sigma_pre = 3 kPa;
-// pre-shear at constant tip speed for pre_shear_travel diameters: pre_shear_stress is the mean tau
-// of the last third (steady state). Then re-consolidate the pre-sheared state at sigma_pre with
-// the head at rest, once, and for every sigma_x of Table 3 start again from that state (the seed's
-// restart files): reduce to sigma_x, and drive the head by torque: the set torque ramps up, the
-// head turns at
+// Phases: fill and settle; insert head (lowered into the bed); consolidate until the floor holds
+// sigma_pre = 3 kPa; pre-shear at constant tip speed until the flow is steady at sigma_pre (at
+// least pre_shear_travel diameters): pre_shear_stress is the mean tau of its last window. Then
+// re-consolidate the pre-sheared state at sigma_pre with the head at rest, once, and for every
+// sigma_x of Table 3 start again from that state (the seed's restart files): reduce to sigma_x, and
+// drive the head by torque: the set torque ramps up, the head turns at
 //   omega = clamp(k (T_set - T), 0, omega_max)
 // and the bed has yielded once the tips have travelled 1.5 diameters; the yield shear stress is
 // the largest tau (mean over 0.5 d of tip travel) on the way. A least-squares line through the five
