@@ -82,8 +82,10 @@ namespace {
 
 /// A run of an instance that takes none of the diagnosis's switches is the design's run at the
 /// same point when the design has one (its factors at the same levels): the same parameters and
-/// seed, so the store hands its result back instead of simulating it again.
+/// seed, so the store hands its result back instead of simulating it again. A replicate after the
+/// first (a seed other than the instance's own) keeps its seed, so its noise stays its own.
 void share_design_run(const CampaignPlan& plan, PlannedRun& run) {
+  if (run.seed != plan.instances[run.instance].seed) return;
   for (const auto& d : design_runs(plan, plan.factors, run.kind, 0, run.high))
     if (d.instance == run.instance && d.parameters == run.parameters) {
       run.seed = d.seed;

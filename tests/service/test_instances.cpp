@@ -381,6 +381,14 @@ TEST(TestInstances, ThePreparationCandidateBuildsClustersWhereATestCan) {
       EXPECT_EQ(shared, !compression && at_design_point) << job.test() << " mu_s " << mu_s;
     }
   }
+  // A second replicate at the design point keeps its own seed: its noise is not the design's.
+  const auto replicate =
+      server::runs_at(plan,
+                      {{"particle_law.tangential.mu_s", plan.factors[0].factor.to_natural(-1.0)},
+                       {"preparation.agitation_time", agitation}},
+                      false, 1, job_kind::diagnosis("preparation"), 1);
+  for (const auto& j : server::jobs_of(plan, replicate, clusters))
+    for (const auto& d : design) EXPECT_NE(d.run_key.key, j.run_key.key) << j.test;
 }
 
 TEST(TestInstances, AnInstancesPreparationOutOfRangeIsRefusedWhereWritten) {
