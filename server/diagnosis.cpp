@@ -36,7 +36,7 @@ double median_radius(const lab::MaterialModel& model) {
 /// a wall path sets every instance's wall law).
 void describe_size(const CampaignPlan& plan, diagnose::Problem& p) {
   std::map<std::string, double> centre;
-  for (const auto& f : plan.factors) centre[f.path] = f.factor.to_natural(0.0);
+  for (const auto& f : plan.factors) centre[f.path] = f.factor.centre();
   const lab::MaterialModel model =
       lab::with_run_parameters(plan.material, run_parameters(plan, centre, false));
   p.median_radius = median_radius(model);

@@ -1,5 +1,6 @@
 // The runs of a plan and the jobs that simulate them (plan.hpp).
 #include <algorithm>
+#include <optional>
 
 #include "core/model/campaign_model.hpp"
 #include "rpc/material_convert.hpp"
@@ -81,12 +82,14 @@ std::vector<PlannedRun> runs_at(const CampaignPlan& plan,
 namespace {
 
 /// A run of an instance that takes none of the diagnosis's switches is the design's run at the
-/// same point when the design has one (its factors at the same levels): the same parameters and
-/// seed, so the store hands its result back instead of simulating it again. A replicate after the
-/// first (a seed other than the instance's own) keeps its seed, so its noise stays its own.
-void share_design_run(const CampaignPlan& plan, PlannedRun& run) {
+/// same point when the design has one (its factors at the same levels, among `design`): the same
+/// parameters and seed, so the store hands its result back instead of simulating it again. A
+/// replicate after the first (a seed other than the instance's own) keeps its seed, so its noise
+/// stays its own.
+void share_design_run(const CampaignPlan& plan, const std::vector<PlannedRun>& design,
+                      PlannedRun& run) {
   if (run.seed != plan.instances[run.instance].seed) return;
-  for (const auto& d : design_runs(plan, plan.factors, run.kind, 0, run.high))
+  for (const auto& d : design)
     if (d.instance == run.instance && d.parameters == run.parameters) {
       run.seed = d.seed;
       return;
@@ -108,11 +111,15 @@ std::vector<NewJob> jobs_of(const CampaignPlan& plan, const std::vector<PlannedR
                              : lab::with_switches(instance.material, taken.back())));
   }
   std::vector<NewJob> jobs;
+  std::optional<std::vector<PlannedRun>> design;  // the design's runs, once one is looked for
   for (PlannedRun run : runs) {
     const auto& own = taken[run.instance];
     if (own.size() != switches.size()) {
       run.parameters = lab::taken_parameters(run.parameters, switches, own);
-      if (own.empty()) share_design_run(plan, run);
+      if (own.empty()) {
+        if (!design) design = design_runs(plan, plan.factors, run.kind, 0, run.high);
+        share_design_run(plan, *design, run);
+      }
     }
     const v1::JobSpec job = job_spec(plan, run, materials[run.instance]);
     const auto& instance = plan.instances[run.instance];

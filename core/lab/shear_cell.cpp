@@ -274,6 +274,36 @@ bool at_pre_stress(const ShearCell& c, const ShearCellSettings& s, double sigma)
   return std::abs(sigma - c.sigma_pre) <= s.stress_tolerance * c.sigma_pre;
 }
 
+/// Means of a quantity (and a second one alongside) over consecutive blocks of simulated time.
+class BlockMeans {
+ public:
+  BlockMeans(double start, double length) : start_(start), length_(length) {}
+  /// Adds one step's values at `time`; true when the step closes a block, whose means mean_a()
+  /// and mean_b() then hold until the next one closes.
+  bool add(double time, double a, double b = 0.0) {
+    sum_a_ += a;
+    sum_b_ += b;
+    ++n_;
+    if (time - start_ < length_) return false;
+    mean_a_ = sum_a_ / static_cast<double>(n_);
+    mean_b_ = sum_b_ / static_cast<double>(n_);
+    start_ = time;
+    sum_a_ = sum_b_ = 0.0;
+    n_ = 0;
+    ++blocks_;
+    return true;
+  }
+  double mean_a() const { return mean_a_; }
+  double mean_b() const { return mean_b_; }
+  int blocks() const { return blocks_; }
+
+ private:
+  double start_, length_;
+  double sum_a_ = 0.0, sum_b_ = 0.0, mean_a_ = 0.0, mean_b_ = 0.0;
+  long n_ = 0;
+  int blocks_ = 0;
+};
+
 /// Consolidates at sigma_pre with the head at rest, the bed rising into the vanes (phase
 /// "consolidate"), until the floor's stress averaged over a block of consolidation_time is within
 /// the stress tolerance of sigma_pre. A loose bed compacts by a good part of its height first, at
@@ -282,18 +312,11 @@ bool at_pre_stress(const ShearCell& c, const ShearCellSettings& s, double sigma)
 void consolidate(ShearCell& c, const ShearCellSettings& s, LabOutput& out) {
   const PhaseClock clock(c.w);
   const double limit = s.consolidation_time + 2.0 * bed_height(c) / c.servo.max_speed;
-  const double t0 = c.w.time;
-  double block_start = t0, sum = 0.0;
-  long n = 0;
+  BlockMeans stress(c.w.time, s.consolidation_time);
   bool reached = false;
   c.servo_run(c.w, c.sigma_pre, limit, [&](sim::World& w) {
-    sum += c.floor_stress(w);
-    ++n;
-    if (w.time - block_start < s.consolidation_time) return true;
-    reached = at_pre_stress(c, s, sum / static_cast<double>(n));
-    block_start = w.time;
-    sum = 0.0;
-    n = 0;
+    if (!stress.add(w.time, c.floor_stress(w))) return true;
+    reached = at_pre_stress(c, s, stress.mean_a());
     return !reached;
   });
   char target[160];
@@ -321,31 +344,23 @@ PreShear pre_shear(ShearCell& c, const ShearCellSettings& s, const RunOptions& o
   const double window = s.pre_shear_travel / 3.0 * c.d / s.tip_speed;
   const double most = s.max_pre_shear_travel * c.d / s.tip_speed;
   const double t0 = w.time;
-  double block_start = t0, tau_sum = 0.0, sigma_sum = 0.0;
-  long n = 0;
-  std::vector<double> taus;  // each third's mean shear stress
+  BlockMeans thirds(t0, window);  // shear stress and floor stress of each window
+  double previous_tau = 0.0;
   PreShear result;
   bool steady = false;
   const long record = std::max<long>(1, std::lround(0.002 / w.dt));
   const PhaseClock clock(w);
   c.servo_run(w, c.sigma_pre, most, [&](sim::World& ww) {
     const double t = ww.time - t0;
-    tau_sum += shear_stress(ww, c.r_head);
-    sigma_sum += c.floor_stress(ww);
-    ++n;
+    const double tau = shear_stress(ww, c.r_head), sigma = c.floor_stress(ww);
     if (ww.step_count % record == 0)
-      pre.rows.push_back({ww.time, c.floor_stress(ww) / c.real_kpa,
-                          shear_stress(ww, c.r_head) / c.real_kpa, t * s.tip_speed / c.d});
+      pre.rows.push_back({ww.time, sigma / c.real_kpa, tau / c.real_kpa, t * s.tip_speed / c.d});
     if (options.progress) options.progress(0.4 * std::min(1.0, t / (3.0 * window)));
-    if (ww.time - block_start < window) return true;
-    result = {tau_sum / static_cast<double>(n), sigma_sum / static_cast<double>(n)};
-    taus.push_back(result.tau);
-    steady = taus.size() >= 3 && at_pre_stress(c, s, result.sigma) &&
-             std::abs(result.tau - taus[taus.size() - 2]) <=
-                 s.pre_shear_steadiness * std::abs(result.tau);
-    block_start = ww.time;
-    tau_sum = sigma_sum = 0.0;
-    n = 0;
+    if (!thirds.add(ww.time, tau, sigma)) return true;
+    result = {thirds.mean_a(), thirds.mean_b()};
+    steady = thirds.blocks() >= 3 && at_pre_stress(c, s, result.sigma) &&
+             std::abs(result.tau - previous_tau) <= s.pre_shear_steadiness * std::abs(result.tau);
+    previous_tau = result.tau;
     return !steady;
   });
   char target[200];
