@@ -469,8 +469,11 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
   Series points{{"sigma_x_kpa", "sigma_measured_kpa", "yield_shear_stress_kpa"}, {}};
   LineFit locus;
   std::vector<double> ys;
-  // The stages: the pre-sheared cell re-consolidated, then each shear step done.
-  std::vector<std::string> names{"re-consolidated"};
+  // The stages: the cell built (filled, settled, the head in the bed), consolidated, pre-sheared
+  // and re-consolidated, then each shear step done. The first two cut the work a stopped run
+  // loses: a cohesive bed of fine particles may take most of its run to settle and consolidate.
+  std::vector<std::string> names{"cell built", "consolidated", "re-consolidated"};
+  constexpr std::size_t kFirstStep = 3;
   for (const double kpa : kShearNormalKPa) {
     char name[64];
     std::snprintf(name, sizeof name, "shear step %g kPa", kpa);
@@ -483,29 +486,37 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
     a.field(locus);
     a.field(ys);
   });
-  std::size_t next = 1;
+  std::size_t next = 0;
   if (stages.resuming()) {
     c.w = cell_world(material, s, options);
     next = stages.resume(c.w);
-  } else {
+  }
+  if (next == 0) {
     c = build_cell(material, s, options, out);
+    stages.reached(0, c.w);
+  }
+  if (next <= 1) {
     consolidate(c, s, out);
+    stages.reached(1, c.w);
+  }
+  if (next <= 2) {
     pre = pre_shear(c, s, options, out);
     write_snapshot(c.w, options, "shear_cell_preshear", out, c.radius);
     reconsolidate(c, s, out);
-    stages.reached(0, c.w);
+    stages.reached(2, c.w);
   }
   // The shear steps, each from the re-consolidated state (c.w, left as it is); the locus uses the
   // normal stress measured on the floor at the yield point.
-  for (std::size_t k = next - 1; k < kShearNormalKPa.size(); ++k) {
-    const YieldStep y = shear_step(c, stages.name(k + 1), kShearNormalKPa[k], s, pre.tau, out);
+  for (std::size_t k = std::max(next, kFirstStep) - kFirstStep; k < kShearNormalKPa.size(); ++k) {
+    const std::size_t stage = kFirstStep + k;
+    const YieldStep y = shear_step(c, stages.name(stage), kShearNormalKPa[k], s, pre.tau, out);
     points.rows.push_back({y.sigma_x / c.real_kpa, y.sigma / c.real_kpa, y.tau / c.real_kpa});
     locus.add(y.sigma / c.real_kpa, y.tau / c.real_kpa);
     ys.push_back(y.tau / c.real_kpa);
     if (options.progress)
       options.progress(0.4 + 0.6 * static_cast<double>(k + 1) /
                                  static_cast<double>(kShearNormalKPa.size()));
-    stages.reached(k + 1, c.w);
+    stages.reached(stage, c.w);
   }
   // The yield locus: least squares tau = slope sigma + intercept through the yield points (kPa).
   const MohrResult mohr = mohr_evaluation(locus.slope(), locus.intercept(),
