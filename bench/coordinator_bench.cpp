@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <iterator>
+#include <memory>
 #include <thread>
 #include <vector>
 
@@ -25,9 +27,23 @@ namespace {
 using namespace demcal;
 using Clock = std::chrono::steady_clock;
 
-/// A packing campaign of (4 + centre points) x replicates jobs; never simulated here.
-std::string spec_text(int centre_points, int replicates) {
-  return R"(
+/// The factors a spec may vary, in the order the bench takes them: (path, low, high).
+constexpr const char* kFactors[][3] = {
+    {"particle_law.tangential.mu_s", "0.1", "0.5"},
+    {"particle_law.normal.restitution", "0.2", "0.6"},
+    {"particle_law.normal.youngs_modulus", "1.0e6", "4.0e6"},
+    {"particle_law.tangential.mu_d_ratio", "0.5", "1.0"},
+    {"particle_law.tangential.kt_ratio", "0.3", "0.9"},
+    {"particle_law.tangential.gamma_t_ratio", "0.3", "0.9"},
+    {"sizes.radius", "0.0004", "0.0006"},
+    {"density", "2000", "3000"},
+    {"particle_law.normal.poisson_ratio", "0.2", "0.4"},
+};
+constexpr int kMaxFactors = static_cast<int>(std::size(kFactors));
+
+/// A packing campaign of (2^factors + centre points) x replicates jobs; never simulated here.
+std::string spec_text(int factors, int centre_points, int replicates) {
+  std::string text = R"(
 name: bench
 material:
   particle_law:
@@ -39,10 +55,12 @@ tests:
   - test: packing
     settings: {particles: 30}
 factors:
-  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
-  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
-design: {type: full_factorial, centre_points: )" +
-         std::to_string(centre_points) + ", replicates: " + std::to_string(replicates) + "}\n";
+)";
+  for (int k = 0; k < factors; ++k)
+    text += std::string("  - {path: ") + kFactors[k][0] + ", low: " + kFactors[k][1] +
+            ", high: " + kFactors[k][2] + "}\n";
+  return text + "design: {type: full_factorial, centre_points: " + std::to_string(centre_points) +
+         ", replicates: " + std::to_string(replicates) + "}\n";
 }
 
 /// Leases and completes until the queue is empty; returns the jobs completed.
@@ -84,11 +102,14 @@ int watcher(const rpc::ChannelOptions& channel, std::int64_t id) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int workers = 8, watchers = 50, centre_points = 64, replicates = 16;
+  int workers = 8, watchers = 50, factors = 2, centre_points = 64, replicates = 16;
   std::string dir = "coordinator-bench";
   CLI::App app{"coordinator throughput: lease + complete per second, no physics"};
   app.add_option("--workers", workers, "fake workers (threads)")->capture_default_str();
   app.add_option("--watchers", watchers, "concurrent Watch streams")->capture_default_str();
+  app.add_option("--factors", factors, "factors of the full factorial (2^factors runs)")
+      ->check(CLI::Range(1, kMaxFactors))
+      ->capture_default_str();
   app.add_option("--centre-points", centre_points)->capture_default_str();
   app.add_option("--replicates", replicates)->capture_default_str();
   app.add_option("--dir", dir, "directory of the SQLite file (emptied)")->capture_default_str();
@@ -101,14 +122,14 @@ int main(int argc, char** argv) {
   co.listen = "127.0.0.1:0";
   co.db = dir + "/bench.db";
   co.token = "bench-token";
-  server::Coordinator coordinator(co);
+  auto first = std::make_unique<server::Coordinator>(co);
   rpc::ChannelOptions channel;
-  channel.address = "127.0.0.1:" + std::to_string(coordinator.port());
+  channel.address = "127.0.0.1:" + std::to_string(first->port());
   channel.token = co.token;
 
   v1::SubmitRequest sreq;
   *sreq.mutable_spec() =
-      cli::parse_campaign_spec(spec_text(centre_points, replicates), "bench.yaml").spec;
+      cli::parse_campaign_spec(spec_text(factors, centre_points, replicates), "bench.yaml").spec;
   v1::SubmitReply sr;
   const auto submit_start = Clock::now();
   const auto st = v1::CampaignService::NewStub(rpc::make_channel(channel))
@@ -119,6 +140,15 @@ int main(int argc, char** argv) {
   }
   const double submit_s = std::chrono::duration<double>(Clock::now() - submit_start).count();
   const int jobs = sr.design().jobs();
+
+  // A coordinator started again on the file, every job still queued: its start derives each
+  // queued job's run key again (this build's protocol versions).
+  first->shutdown();
+  first.reset();
+  const auto reopen_start = Clock::now();
+  server::Coordinator coordinator(co);
+  const double reopen_s = std::chrono::duration<double>(Clock::now() - reopen_start).count();
+  channel.address = "127.0.0.1:" + std::to_string(coordinator.port());
 
   std::vector<std::thread> watch_threads;
   std::atomic<int> updates{0};
@@ -136,9 +166,9 @@ int main(int argc, char** argv) {
   coordinator.shutdown();
 
   std::printf(
-      "jobs %d (submitted in %.3f s), completed %d by %d fake workers with %d Watch "
-      "streams (%d updates)\n",
-      jobs, submit_s, completed.load(), workers, watchers, updates.load());
+      "jobs %d (submitted in %.3f s; a coordinator started on them, their run keys derived "
+      "again, in %.3f s), completed %d by %d fake workers with %d Watch streams (%d updates)\n",
+      jobs, submit_s, reopen_s, completed.load(), workers, watchers, updates.load());
   std::printf("lease + complete: %.0f jobs/s (%.2f s)\n", completed / seconds, seconds);
   return completed == jobs ? 0 : 1;
 }
