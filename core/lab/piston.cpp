@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/lab/block_means.hpp"
 #include "core/lab/run_cancelled.hpp"
 #include "core/sim/step.hpp"
 #include "core/sim/time_step.hpp"
@@ -121,8 +122,7 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
                                            stress_of, record, record_every);
   // The stress on a piston is carried by a few tens of contacts and rattles; the phase ends when
   // the mean over a block of hold_time is within tolerance of the target.
-  double block_start = world.time, sum_s = 0.0, sum_z = 0.0;
-  long n_sum = 0;
+  BlockMeans held(world.time, hold_time);  // the stress and the driven wall's position
   run_checked(world, std::numeric_limits<long>::max() / 2, limits, [&](sim::World& w) {
     const double stress = stress_of(w);
     walls::Wall probe;
@@ -133,26 +133,16 @@ ServoPhase servo_phase(sim::World& world, std::size_t driven, std::size_t measur
     w.walls[driven].velocity =
         at_limit && dot(probe.velocity, axis) < 0.0 ? Vec3{} : probe.velocity;
     if (record && w.step_count % record_every == 0) record(w, stress);
-    sum_s += stress;
-    sum_z += axial_position(w.walls[driven]);
-    ++n_sum;
-    if (w.time - block_start >= hold_time) {
-      out.stress = sum_s / static_cast<double>(n_sum);
-      out.position = sum_z / static_cast<double>(n_sum);
-      if (std::abs(out.stress - target) <= s.tolerance) {
-        out.reached = true;
-        return false;
-      }
-      block_start = w.time;
-      sum_s = sum_z = 0.0;
-      n_sum = 0;
+    if (held.add(w.time, stress, axial_position(w.walls[driven])) &&
+        std::abs(held.mean_a() - target) <= s.tolerance) {
+      out.reached = true;
+      return false;
     }
     return w.time - t0 < time_limit;
   });
-  if (!out.reached && n_sum > 0) {
-    out.stress = sum_s / static_cast<double>(n_sum);
-    out.position = sum_z / static_cast<double>(n_sum);
-  }
+  if (!out.reached) held.close(world.time);
+  out.stress = held.mean_a();
+  out.position = held.mean_b();
   world.walls[driven].velocity = {};
   out.time = world.time - t0;
   char goal[160];

@@ -29,6 +29,7 @@
 #include "core/common/line_fit.hpp"
 #include "core/common/rng.hpp"
 #include "core/lab/bed.hpp"
+#include "core/lab/block_means.hpp"
 #include "core/lab/stages.hpp"
 #include "core/metrics/bulk.hpp"
 #include "core/particles/insertion.hpp"
@@ -273,36 +274,6 @@ double bed_height(const ShearCell& c) {
 bool at_pre_stress(const ShearCell& c, const ShearCellSettings& s, double sigma) {
   return std::abs(sigma - c.sigma_pre) <= s.stress_tolerance * c.sigma_pre;
 }
-
-/// Means of a quantity (and a second one alongside) over consecutive blocks of simulated time.
-class BlockMeans {
- public:
-  BlockMeans(double start, double length) : start_(start), length_(length) {}
-  /// Adds one step's values at `time`; true when the step closes a block, whose means mean_a()
-  /// and mean_b() then hold until the next one closes.
-  bool add(double time, double a, double b = 0.0) {
-    sum_a_ += a;
-    sum_b_ += b;
-    ++n_;
-    if (time - start_ < length_) return false;
-    mean_a_ = sum_a_ / static_cast<double>(n_);
-    mean_b_ = sum_b_ / static_cast<double>(n_);
-    start_ = time;
-    sum_a_ = sum_b_ = 0.0;
-    n_ = 0;
-    ++blocks_;
-    return true;
-  }
-  double mean_a() const { return mean_a_; }
-  double mean_b() const { return mean_b_; }
-  int blocks() const { return blocks_; }
-
- private:
-  double start_, length_;
-  double sum_a_ = 0.0, sum_b_ = 0.0, mean_a_ = 0.0, mean_b_ = 0.0;
-  long n_ = 0;
-  int blocks_ = 0;
-};
 
 /// Consolidates at sigma_pre with the head at rest, the bed rising into the vanes (phase
 /// "consolidate"), until the floor's stress averaged over a block of consolidation_time is within
