@@ -9,9 +9,12 @@ if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_L
   target_compile_options(demcal_warnings INTERFACE -Wno-restrict)
 endif()
 if(DEMCAL_NATIVE AND NOT DEMCAL_SANITIZE)
-  # GCC 12 reports false -Wmaybe-uninitialized positives inside Eigen's AVX-512 kernels, which
-  # -march=native enables on this hardware.
-  target_compile_options(demcal_warnings INTERFACE -march=native -Wno-maybe-uninitialized)
+  # Without contracted multiply-adds the wider instructions keep the portable build's arithmetic:
+  # a sphere run gives its bits (docs/engine.md, "The native build"). GCC 12 reports false
+  # -Wmaybe-uninitialized positives inside Eigen's AVX-512 kernels, which -march=native enables
+  # on this hardware.
+  target_compile_options(demcal_warnings INTERFACE -march=native -ffp-contract=off
+    -Wno-maybe-uninitialized)
 endif()
 if(DEMCAL_SANITIZE OR DEMCAL_FUZZ)
   # Undefined behaviour stops the program, as an address error does, so a test cannot pass over it.
