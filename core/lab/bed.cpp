@@ -222,7 +222,9 @@ double centre_height(const particles::ParticleStore& p) {
 /// The bed's centre of mass at each settling check, and whether the bed has stopped sinking.
 class SinkWatch {
  public:
-  void record(const sim::World& w) { checks_.emplace_back(w.time, centre_height(w.particles)); }
+  explicit SinkWatch(std::vector<SettleCheck> checks) : checks_(std::move(checks)) {}
+  void record(const sim::World& w) { checks_.push_back({w.time, centre_height(w.particles)}); }
+  const std::vector<SettleCheck>& checks() const { return checks_; }
   /// The centre of mass moved by less than `rate` x the bed's height (twice the centre's height
   /// above `bottom`) per real second over the last kChecks checks.
   bool still(double rate, double bottom, double time_factor) const {
@@ -237,33 +239,50 @@ class SinkWatch {
   double strain_rate(double window, double bottom) const {
     const auto& [t_now, z_now] = checks_.back();
     for (auto it = checks_.rbegin(); it != checks_.rend(); ++it)
-      if (t_now - it->first >= window)
-        return std::abs(z_now - it->second) / (z_now - bottom) / (t_now - it->first);
+      if (t_now - it->time >= window)
+        return std::abs(z_now - it->z) / (z_now - bottom) / (t_now - it->time);
     return std::numeric_limits<double>::infinity();
   }
 
  private:
   static constexpr std::size_t kChecks = 5;
-  std::vector<std::pair<double, double>> checks_;  // (time, centre of mass height)
+  std::vector<SettleCheck> checks_;
 };
+
+/// Where a settle phase begins: the bed's extent and the steps between checks (from the time
+/// step it begins with), its clock at the world's step and time.
+SettleProgress settle_start(const sim::World& w, const BedSpec& spec, double time_factor) {
+  SettleProgress s;
+  const auto& p = w.particles;
+  s.bottom = std::numeric_limits<double>::infinity();
+  s.top = -s.bottom;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    s.bottom = std::min(s.bottom, p.x[i].z - p.radius[i]);
+    s.top = std::max(s.top, p.x[i].z + p.radius[i]);
+  }
+  s.chunk = spec.creep_window > 0.0 ? std::max<long>(1, std::lround(0.2 * spec.creep_window / w.dt))
+                                    : std::max<long>(200, std::lround(0.002 * time_factor / w.dt));
+  s.steps0 = w.step_count;
+  s.time0 = w.time;
+  return s;
+}
 
 }  // namespace
 
 PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limits,
-                 double time_factor) {
-  const PhaseClock clock(w);
+                 double time_factor, const SettleCheckpoints& checkpoints) {
+  SettleProgress at = checkpoints.resume ? *checkpoints.resume : settle_start(w, spec, time_factor);
+  const PhaseClock clock(at.steps0, at.time0, at.wall_seconds);
   const double max_time = spec.max_settle_time * time_factor;
   const auto& p = w.particles;
   double mass = 0.0, volume = 0.0;
-  double bottom = std::numeric_limits<double>::infinity(), top = -bottom;
   for (std::size_t i = 0; i < p.size(); ++i) {
     mass += p.mass[i];
     volume += 4.0 / 3.0 * M_PI * std::pow(p.radius[i], 3);
-    bottom = std::min(bottom, p.x[i].z - p.radius[i]);
-    top = std::max(top, p.x[i].z + p.radius[i]);
   }
   const double rho = volume > 0.0 ? mass / volume : 0.0;
-  const double height = std::max(top - bottom, 0.0);
+  const double bottom = at.bottom;
+  const double height = std::max(at.top - bottom, 0.0);
   const double g = norm(w.gravity);
   // Two ways to rest, the first met ends the phase:
   // - quiet: the kinetic stress is small against the order of the bed's weight stress (solid
@@ -288,13 +307,11 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
   // The creep rule's inertial number of the bed's height change, I_h = strain rate x
   // d sqrt(rho_p / sigma_ref) (GDR MiDi 2004, with the bed's strain rate for the shear rate).
   const double creep_time = mean_diameter(p) * std::sqrt(rho / quiet_stress);
-  const double t0 = w.time;
-  const long chunk = creep_rule ? std::max<long>(1, std::lround(0.2 * spec.creep_window / w.dt))
-                                : std::max<long>(200, std::lround(0.002 * time_factor / w.dt));
-  SinkWatch sinking;
+  const double t0 = at.time0;
+  SinkWatch sinking(std::move(at.checks));
   bool rest = false;
   while (!rest && w.time - t0 < t_end) {
-    run_checked(w, chunk, limits);
+    run_checked(w, at.chunk, limits);
     sinking.record(w);
     const bool still = sinking.still(spec.rest_sink_rate, bottom, time_factor);
     const double ke = p.kinetic_energy();
@@ -303,6 +320,11 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
     if (creep_rule)
       rest = rest && sinking.strain_rate(spec.creep_window, bottom) * creep_time <
                          spec.creep_inertial_number;
+    if (!rest && checkpoints.offer) {
+      at.checks = sinking.checks();
+      at.wall_seconds = clock.wall_seconds();
+      checkpoints.offer(at);
+    }
   }
   char target[200];
   std::snprintf(target, sizeof target,
@@ -583,11 +605,21 @@ GrownBed grow_bed(sim::World& w, const MaterialModel& material, const sim::Healt
   return out;
 }
 
-PreparedBed prepare_and_settle(sim::World& w, const MaterialModel& material, const BedSpec& spec,
-                               const sim::HealthLimits& limits, double lid, std::uint64_t seed) {
-  const auto full_law = w.pair_law(0, 0);
+namespace {
+
+/// The law a prepared bed settles with, when it is not the material's full law: cohesion only
+/// in contact, except after clusters (seed 000 §2.7.1).
+std::optional<contact::ContactLawSpec> settling_law(const MaterialModel& material) {
+  if (material.preparation.method == PreparationMethod::kClusters) return std::nullopt;
+  return contact_only(material.particle_law);
+}
+
+}  // namespace
+
+PreparedBed prepare_bed(sim::World& w, const MaterialModel& material,
+                        const sim::HealthLimits& limits, double lid, std::uint64_t seed) {
   const PhaseClock clock(w);
-  std::optional<GrownBed> grown;
+  PreparedBed out;
   switch (material.preparation.method) {
     case PreparationMethod::kClusters:
     case PreparationMethod::kRandomMotion:
@@ -601,25 +633,36 @@ PreparedBed prepare_and_settle(sim::World& w, const MaterialModel& material, con
       cohesion_in_contact(w, material);
       break;
     case PreparationMethod::kGrowth:
-      grown = grow_bed(w, material, limits);
+      out.grown = grow_bed(w, material, limits);
       break;
   }
-  PreparedBed out;
-  if (grown) out.grown = *grown;
   const std::string name = "prepare " + preparation_method_name(material.preparation.method);
-  if (!grown) {
-    out.prepared = clock.stop(w, name, "its fixed time", true);
-    out.settled = settle(w, spec, limits, material.factors().time);
-  } else {
-    out.prepared = clock.stop(w, name, growth_text(*grown), true);
-    out.settled =
-        settle(w, growth_settle(spec, grown->critical_time), limits, material.factors().time);
-  }
-  // The settled bed keeps its contacts' history under the full law.
-  if (material.preparation.method != PreparationMethod::kClusters &&
-      contact_only(material.particle_law))
-    w.change_pair_law(0, 0, full_law);
+  const bool grown = material.preparation.method == PreparationMethod::kGrowth;
+  out.prepared = clock.stop(w, name, grown ? growth_text(out.grown) : "its fixed time", true);
   return out;
+}
+
+void set_settling_law(sim::World& w, const MaterialModel& material) {
+  if (const auto spec = settling_law(material))
+    w.set_pair_law(0, 0, simulated_law(material, *spec));
+}
+
+void settle_prepared(sim::World& w, const MaterialModel& material, const BedSpec& spec,
+                     const sim::HealthLimits& limits, const contact::ContactLaw& full_law,
+                     PreparedBed& bed, const SettleCheckpoints& checkpoints) {
+  const bool grown = material.preparation.method == PreparationMethod::kGrowth;
+  bed.settled = settle(w, grown ? growth_settle(spec, bed.grown.critical_time) : spec, limits,
+                       material.factors().time, checkpoints);
+  // The settled bed keeps its contacts' history under the full law.
+  if (settling_law(material)) w.change_pair_law(0, 0, full_law);
+}
+
+PreparedBed prepare_and_settle(sim::World& w, const MaterialModel& material, const BedSpec& spec,
+                               const sim::HealthLimits& limits, double lid, std::uint64_t seed) {
+  const auto full_law = w.pair_law(0, 0);
+  PreparedBed bed = prepare_bed(w, material, limits, lid, seed);
+  settle_prepared(w, material, spec, limits, full_law, bed);
+  return bed;
 }
 
 }  // namespace demcal::lab

@@ -82,6 +82,43 @@ sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
 /// Height of the highest particle top (m), 0 for an empty world.
 double metrics_top(const sim::World& world);
 
+/// One check of a settle phase: the time and the height of the bed's centre of mass.
+struct SettleCheck {
+  double time = 0.0, z = 0.0;
+};
+
+/// Where a settle phase stands: what it derived from the bed when it began, its clock and the
+/// checks it has made. With the world's state it is all the phase carries from check to check,
+/// so a settle resumed from it goes on as the phase that made it would have.
+struct SettleProgress {
+  double bottom = 0.0, top = 0.0;  ///< the bed's lowest and highest point when it began (m)
+  long chunk = 0;                  ///< steps between checks (from the time step it began with)
+  std::int64_t steps0 = 0;         ///< the world's step count and time when it began
+  double time0 = 0.0;
+  double wall_seconds = 0.0;  ///< its wall time so far, over the attempts that ran it
+  std::vector<SettleCheck> checks;
+};
+
+/// A settle progress in a checkpoint record (core/lab/stages.hpp).
+template <class A, RecordOf<SettleProgress> P>
+void record_fields(A& a, P& p) {
+  a.field(p.bottom);
+  a.field(p.top);
+  a.field(p.chunk);
+  a.field(p.steps0);
+  a.field(p.time0);
+  a.field(p.wall_seconds);
+  a.field(p.checks);
+}
+
+/// Checkpoints inside a settle phase, which in a cohesive bed of fine particles can take most of
+/// a run: `offer` (if set) gets the progress after each check that did not end the phase;
+/// `resume` (if set) is where an earlier attempt's phase stood, and the phase goes on from there.
+struct SettleCheckpoints {
+  std::function<void(const SettleProgress&)> offer;
+  const SettleProgress* resume = nullptr;
+};
+
 /// Steps until the bed is at rest (mean kinetic energy criterion of BedSpec) or max time; checks
 /// health every few hundred steps. Returns the phase "settle" with whether it came to rest.
 /// `time_factor` turns the protocol's real seconds (the checks every 0.002 s, max_settle_time)
@@ -89,7 +126,7 @@ double metrics_top(const sim::World& world);
 /// particles (a coarse-grained bed is then the similar bed of the real particles, exactly), 1
 /// where the geometry is the real apparatus (the rotating drum).
 PhaseCost settle(sim::World& world, const BedSpec& spec, const sim::HealthLimits& limits,
-                 double time_factor);
+                 double time_factor, const SettleCheckpoints& checkpoints = {});
 
 /// What the growth preparation built before gravity came on (grow_bed).
 struct GrownBed {
@@ -116,12 +153,34 @@ struct PreparedBed {
   PhaseCost settled;
   GrownBed grown;  ///< growth only
 };
+/// A grown bed in a checkpoint record.
+template <class A, RecordOf<GrownBed> G>
+void record_fields(A& a, G& g) {
+  for (auto* v : {&g.critical_time, &g.start_factor, &g.growth_time, &g.height, &g.largest_overlap,
+                  &g.solid_fraction, &g.coordination})
+    a.field(*v);
+}
+
 /// Builds the bed by the material's preparation method (material.preparation, seed 000 §2.7.1)
 /// from the particles inserted below `lid` (the top of the insertion region, where the lid of
-/// the methods with free motion sits), settles it under the law the method settles with (the
-/// full van der Waals law after clusters, cohesion only in contact otherwise; growth with the
-/// creep rule and budget of BedSpec, in critical times of its grown bed), and gives the
-/// particles back the material's full law.
+/// the methods with free motion sits) and leaves it under the law it settles with (the full van
+/// der Waals law after clusters, cohesion only in contact otherwise). Fills `prepared` (and
+/// `grown` for growth), not `settled`.
+PreparedBed prepare_bed(sim::World& world, const MaterialModel& material,
+                        const sim::HealthLimits& limits, double lid, std::uint64_t seed);
+
+/// For a run resumed inside the settle of a prepared bed: gives the world, made as the test
+/// makes it, the law the bed settles with, before its state is restored.
+void set_settling_law(sim::World& world, const MaterialModel& material);
+
+/// Settles a prepared bed (growth with the creep rule and budget of BedSpec, in critical times
+/// of its grown bed), records the phase in `bed.settled` and gives the particles back
+/// `full_law`, the material's law the world had before its preparation.
+void settle_prepared(sim::World& world, const MaterialModel& material, const BedSpec& spec,
+                     const sim::HealthLimits& limits, const contact::ContactLaw& full_law,
+                     PreparedBed& bed, const SettleCheckpoints& checkpoints = {});
+
+/// prepare_bed, then settle_prepared.
 PreparedBed prepare_and_settle(sim::World& world, const MaterialModel& material,
                                const BedSpec& spec, const sim::HealthLimits& limits, double lid,
                                std::uint64_t seed);

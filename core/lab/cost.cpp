@@ -54,6 +54,17 @@ PhaseClock::PhaseClock(const sim::World& world)
 
 PhaseClock::PhaseClock() : wall0_(std::chrono::steady_clock::now()) {}
 
+PhaseClock::PhaseClock(std::int64_t steps0, double time0, double wall_before)
+    : steps0_(steps0),
+      time0_(time0),
+      wall0_(std::chrono::steady_clock::now() -
+             std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                 std::chrono::duration<double>(wall_before))) {}
+
+double PhaseClock::wall_seconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+}
+
 PhaseCost PhaseClock::stop(const sim::World& world, std::string name, std::string target,
                            bool reached) const {
   PhaseCost c;
@@ -61,7 +72,7 @@ PhaseCost PhaseClock::stop(const sim::World& world, std::string name, std::strin
   c.target = std::move(target);
   c.steps = world.step_count - steps0_;
   c.simulated_time = world.time - time0_;
-  c.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+  c.wall_seconds = wall_seconds();
   c.reached = reached;
   return c;
 }

@@ -51,6 +51,11 @@ class PhaseClock {
   explicit PhaseClock(const sim::World& world);
   /// Starts at step 0, time 0: for the phase that creates the world.
   PhaseClock();
+  /// Goes on with a phase that began at `steps0` and `time0` and has run `wall_before` seconds
+  /// (in an earlier attempt, for a run resumed inside it).
+  PhaseClock(std::int64_t steps0, double time0, double wall_before);
+  /// The phase's wall time so far.
+  double wall_seconds() const;
   PhaseCost stop(const sim::World& world, std::string name, std::string target, bool reached) const;
 
  private:

@@ -181,15 +181,24 @@ void check_piston(const PistonBed& bed) {
     throw InputError("checkpoint", "its piston is not a disk wall of its world");
 }
 
-PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
-                          const RunOptions& options) {
+namespace {
+
+/// The settling criterion of a piston test's bed: relative to the test's stress level.
+BedSpec piston_bed_spec(const PistonBedRequest& request) {
   BedSpec spec;
   spec.particles = request.particles;
   spec.time_step_safety = request.safety;
   spec.rest_stress = request.stress_level;
+  return spec;
+}
+
+}  // namespace
+
+PistonBed begin_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
+                           const RunOptions& options) {
   PistonBed b;
   const PhaseClock fill_clock;
-  b.world = make_die_world(material, spec, options);
+  b.world = make_die_world(material, piston_bed_spec(request), options);
   b.filled = fill_clock.stop(b.world, "fill", "all particles inserted", true);
   sim::World& w = b.world;
   if (request.set_laws) request.set_laws(w);
@@ -201,7 +210,14 @@ PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest&
   b.limits = die_limits(w, b.radius, top);
   b.piston = add_piston(w, 1e3 * top + 1.0);
   w.dt = sim::adapted_time_step(w, request.safety);
-  b.built = prepare_and_settle(w, material, spec, b.limits, top, options.seed);
+  b.built = prepare_bed(w, material, b.limits, top, options.seed);
+  return b;
+}
+
+void finish_piston_bed(PistonBed& b, const MaterialModel& material, const PistonBedRequest& request,
+                       const contact::ContactLaw& full_law, const SettleCheckpoints& checkpoints) {
+  sim::World& w = b.world;
+  settle_prepared(w, material, piston_bed_spec(request), b.limits, full_law, b.built, checkpoints);
   b.h0 = metrics_top(w);
   if (const metrics::SamplingCylinder region = bed_sample(w, b.radius, b.h0);
       region.radius > 0.0 && region.z_hi > region.z_lo) {
@@ -214,6 +230,13 @@ PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest&
   b.limits = die_limits(w, b.radius, b.h0);
   if (request.stress_level > 0.0)
     b.servo = make_servo(w, b.h0, request.stress_level, request.servo);
+}
+
+PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
+                          const RunOptions& options) {
+  const contact::ContactLaw full_law = material.simulated_particle_law();
+  PistonBed b = begin_piston_bed(material, request, options);
+  finish_piston_bed(b, material, request, full_law, {});
   return b;
 }
 

@@ -136,13 +136,23 @@ void add_bed_phases(LabOutput& out, const PistonBed& bed, const PistonBedRequest
 /// Records a servo phase under `name`, flagging `depending` if it did not reach its target.
 void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string& name,
                      const std::vector<std::string>& depending);
-/// Builds the die world, lets `set_laws` replace wall laws, settles relative to the stress level
-/// with the adapted time step, adds the piston at the bed top and sets its servo.
+/// The die bed up to its settle: the die world filled, `set_laws` replacing wall laws, the
+/// piston far above, the time step adapted, the bed prepared (prepare_bed).
+PistonBed begin_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
+                           const RunOptions& options);
+/// Settles a begun bed relative to the stress level (settle_prepared, `full_law` the material's
+/// simulated particle law), rests the piston on its top and sets its servo.
+void finish_piston_bed(PistonBed& bed, const MaterialModel& material,
+                       const PistonBedRequest& request, const contact::ContactLaw& full_law,
+                       const SettleCheckpoints& checkpoints);
+/// begin_piston_bed, then finish_piston_bed.
 PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
                           const RunOptions& options);
 
 /// The first checkpoint stage of every piston test: the settled bed with its piston.
 inline constexpr const char* kPistonBedStage = "piston bed";
+/// The checkpoint inside the settle of a piston test's bed, before kPistonBedStage.
+inline constexpr const char* kSettlingStage = "settling";
 
 /// The sampling cylinder of a die bed up to `top`: one largest diameter from die, floor and top.
 metrics::SamplingCylinder bed_sample(const sim::World& world, double die_radius, double top);
@@ -152,20 +162,44 @@ void check_piston(const PistonBed& bed);
 
 /// The start of a piston test whose stages (core/lab/stages.hpp) begin with kPistonBedStage:
 /// a run resumed from one of them gets its bed, output and fields restored; any other makes
-/// the bed, records its phases in `out` and offers the stage. Returns the index of the first
-/// stage still to reach.
+/// the bed, offering kSettlingStage checkpoints during its settle (a run resumed from one goes
+/// on with that settle), records its phases in `out` and offers the stage. Returns the index of
+/// the first stage still to reach.
 template <class S>
 std::size_t start_piston_test(S& stages, const MaterialModel& material,
                               const PistonBedRequest& request, const RunOptions& options,
                               PistonBed& bed, LabOutput& out) {
+  stages.add_within(kSettlingStage, 0);
+  // The settle's progress and the grown bed's record (growth settles by its critical time): the
+  // phase's own fields of a kSettlingStage record.
+  SettleProgress progress;
+  auto settle_fields = [&](auto& a) {
+    a.field(progress);
+    a.field(bed.built.grown);
+  };
+  SettleCheckpoints checkpoints;
+  checkpoints.offer = [&](const SettleProgress& at) {
+    progress = at;
+    stages.offer_within(kSettlingStage, bed.world, settle_fields);
+  };
+  const contact::ContactLaw full_law = material.simulated_particle_law();
   if (stages.resuming()) {
     bed.world = make_material_world(material, options);
     if (request.set_laws) request.set_laws(bed.world);
+    const bool settling = stages.resuming_within();
+    if (settling) set_settling_law(bed.world, material);
     const std::size_t next = stages.resume(bed.world);
     check_piston(bed);
-    return next;
+    if (!settling) return next;
+    stages.read_within(settle_fields);
+    // The earlier attempt's wall time: the bed's phases up to the checkpoint.
+    out.cost.wall_seconds +=
+        bed.filled.wall_seconds + bed.built.prepared.wall_seconds + progress.wall_seconds;
+    checkpoints.resume = &progress;
+  } else {
+    bed = begin_piston_bed(material, request, options);
   }
-  bed = make_piston_bed(material, request, options);
+  finish_piston_bed(bed, material, request, full_law, checkpoints);
   add_bed_phases(out, bed, request);
   stages.reached(0, bed.world);
   return 1;

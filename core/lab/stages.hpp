@@ -54,11 +54,15 @@ class Stages {
   /// from one of the stages gets its record restored into `world` (made as the test makes it:
   /// its laws, its threads), the output and the fields, and the index after that stage; a
   /// stage that is not one of them is refused naming `checkpoint`.
+  /// A run resumed from a checkpoint inside the phases before a stage (add_within) gets the
+  /// index of that stage, and the phase's own fields from read_within.
   std::size_t resume(sim::World& world) {
     if (!resuming()) return 0;
     const std::string& stage = options_.resume.stage;
     const auto at = std::find(names_.begin(), names_.end(), stage);
-    if (at == names_.end())
+    const auto inside = std::find_if(within_.begin(), within_.end(),
+                                     [&](const auto& w) { return w.first == stage; });
+    if (at == names_.end() && inside == within_.end())
       throw InputError("checkpoint", "stage '" + stage + "' is not one this test goes on from");
     ByteReader in(options_.resume.state, "checkpoint");
     if (const auto format = in.get<std::uint32_t>(); format != kFormat)
@@ -69,6 +73,7 @@ class Stages {
     world.restore_state(state);
     in.field(out_);
     fields_(in);
+    if (inside != within_.end()) in.get(within_record_);
     in.expect_end();
     // The run's wall time counts the phases the earlier attempt ran (run_lab_test adds this
     // attempt's), so that its particle-steps per second stay those of the steps it counts.
@@ -76,24 +81,59 @@ class Stages {
     out_.resumed_from = stage;
     out_.notes.push_back("went on from the checkpoint '" + stage +
                          "': the phases up to it ran in an earlier attempt (their costs are its)");
+    if (inside != within_.end()) return inside->second;
     return static_cast<std::size_t>(at - names_.begin()) + 1;
+  }
+
+  /// Names a checkpoint inside the phases before stage `k` (e.g. "settling", before "piston
+  /// bed"), which a long phase offers with offer_within.
+  void add_within(std::string name, std::size_t k) { within_.emplace_back(std::move(name), k); }
+  /// The run goes on from a checkpoint inside a phase: read_within has the phase's fields.
+  bool resuming_within() const {
+    return std::any_of(within_.begin(), within_.end(),
+                       [&](const auto& w) { return w.first == options_.resume.stage; });
+  }
+
+  /// Offers the checkpoint `name` (add_within) from inside a phase with `world`: its record is
+  /// a stage's with the phase's own fields after the runner's (`phase` is called as `Fields`).
+  template <class Phase>
+  void offer_within(const std::string& name, const sim::World& world, Phase phase) const {
+    if (!options_.checkpoint) return;
+    options_.checkpoint(name, [&] {
+      ByteWriter inner;
+      phase(inner);
+      ByteWriter record = stage_record(world);
+      record.put(inner.take());
+      return record.take();
+    });
+  }
+
+  /// Hands the phase's fields of the record the run went on from (resuming_within) to `phase`.
+  template <class Phase>
+  void read_within(Phase phase) const {
+    ByteReader in(within_record_, "checkpoint");
+    phase(in);
+    in.expect_end();
   }
 
   /// Stage `k` is reached with `world`: offers its checkpoint (the record is made only when
   /// the receiver keeps it).
   void reached(std::size_t k, const sim::World& world) const {
     if (!options_.checkpoint) return;
-    options_.checkpoint(names_.at(k), [&] {
-      ByteWriter record;
-      record.put(kFormat);
-      record.put(world.save_state());
-      record.field(out_);
-      fields_(record);
-      return record.take();
-    });
+    options_.checkpoint(names_.at(k), [&] { return stage_record(world).take(); });
   }
 
  private:
+  /// A stage's record: the format, the world's state, the output, the runner's fields.
+  ByteWriter stage_record(const sim::World& world) const {
+    ByteWriter record;
+    record.put(kFormat);
+    record.put(world.save_state());
+    record.field(out_);
+    fields_(record);
+    return record;
+  }
+
   /// The record's layout: the world's state, the output, the runner's fields (1: the bed
   /// alone, without this number).
   static constexpr std::uint32_t kFormat = 2;
@@ -101,6 +141,8 @@ class Stages {
   std::vector<std::string> names_;
   LabOutput& out_;
   Fields fields_;
+  std::vector<std::pair<std::string, std::size_t>> within_;  ///< in-phase checkpoints, their stage
+  std::string within_record_;  ///< the phase's fields of the record the run went on from
 };
 
 }  // namespace demcal::lab
