@@ -145,7 +145,11 @@ struct ShearCell {
                  const std::function<bool(sim::World&)>& each) {
     servo.target = target;
     servo.reset();
-    const long steps = std::max<long>(1, std::lround(seconds / world.dt));
+    return servo_steps(world, std::max<long>(1, std::lround(seconds / world.dt)), each);
+  }
+  /// Runs `world` for `steps` steps with the floor servo as it stands, calling `each` after every
+  /// step until it returns false.
+  long servo_steps(sim::World& world, long steps, const std::function<bool(sim::World&)>& each) {
     return run_checked(world, steps, limits, [&](sim::World& ww) {
       servo.update(ww.walls[kFloor], ww.dt);
       return each ? each(ww) : true;
@@ -275,26 +279,67 @@ bool at_pre_stress(const ShearCell& c, const ShearCellSettings& s, double sigma)
   return std::abs(sigma - c.sigma_pre) <= s.stress_tolerance * c.sigma_pre;
 }
 
+/// Where the consolidation stands, for a checkpoint inside it: what the phase fixed when it
+/// began, its clock and the floor stress's block means so far (the servo is the cell's own).
+struct Consolidating {
+  std::int64_t steps0 = 0;  ///< the world's step count and time when it began
+  double time0 = 0.0;
+  double wall_seconds = 0.0;  ///< its wall time so far, over the attempts that ran it
+  double limit = 0.0;         ///< its time limit (s), from the bed's height when it began
+  long steps = 0;             ///< the steps of that limit at the time step it began with
+  BlockMeans stress{0.0, 0.0};
+};
+
+template <class A, RecordOf<Consolidating> C>
+void record_fields(A& a, C& c) {
+  a.field(c.steps0);
+  a.field(c.time0);
+  a.field(c.wall_seconds);
+  a.field(c.limit);
+  a.field(c.steps);
+  a.field(c.stress);
+}
+
+/// The checkpoint inside the consolidation, before the stage "consolidated".
+constexpr const char* kConsolidatingStage = "consolidating";
+
 /// Consolidates at sigma_pre with the head at rest, the bed rising into the vanes (phase
 /// "consolidate"), until the floor's stress averaged over a block of consolidation_time is within
 /// the stress tolerance of sigma_pre. A loose bed compacts by a good part of its height first, at
 /// most at the servo's speed limit: the phase may take the time that limit needs for twice the
-/// bed's height.
-void consolidate(ShearCell& c, const ShearCellSettings& s, LabOutput& out) {
-  const PhaseClock clock(c.w);
-  const double limit = s.consolidation_time + 2.0 * bed_height(c) / c.servo.max_speed;
-  BlockMeans stress(c.w.time, s.consolidation_time);
+/// bed's height. `offer` gets where it stands after each block that does not end it; from
+/// `resume` (if set) it goes on where an earlier attempt's phase stood.
+void consolidate(ShearCell& c, const ShearCellSettings& s, LabOutput& out,
+                 const std::function<void(const Consolidating&)>& offer,
+                 const Consolidating* resume) {
+  Consolidating at;
+  if (resume) {
+    at = *resume;
+  } else {
+    at.steps0 = c.w.step_count;
+    at.time0 = c.w.time;
+    at.limit = s.consolidation_time + 2.0 * bed_height(c) / c.servo.max_speed;
+    at.steps = std::max<long>(1, std::lround(at.limit / c.w.dt));
+    at.stress = BlockMeans(c.w.time, s.consolidation_time);
+    c.servo.target = c.sigma_pre;
+    c.servo.reset();
+  }
+  const PhaseClock clock(at.steps0, at.time0, at.wall_seconds);
   bool reached = false;
-  c.servo_run(c.w, c.sigma_pre, limit, [&](sim::World& w) {
-    if (!stress.add(w.time, c.floor_stress(w))) return true;
-    reached = at_pre_stress(c, s, stress.mean_a());
+  c.servo_steps(c.w, at.steps - (c.w.step_count - at.steps0), [&](sim::World& w) {
+    if (!at.stress.add(w.time, c.floor_stress(w))) return true;
+    reached = at_pre_stress(c, s, at.stress.mean_a());
+    if (!reached && offer) {
+      at.wall_seconds = clock.wall_seconds();
+      offer(at);
+    }
     return !reached;
   });
   char target[160];
   std::snprintf(target, sizeof target,
                 "floor stress %s +- %.3g %% (simulated), mean over %.3g s, within %.3g s",
                 stress_text(c.sigma_pre).c_str(), 100.0 * s.stress_tolerance, s.consolidation_time,
-                limit);
+                at.limit);
   // Flags nothing: the pre-shear's steady flow at sigma_pre is the state the metrics come from.
   out.add_phase(clock.stop(c.w, "consolidate", target, reached), {});
 }
@@ -457,17 +502,31 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
     a.field(locus);
     a.field(ys);
   });
+  stages.add_within(kConsolidatingStage, 1);
+  Consolidating consolidating;
+  auto consolidating_fields = [&](auto& a) { a.field(consolidating); };
   std::size_t next = 0;
   if (stages.resuming()) {
     c.w = cell_world(material, s, options);
     next = stages.resume(c.w);
+    if (stages.resuming_within()) {
+      stages.read_within(consolidating_fields);
+      // The earlier attempt's wall time in the consolidation it ran.
+      out.cost.wall_seconds += consolidating.wall_seconds;
+    }
   }
   if (next == 0) {
     c = build_cell(material, s, options, out);
     stages.reached(0, c.w);
   }
   if (next <= 1) {
-    consolidate(c, s, out);
+    consolidate(
+        c, s, out,
+        [&](const Consolidating& at) {
+          consolidating = at;
+          stages.offer_within(kConsolidatingStage, c.w, consolidating_fields);
+        },
+        stages.resuming_within() ? &consolidating : nullptr);
     stages.reached(1, c.w);
   }
   if (next <= 2) {
