@@ -222,9 +222,9 @@ double centre_height(const particles::ParticleStore& p) {
 /// The bed's centre of mass at each settling check, and whether the bed has stopped sinking.
 class SinkWatch {
  public:
-  explicit SinkWatch(std::vector<SettleCheck> checks) : checks_(std::move(checks)) {}
+  /// Watches `checks`, those of a resumed phase included, and adds to them.
+  explicit SinkWatch(std::vector<SettleCheck>& checks) : checks_(checks) {}
   void record(const sim::World& w) { checks_.push_back({w.time, centre_height(w.particles)}); }
-  const std::vector<SettleCheck>& checks() const { return checks_; }
   /// The centre of mass moved by less than `rate` x the bed's height (twice the centre's height
   /// above `bottom`) per real second over the last kChecks checks.
   bool still(double rate, double bottom, double time_factor) const {
@@ -246,7 +246,7 @@ class SinkWatch {
 
  private:
   static constexpr std::size_t kChecks = 5;
-  std::vector<SettleCheck> checks_;
+  std::vector<SettleCheck>& checks_;
 };
 
 /// Where a settle phase begins: the bed's extent and the steps between checks (from the time
@@ -308,7 +308,7 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
   // d sqrt(rho_p / sigma_ref) (GDR MiDi 2004, with the bed's strain rate for the shear rate).
   const double creep_time = mean_diameter(p) * std::sqrt(rho / quiet_stress);
   const double t0 = at.time0;
-  SinkWatch sinking(std::move(at.checks));
+  SinkWatch sinking(at.checks);
   bool rest = false;
   while (!rest && w.time - t0 < t_end) {
     run_checked(w, at.chunk, limits);
@@ -321,7 +321,6 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
       rest = rest && sinking.strain_rate(spec.creep_window, bottom) * creep_time <
                          spec.creep_inertial_number;
     if (!rest && checkpoints.offer) {
-      at.checks = sinking.checks();
       at.wall_seconds = clock.wall_seconds();
       checkpoints.offer(at);
     }

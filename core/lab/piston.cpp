@@ -215,9 +215,10 @@ PistonBed begin_piston_bed(const MaterialModel& material, const PistonBedRequest
 }
 
 void finish_piston_bed(PistonBed& b, const MaterialModel& material, const PistonBedRequest& request,
-                       const contact::ContactLaw& full_law, const SettleCheckpoints& checkpoints) {
+                       const SettleCheckpoints& checkpoints) {
   sim::World& w = b.world;
-  settle_prepared(w, material, piston_bed_spec(request), b.limits, full_law, b.built, checkpoints);
+  settle_prepared(w, material, piston_bed_spec(request), b.limits,
+                  material.simulated_particle_law(), b.built, checkpoints);
   b.h0 = metrics_top(w);
   if (const metrics::SamplingCylinder region = bed_sample(w, b.radius, b.h0);
       region.radius > 0.0 && region.z_hi > region.z_lo) {
@@ -234,9 +235,8 @@ void finish_piston_bed(PistonBed& b, const MaterialModel& material, const Piston
 
 PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
                           const RunOptions& options) {
-  const contact::ContactLaw full_law = material.simulated_particle_law();
   PistonBed b = begin_piston_bed(material, request, options);
-  finish_piston_bed(b, material, request, full_law, {});
+  finish_piston_bed(b, material, request, {});
   return b;
 }
 

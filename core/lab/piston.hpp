@@ -140,11 +140,11 @@ void add_servo_phase(LabOutput& out, const ServoPhase& phase, const std::string&
 /// piston far above, the time step adapted, the bed prepared (prepare_bed).
 PistonBed begin_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
                            const RunOptions& options);
-/// Settles a begun bed relative to the stress level (settle_prepared, `full_law` the material's
-/// simulated particle law), rests the piston on its top and sets its servo.
+/// Settles a begun bed relative to the stress level (settle_prepared, back to the material's
+/// simulated particle law, the one make_material_world gave the world), rests the piston on its
+/// top and sets its servo.
 void finish_piston_bed(PistonBed& bed, const MaterialModel& material,
-                       const PistonBedRequest& request, const contact::ContactLaw& full_law,
-                       const SettleCheckpoints& checkpoints);
+                       const PistonBedRequest& request, const SettleCheckpoints& checkpoints);
 /// begin_piston_bed, then finish_piston_bed.
 PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest& request,
                           const RunOptions& options);
@@ -179,10 +179,11 @@ std::size_t start_piston_test(S& stages, const MaterialModel& material,
   };
   SettleCheckpoints checkpoints;
   checkpoints.offer = [&](const SettleProgress& at) {
-    progress = at;
-    stages.offer_within(kSettlingStage, bed.world, settle_fields);
+    stages.offer_within(kSettlingStage, bed.world, [&](auto& a) {
+      progress = at;  // only for a checkpoint the receiver keeps
+      settle_fields(a);
+    });
   };
-  const contact::ContactLaw full_law = material.simulated_particle_law();
   if (stages.resuming()) {
     bed.world = make_material_world(material, options);
     if (request.set_laws) request.set_laws(bed.world);
@@ -199,7 +200,7 @@ std::size_t start_piston_test(S& stages, const MaterialModel& material,
   } else {
     bed = begin_piston_bed(material, request, options);
   }
-  finish_piston_bed(bed, material, request, full_law, checkpoints);
+  finish_piston_bed(bed, material, request, checkpoints);
   add_bed_phases(out, bed, request);
   stages.reached(0, bed.world);
   return 1;

@@ -523,8 +523,10 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
     consolidate(
         c, s, out,
         [&](const Consolidating& at) {
-          consolidating = at;
-          stages.offer_within(kConsolidatingStage, c.w, consolidating_fields);
+          stages.offer_within(kConsolidatingStage, c.w, [&](auto& a) {
+            consolidating = at;  // only for a checkpoint the receiver keeps
+            consolidating_fields(a);
+          });
         },
         stages.resuming_within() ? &consolidating : nullptr);
     stages.reached(1, c.w);

@@ -60,8 +60,7 @@ class Stages {
     if (!resuming()) return 0;
     const std::string& stage = options_.resume.stage;
     const auto at = std::find(names_.begin(), names_.end(), stage);
-    const auto inside = std::find_if(within_.begin(), within_.end(),
-                                     [&](const auto& w) { return w.first == stage; });
+    const auto inside = find_within(stage);
     if (at == names_.end() && inside == within_.end())
       throw InputError("checkpoint", "stage '" + stage + "' is not one this test goes on from");
     ByteReader in(options_.resume.state, "checkpoint");
@@ -89,10 +88,7 @@ class Stages {
   /// bed"), which a long phase offers with offer_within.
   void add_within(std::string name, std::size_t k) { within_.emplace_back(std::move(name), k); }
   /// The run goes on from a checkpoint inside a phase: read_within has the phase's fields.
-  bool resuming_within() const {
-    return std::any_of(within_.begin(), within_.end(),
-                       [&](const auto& w) { return w.first == options_.resume.stage; });
-  }
+  bool resuming_within() const { return find_within(options_.resume.stage) != within_.end(); }
 
   /// Offers the checkpoint `name` (add_within) from inside a phase with `world`: its record is
   /// a stage's with the phase's own fields after the runner's (`phase` is called as `Fields`).
@@ -124,6 +120,10 @@ class Stages {
   }
 
  private:
+  auto find_within(const std::string& name) const {
+    return std::find_if(within_.begin(), within_.end(),
+                        [&](const auto& w) { return w.first == name; });
+  }
   /// A stage's record: the format, the world's state, the output, the runner's fields.
   ByteWriter stage_record(const sim::World& world) const {
     ByteWriter record;
