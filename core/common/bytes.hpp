@@ -95,7 +95,8 @@ class ByteReader {
   }
   template <class T>
   void get(T& value) {
-    value = get<T>();
+    static_assert(std::is_trivially_copyable_v<T>);
+    std::memcpy(&value, take(sizeof(T)), sizeof(T));
   }
   template <class T>
   void get(std::vector<T>& values) {

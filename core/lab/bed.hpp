@@ -111,6 +111,9 @@ void record_fields(A& a, P& p) {
   a.field(p.checks);
 }
 
+/// The checkpoint inside a test's settle phase, before the stage of its settled bed.
+inline constexpr const char* kSettlingStage = "settling";
+
 /// Checkpoints inside a settle phase, which in a cohesive bed of fine particles can take most of
 /// a run: `offer` (if set) gets the progress after each check that did not end the phase;
 /// `resume` (if set) is where an earlier attempt's phase stood, and the phase goes on from there.

@@ -151,8 +151,6 @@ PistonBed make_piston_bed(const MaterialModel& material, const PistonBedRequest&
 
 /// The first checkpoint stage of every piston test: the settled bed with its piston.
 inline constexpr const char* kPistonBedStage = "piston bed";
-/// The checkpoint inside the settle of a piston test's bed, before kPistonBedStage.
-inline constexpr const char* kSettlingStage = "settling";
 
 /// The sampling cylinder of a die bed up to `top`: one largest diameter from die, floor and top.
 metrics::SamplingCylinder bed_sample(const sim::World& world, double die_radius, double top);

@@ -219,10 +219,9 @@ void insert_head(ShearCell& c, const ShearCellSettings& s, double h_v, LabOutput
   out.add_phase(clock.stop(w, "insert head", target, reached), every_metric());
 }
 
-/// Fills the vessel, settles the bed and lowers the head into it (insert_head); records the fill,
-/// settle and insert head phases.
-ShearCell build_cell(const MaterialModel& material, const ShearCellSettings& s,
-                     const RunOptions& options, LabOutput& out) {
+/// Fills the vessel (phase "fill") and sets the bed's health limits: the cell before its settle.
+ShearCell fill_cell(const MaterialModel& material, const ShearCellSettings& s,
+                    const RunOptions& options, LabOutput& out) {
   ShearCell c;
   sim::World& w = c.w;
   w = cell_world(material, s, options);
@@ -232,7 +231,6 @@ ShearCell build_cell(const MaterialModel& material, const ShearCellSettings& s,
   const double solid = expected_solid_volume(sizes, s.particles, options.seed);
   // A settled bed (~0.6) about as high as the vessel is wide.
   c.radius = std::max(4.0 * c.d, std::cbrt(solid / (0.6 * 2.0 * M_PI)));
-  const double h_v = s.vane_height * c.d;
   const double fill_h = solid / (0.2 * M_PI * c.radius * c.radius);
   w.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
   w.walls.push_back(
@@ -241,19 +239,28 @@ ShearCell build_cell(const MaterialModel& material, const ShearCellSettings& s,
       material_insert_request(material, particles::CylinderRegion{{0, 0, 0}, c.radius, 0.0, fill_h},
                               static_cast<std::size_t>(s.particles));
   out.add_phase(timed_fill(w, req, rng, s.time_step_safety, material.factors().time), {});
-  c.limits = die_limits(w, c.radius, fill_h + h_v);
+  c.limits = die_limits(w, c.radius, fill_h + s.vane_height * c.d);
   c.limits.lo.z = -fill_h;
-
-  BedSpec settle_spec;
-  settle_spec.max_settle_time = 1.0;
   // Settings and metrics are real stresses; the bed feels them x the scaling law's stress factor.
   c.real_kpa = 1e3 * material.factors().stress;
-  settle_spec.rest_stress = kShearPreKPa * c.real_kpa * s.stress_scale;
-  out.add_phase(settle(w, settle_spec, c.limits, material.factors().time), every_metric());
-
-  insert_head(c, s, h_v, out);
-
   c.sigma_pre = kShearPreKPa * c.real_kpa * s.stress_scale;
+  return c;
+}
+
+/// Settles the filled bed (phase "settle") at rest against the pre-shear stress; `checkpoints`
+/// as for settle().
+void settle_cell(ShearCell& c, const MaterialModel& material, LabOutput& out,
+                 const SettleCheckpoints& checkpoints) {
+  BedSpec spec;
+  spec.max_settle_time = 1.0;
+  spec.rest_stress = c.sigma_pre;
+  out.add_phase(settle(c.w, spec, c.limits, material.factors().time, checkpoints), every_metric());
+}
+
+/// Lowers the head into the settled bed (insert_head) and sets the floor's servo up: the cell
+/// built.
+void finish_cell(ShearCell& c, const ShearCellSettings& s, LabOutput& out) {
+  insert_head(c, s, s.vane_height * c.d, out);
   c.servo.axis = {0, 0, 1};  // the floor pushes the bed up against the head
   c.servo.area = M_PI * c.radius * c.radius;
   c.servo.max_speed = 0.5 * s.tip_speed;
@@ -261,7 +268,6 @@ ShearCell build_cell(const MaterialModel& material, const ShearCellSettings& s,
   // Removes the steady error of a dilating / compacting bed in ~20 ms.
   c.servo.ki = c.servo.kp / 0.02;
   c.omega = s.tip_speed / c.r_head;
-  return c;
 }
 
 struct PreShear {
@@ -344,6 +350,36 @@ void consolidate(ShearCell& c, const ShearCellSettings& s, LabOutput& out,
   out.add_phase(clock.stop(c.w, "consolidate", target, reached), {});
 }
 
+/// Where the pre-shear stands, for a checkpoint inside it: what the phase fixed when it began, its
+/// clock, its thirds' means so far and the series it has recorded (the servo is the cell's own).
+struct PreShearing {
+  std::int64_t steps0 = 0;  ///< the world's step count and time when it began
+  double time0 = 0.0;
+  double wall_seconds = 0.0;  ///< its wall time so far, over the attempts that ran it
+  long steps = 0;             ///< the steps of max_pre_shear_travel at the time step it began with
+  long record = 0;            ///< steps between the series' rows
+  BlockMeans thirds{0.0, 0.0};
+  double previous_tau = 0.0;  ///< the shear stress of the third before
+  PreShear last;              ///< the last third's means
+  Series series;
+};
+
+template <class A, RecordOf<PreShearing> P>
+void record_fields(A& a, P& p) {
+  a.field(p.steps0);
+  a.field(p.time0);
+  a.field(p.wall_seconds);
+  a.field(p.steps);
+  a.field(p.record);
+  a.field(p.thirds);
+  a.field(p.previous_tau);
+  a.field(p.last);
+  a.field(p.series);
+}
+
+/// The checkpoint inside the pre-shear, before the stage "re-consolidated".
+constexpr const char* kPreShearingStage = "pre-shearing";
+
 /// Turns the head at tip_speed, the floor holding sigma_pre, until the flow is steady (phase
 /// "pre-shear"): over the last third of pre_shear_travel diameters of tip travel the floor's mean
 /// stress is within the stress tolerance of sigma_pre, the mean shear stress differs from the
@@ -352,31 +388,46 @@ void consolidate(ShearCell& c, const ShearCellSettings& s, LabOutput& out,
 /// normal stress are the last third's means. A bed still compacting or dilating is not in steady
 /// flow: its shear stress is that of another normal stress or density (seed 000 §2.7.4: "the
 /// duration ... set high enough for the simulation to reach a stationary shear stress").
+/// `offer` gets where it stands after each third that does not end it; from `resume` (if set) it
+/// goes on where an earlier attempt's phase stood.
 PreShear pre_shear(ShearCell& c, const ShearCellSettings& s, const RunOptions& options,
-                   LabOutput& out) {
+                   LabOutput& out, const std::function<void(const PreShearing&)>& offer,
+                   const PreShearing* resume) {
   sim::World& w = c.w;
-  Series pre{{"time", "normal_stress_kpa", "shear_stress_kpa", "tip_travel"}, {}};
-  w.walls[kHead].omega = {0, 0, c.omega};
   const double window = s.pre_shear_travel / 3.0 * c.d / s.tip_speed;
-  const double most = s.max_pre_shear_travel * c.d / s.tip_speed;
-  const double t0 = w.time;
-  BlockMeans thirds(t0, window);  // shear stress and floor stress of each window
-  double previous_tau = 0.0;
-  PreShear result;
+  PreShearing at;
+  if (resume) {
+    at = *resume;
+  } else {
+    w.walls[kHead].omega = {0, 0, c.omega};
+    at.steps0 = w.step_count;
+    at.time0 = w.time;
+    at.steps = std::max<long>(1, std::lround(s.max_pre_shear_travel * c.d / s.tip_speed / w.dt));
+    at.record = std::max<long>(1, std::lround(0.002 / w.dt));
+    at.thirds = BlockMeans(w.time, window);  // shear stress and floor stress of each third
+    at.series = {{"time", "normal_stress_kpa", "shear_stress_kpa", "tip_travel"}, {}};
+    c.servo.target = c.sigma_pre;
+    c.servo.reset();
+  }
+  const PhaseClock clock(at.steps0, at.time0, at.wall_seconds);
   bool steady = false;
-  const long record = std::max<long>(1, std::lround(0.002 / w.dt));
-  const PhaseClock clock(w);
-  c.servo_run(w, c.sigma_pre, most, [&](sim::World& ww) {
-    const double t = ww.time - t0;
+  c.servo_steps(w, at.steps - (w.step_count - at.steps0), [&](sim::World& ww) {
+    const double t = ww.time - at.time0;
     const double tau = shear_stress(ww, c.r_head), sigma = c.floor_stress(ww);
-    if (ww.step_count % record == 0)
-      pre.rows.push_back({ww.time, sigma / c.real_kpa, tau / c.real_kpa, t * s.tip_speed / c.d});
+    if (ww.step_count % at.record == 0)
+      at.series.rows.push_back(
+          {ww.time, sigma / c.real_kpa, tau / c.real_kpa, t * s.tip_speed / c.d});
     if (options.progress) options.progress(0.4 * std::min(1.0, t / (3.0 * window)));
-    if (!thirds.add(ww.time, tau, sigma)) return true;
-    result = {thirds.mean_a(), thirds.mean_b()};
-    steady = thirds.blocks() >= 3 && at_pre_stress(c, s, result.sigma) &&
-             std::abs(result.tau - previous_tau) <= s.pre_shear_steadiness * std::abs(result.tau);
-    previous_tau = result.tau;
+    if (!at.thirds.add(ww.time, tau, sigma)) return true;
+    at.last = {at.thirds.mean_a(), at.thirds.mean_b()};
+    steady =
+        at.thirds.blocks() >= 3 && at_pre_stress(c, s, at.last.sigma) &&
+        std::abs(at.last.tau - at.previous_tau) <= s.pre_shear_steadiness * std::abs(at.last.tau);
+    at.previous_tau = at.last.tau;
+    if (!steady && offer) {
+      at.wall_seconds = clock.wall_seconds();
+      offer(at);
+    }
     return !steady;
   });
   char target[200];
@@ -387,8 +438,8 @@ PreShear pre_shear(ShearCell& c, const ShearCellSettings& s, const RunOptions& o
                 100.0 * s.pre_shear_steadiness, s.max_pre_shear_travel);
   out.add_phase(clock.stop(w, "pre-shear", target, steady), every_metric());
   w.walls[kHead].omega = {};
-  out.series["pre_shear"] = std::move(pre);
-  return result;
+  out.series["pre_shear"] = std::move(at.series);
+  return at.last;
 }
 
 /// The mean of the last `n` values pushed (and of a second quantity alongside).
@@ -486,8 +537,9 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
   LineFit locus;
   std::vector<double> ys;
   // The stages: the cell built (filled, settled, the head in the bed), consolidated, pre-sheared
-  // and re-consolidated, then each shear step done. The first two cut the work a stopped run
-  // loses: a cohesive bed of fine particles may take most of its run to settle and consolidate.
+  // and re-consolidated, then each shear step done. Its settle, consolidation and pre-shear also
+  // offer checkpoints inside them: a cohesive bed of fine particles may take most of its run in
+  // them, and a stopped run then loses little of it.
   std::vector<std::string> names{"cell built", "consolidated", "re-consolidated"};
   constexpr std::size_t kFirstStep = 3;
   for (const double kpa : kShearNormalKPa) {
@@ -502,37 +554,49 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
     a.field(locus);
     a.field(ys);
   });
+  stages.add_within(kSettlingStage, 0);
   stages.add_within(kConsolidatingStage, 1);
+  stages.add_within(kPreShearingStage, 2);
+  // Where each of those phases stands, in its checkpoints' records.
+  SettleProgress settling;
   Consolidating consolidating;
-  auto consolidating_fields = [&](auto& a) { a.field(consolidating); };
+  PreShearing pre_shearing;
+  // The phase's offer of the checkpoint `stage` from inside it.
+  auto offer_at = [&](const char* stage, auto& kept) {
+    return [&stages, &c, stage, phase = &kept](const auto& at) {
+      stages.offer_within(stage, c.w, [&](auto& a) {
+        *phase = at;  // only for a checkpoint the receiver keeps
+        a.field(*phase);
+      });
+    };
+  };
+  // Where the phase stands when the run goes on from the checkpoint `stage` inside it, else null.
+  auto resumed_at = [&](const char* stage, auto& kept) -> decltype(&kept) {
+    if (!stages.resuming_within(stage)) return nullptr;
+    stages.read_within([&](auto& a) { a.field(kept); });
+    out.cost.wall_seconds += kept.wall_seconds;  // the earlier attempt's, in the phase
+    return &kept;
+  };
   std::size_t next = 0;
   if (stages.resuming()) {
     c.w = cell_world(material, s, options);
     next = stages.resume(c.w);
-    if (stages.resuming_within()) {
-      stages.read_within(consolidating_fields);
-      // The earlier attempt's wall time in the consolidation it ran.
-      out.cost.wall_seconds += consolidating.wall_seconds;
-    }
   }
   if (next == 0) {
-    c = build_cell(material, s, options, out);
+    const SettleProgress* from = resumed_at(kSettlingStage, settling);
+    if (!from) c = fill_cell(material, s, options, out);
+    settle_cell(c, material, out, {offer_at(kSettlingStage, settling), from});
+    finish_cell(c, s, out);
     stages.reached(0, c.w);
   }
   if (next <= 1) {
-    consolidate(
-        c, s, out,
-        [&](const Consolidating& at) {
-          stages.offer_within(kConsolidatingStage, c.w, [&](auto& a) {
-            consolidating = at;  // only for a checkpoint the receiver keeps
-            consolidating_fields(a);
-          });
-        },
-        stages.resuming_within() ? &consolidating : nullptr);
+    consolidate(c, s, out, offer_at(kConsolidatingStage, consolidating),
+                resumed_at(kConsolidatingStage, consolidating));
     stages.reached(1, c.w);
   }
   if (next <= 2) {
-    pre = pre_shear(c, s, options, out);
+    pre = pre_shear(c, s, options, out, offer_at(kPreShearingStage, pre_shearing),
+                    resumed_at(kPreShearingStage, pre_shearing));
     write_snapshot(c.w, options, "shear_cell_preshear", out, c.radius);
     reconsolidate(c, s, out);
     stages.reached(2, c.w);

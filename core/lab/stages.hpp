@@ -89,6 +89,10 @@ class Stages {
   void add_within(std::string name, std::size_t k) { within_.emplace_back(std::move(name), k); }
   /// The run goes on from a checkpoint inside a phase: read_within has the phase's fields.
   bool resuming_within() const { return find_within(options_.resume.stage) != within_.end(); }
+  /// The run goes on from the checkpoint `name` inside a phase (add_within).
+  bool resuming_within(const std::string& name) const {
+    return options_.resume.stage == name && find_within(name) != within_.end();
+  }
 
   /// Offers the checkpoint `name` (add_within) from inside a phase with `world`: its record is
   /// a stage's with the phase's own fields after the runner's (`phase` is called as `Fields`).

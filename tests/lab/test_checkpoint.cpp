@@ -136,21 +136,22 @@ TEST(Checkpoint, TheTensileTestGoesOnFromEveryStageToTheSameBits) {
                                       "final unload", "unload"}));
 }
 
-TEST(Checkpoint,
-     TheShearCellGoesOnFromItsBuiltConsolidatingConsolidatedAndReconsolidatedCellToTheSameBits) {
+TEST(Checkpoint, TheShearCellGoesOnFromEveryStageAndFromInsideItsLongPhasesToTheSameBits) {
   const Settings settings{{"particles", 120},
                           {"pre_shear_travel", 1},
                           {"torque_ramp_time", 0.05},
                           {"consolidation_time", 0.01}};
   const auto stages = expect_resumes_to_the_same_bits(
       "shear_cell", testing::hertz_spheres(0.5), settings,
-      {"cell built", "consolidating", "consolidated", "re-consolidated", "shear step 1.5 kPa"});
-  // The consolidation is offered again after each block of consolidation_time that does not
-  // end it.
-  EXPECT_EQ(stages, (std::vector<std::string>{"cell built", "consolidating", "consolidated",
-                                              "re-consolidated", "shear step 2 kPa",
-                                              "shear step 1.75 kPa", "shear step 1.5 kPa",
-                                              "shear step 1.25 kPa", "shear step 1 kPa"}));
+      {"settling", "cell built", "consolidating", "consolidated", "pre-shearing", "re-consolidated",
+       "shear step 1.5 kPa"});
+  // The settle is offered again after each of its checks, the consolidation after each block of
+  // consolidation_time and the pre-shear after each third of its travel that does not end them.
+  EXPECT_EQ(stages, (std::vector<std::string>{"settling", "cell built", "consolidating",
+                                              "consolidated", "pre-shearing", "re-consolidated",
+                                              "shear step 2 kPa", "shear step 1.75 kPa",
+                                              "shear step 1.5 kPa", "shear step 1.25 kPa",
+                                              "shear step 1 kPa"}));
 }
 
 TEST(Checkpoint, TheDrumGoesOnFromItsBedTheAngleAndASpeedToTheSameBits) {
