@@ -442,31 +442,44 @@ PreShear pre_shear(ShearCell& c, const ShearCellSettings& s, const RunOptions& o
   return at.last;
 }
 
-/// The mean of the last `n` values pushed (and of a second quantity alongside).
-class WindowMeans {
- public:
-  explicit WindowMeans(long n) : n_(n) {}
-  void push(double a, double b) {
-    a_.push_back(a);
-    sum_a_ += a;
-    b_.push_back(b);
-    sum_b_ += b;
-    if (static_cast<long>(a_.size()) > n_) {
-      sum_a_ -= a_.front();
-      a_.pop_front();
-      sum_b_ -= b_.front();
-      b_.pop_front();
-    }
-  }
-  bool full() const { return static_cast<long>(a_.size()) == n_; }
-  double mean_a() const { return sum_a_ / static_cast<double>(n_); }
-  double mean_b() const { return sum_b_ / static_cast<double>(n_); }
+/// The mean of the last `n` values pushed (and of a second quantity alongside), in a ring of
+/// its own: a checkpoint record holds it as it stands.
+struct WindowMeans {
+  long n = 1;
+  std::vector<double> a, b;  ///< the last n values, the oldest at `next` once full
+  long next = 0, count = 0;
+  double sum_a = 0.0, sum_b = 0.0;
 
- private:
-  long n_;
-  std::deque<double> a_, b_;
-  double sum_a_ = 0.0, sum_b_ = 0.0;
+  WindowMeans() = default;
+  explicit WindowMeans(long size) : n(size), a(size), b(size) {}
+  void push(double va, double vb) {
+    sum_a += va;
+    sum_b += vb;
+    if (count == n) {
+      sum_a -= a[next];
+      sum_b -= b[next];
+    } else {
+      ++count;
+    }
+    a[next] = va;
+    b[next] = vb;
+    next = (next + 1) % n;
+  }
+  bool full() const { return count == n; }
+  double mean_a() const { return sum_a / static_cast<double>(n); }
+  double mean_b() const { return sum_b / static_cast<double>(n); }
 };
+
+template <class A, RecordOf<WindowMeans> W>
+void record_fields(A& a, W& w) {
+  a.field(w.n);
+  a.field(w.a);
+  a.field(w.b);
+  a.field(w.next);
+  a.field(w.count);
+  a.field(w.sum_a);
+  a.field(w.sum_b);
+}
 
 struct YieldStep {
   double sigma_x = 0.0;  ///< the step's normal stress (Pa, simulated)
@@ -474,6 +487,39 @@ struct YieldStep {
   double tau = 0.0;      ///< yield shear stress: the peak of the windowed mean
   bool yielded = false;  ///< the tips moved 1.5 diameters within the time
 };
+
+/// Where a shear step's shear stands, for a checkpoint inside it: the step's world (a copy of the
+/// re-consolidated cell), its clock, the shear's start and steps, the head's turn so far and the
+/// windowed means (the servo is the cell's own).
+struct ShearStepping {
+  std::string world;        ///< the step's world's state
+  std::int64_t steps0 = 0;  ///< the world's step count and time when the step began
+  double time0 = 0.0;
+  double wall_seconds = 0.0;      ///< the step's wall time so far, over the attempts that ran it
+  std::int64_t shear_steps0 = 0;  ///< the step count and time when the shear began
+  double shear_time0 = 0.0;
+  long steps = 0;      ///< the shear's steps at the time step it began with
+  double angle = 0.0;  ///< the head's turn so far (rad)
+  YieldStep y;
+  WindowMeans window;
+};
+
+template <class A, RecordOf<ShearStepping> S>
+void record_fields(A& a, S& s) {
+  a.field(s.world);
+  a.field(s.steps0);
+  a.field(s.time0);
+  a.field(s.wall_seconds);
+  a.field(s.shear_steps0);
+  a.field(s.shear_time0);
+  a.field(s.steps);
+  a.field(s.angle);
+  a.field(s.y);
+  a.field(s.window);
+}
+
+/// Steps of a shear step's shear between the offers of a checkpoint inside it.
+constexpr long kShearOfferSteps = 10000;
 
 /// Re-consolidates the pre-sheared cell at sigma_pre with the head at rest (phase
 /// "re-consolidate"): the state every shear step starts from (the seed's restart files). The five
@@ -487,37 +533,59 @@ void reconsolidate(ShearCell& c, const ShearCellSettings& s, LabOutput& out) {
 /// One shear step (phase `name`) from a copy of the re-consolidated cell: reduced to sigma_x, then
 /// sheared under torque control, the set torque ramped to twice the pre-shear torque; the yield
 /// point is the peak of the shear stress averaged over the time the tips need for 0.5 d at full
-/// speed (a shorter mean would pick up contact noise, not the bed's strength).
+/// speed (a shorter mean would pick up contact noise, not the bed's strength). `offer` gets where
+/// the shear stands every kShearOfferSteps steps; from `resume` (if set) the step goes on where an
+/// earlier attempt's shear stood.
 YieldStep shear_step(ShearCell& c, const std::string& name, double step_kpa,
-                     const ShearCellSettings& s, double tau_pre, LabOutput& out) {
+                     const ShearCellSettings& s, double tau_pre, LabOutput& out,
+                     const std::function<void(const ShearStepping&, const sim::World&)>& offer,
+                     const ShearStepping* resume) {
   sim::World v = c.w;
-  const PhaseClock step_clock(v);
-  YieldStep y;
-  y.sigma_x = step_kpa * c.real_kpa * s.stress_scale;
-  c.servo_run(v, y.sigma_x, s.consolidation_time, {});
+  ShearStepping at;
+  if (resume) {
+    at = *resume;
+    v.restore_state(at.world);
+  } else {
+    at.steps0 = v.step_count;
+    at.time0 = v.time;
+    at.y.sigma_x = step_kpa * c.real_kpa * s.stress_scale;
+    at.y.sigma = at.y.sigma_x;
+  }
+  const PhaseClock step_clock(at.steps0, at.time0, at.wall_seconds);
+  if (!resume) {
+    c.servo_run(v, at.y.sigma_x, s.consolidation_time, {});
+    at.shear_steps0 = v.step_count;
+    at.shear_time0 = v.time;
+    at.steps =
+        std::max<long>(1, std::lround((2.0 * s.torque_ramp_time + 1.5 * c.d / s.tip_speed) / v.dt));
+    at.window = WindowMeans(std::max<long>(1, std::lround(0.5 * c.d / s.tip_speed / v.dt)));
+    c.servo.target = at.y.sigma_x;
+    c.servo.reset();
+  }
   const double torque_pre = tau_pre * 2.0 * M_PI * std::pow(c.r_head, 3) / 3.0;
-  const double t0 = v.time;
   const double t_max = std::max(torque_pre, 1e-12) * 2.0;
   const double gain = c.omega / (0.05 * std::max(torque_pre, 1e-12));
-  double angle = 0.0;
-  y.sigma = y.sigma_x;
-  WindowMeans window(std::max<long>(1, std::lround(0.5 * c.d / s.tip_speed / v.dt)));
-  c.servo_run(v, y.sigma_x, 2.0 * s.torque_ramp_time + 1.5 * c.d / s.tip_speed,
-              [&](sim::World& ww) {
-                const double t = ww.time - t0;
-                const double t_set = t_max * std::min(1.0, t / s.torque_ramp_time);
-                const double torque = -ww.walls[kHead].torque.z;
-                const double om = std::clamp(gain * (t_set - torque), 0.0, c.omega);
-                ww.walls[kHead].omega = {0, 0, om};
-                angle += om * ww.dt;
-                window.push(shear_stress(ww, c.r_head), c.floor_stress(ww));
-                if (window.full() && window.mean_a() > y.tau) {
-                  y.tau = window.mean_a();
-                  y.sigma = window.mean_b();
-                }
-                return angle * c.r_head < 1.5 * c.d;  // yielded: the tips moved 1.5 diameters
-              });
-  y.yielded = angle * c.r_head >= 1.5 * c.d;
+  YieldStep& y = at.y;
+  c.servo_steps(v, at.steps - (v.step_count - at.shear_steps0), [&](sim::World& ww) {
+    const double t = ww.time - at.shear_time0;
+    const double t_set = t_max * std::min(1.0, t / s.torque_ramp_time);
+    const double torque = -ww.walls[kHead].torque.z;
+    const double om = std::clamp(gain * (t_set - torque), 0.0, c.omega);
+    ww.walls[kHead].omega = {0, 0, om};
+    at.angle += om * ww.dt;
+    at.window.push(shear_stress(ww, c.r_head), c.floor_stress(ww));
+    if (at.window.full() && at.window.mean_a() > y.tau) {
+      y.tau = at.window.mean_a();
+      y.sigma = at.window.mean_b();
+    }
+    const bool turning = at.angle * c.r_head < 1.5 * c.d;  // yielded: the tips moved 1.5 d
+    if (turning && offer && (ww.step_count - at.shear_steps0) % kShearOfferSteps == 0) {
+      at.wall_seconds = step_clock.wall_seconds();
+      offer(at, ww);
+    }
+    return turning;
+  });
+  y.yielded = at.angle * c.r_head >= 1.5 * c.d;
   out.add_phase(
       step_clock.stop(v, name, "yield: tips moved 1.5 diameters within the time", y.yielded),
       {"yield_locus_slope", "yield_locus_intercept", "ffc", "effective_friction_angle",
@@ -537,15 +605,18 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
   LineFit locus;
   std::vector<double> ys;
   // The stages: the cell built (filled, settled, the head in the bed), consolidated, pre-sheared
-  // and re-consolidated, then each shear step done. Its settle, consolidation and pre-shear also
-  // offer checkpoints inside them: a cohesive bed of fine particles may take most of its run in
-  // them, and a stopped run then loses little of it.
+  // and re-consolidated, then each shear step done. Its settle, consolidation, pre-shear and the
+  // shear of each step also offer checkpoints inside them: a cohesive bed of fine particles may
+  // take most of its run in any of them, and a stopped run then loses little of it.
   std::vector<std::string> names{"cell built", "consolidated", "re-consolidated"};
+  std::vector<std::string> shearing;  // inside each shear step
   constexpr std::size_t kFirstStep = 3;
   for (const double kpa : kShearNormalKPa) {
     char name[64];
     std::snprintf(name, sizeof name, "shear step %g kPa", kpa);
     names.emplace_back(name);
+    std::snprintf(name, sizeof name, "shearing %g kPa", kpa);
+    shearing.emplace_back(name);
   }
   Stages stages(options, std::move(names), out, [&](auto& a) {
     a.field(c);
@@ -557,10 +628,12 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
   stages.add_within(kSettlingStage, 0);
   stages.add_within(kConsolidatingStage, 1);
   stages.add_within(kPreShearingStage, 2);
+  for (std::size_t k = 0; k < shearing.size(); ++k) stages.add_within(shearing[k], kFirstStep + k);
   // Where each of those phases stands, in its checkpoints' records.
   SettleProgress settling;
   Consolidating consolidating;
   PreShearing pre_shearing;
+  ShearStepping shear_stepping;
   // The phase's offer of the checkpoint `stage` from inside it.
   auto offer_at = [&](const char* stage, auto& kept) {
     return [&stages, &c, stage, phase = &kept](const auto& at) {
@@ -571,7 +644,7 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
     };
   };
   // Where the phase stands when the run goes on from the checkpoint `stage` inside it, else null.
-  auto resumed_at = [&](const char* stage, auto& kept) -> decltype(&kept) {
+  auto resumed_at = [&](const std::string& stage, auto& kept) -> decltype(&kept) {
     if (!stages.resuming_within(stage)) return nullptr;
     stages.read_within([&](auto& a) { a.field(kept); });
     out.cost.wall_seconds += kept.wall_seconds;  // the earlier attempt's, in the phase
@@ -605,7 +678,17 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
   // normal stress measured on the floor at the yield point.
   for (std::size_t k = std::max(next, kFirstStep) - kFirstStep; k < kShearNormalKPa.size(); ++k) {
     const std::size_t stage = kFirstStep + k;
-    const YieldStep y = shear_step(c, stages.name(stage), kShearNormalKPa[k], s, pre.tau, out);
+    const std::string& within = shearing[k];
+    const YieldStep y = shear_step(
+        c, stages.name(stage), kShearNormalKPa[k], s, pre.tau, out,
+        [&](const ShearStepping& at, const sim::World& step_world) {
+          stages.offer_within(within, c.w, [&](auto& a) {
+            shear_stepping = at;  // only for a checkpoint the receiver keeps
+            shear_stepping.world = step_world.save_state();
+            a.field(shear_stepping);
+          });
+        },
+        resumed_at(within, shear_stepping));
     points.rows.push_back({y.sigma_x / c.real_kpa, y.sigma / c.real_kpa, y.tau / c.real_kpa});
     locus.add(y.sigma / c.real_kpa, y.tau / c.real_kpa);
     ys.push_back(y.tau / c.real_kpa);

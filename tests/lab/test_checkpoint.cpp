@@ -144,14 +144,16 @@ TEST(Checkpoint, TheShearCellGoesOnFromEveryStageAndFromInsideItsLongPhasesToThe
   const auto stages = expect_resumes_to_the_same_bits(
       "shear_cell", testing::hertz_spheres(0.5), settings,
       {"settling", "cell built", "consolidating", "consolidated", "pre-shearing", "re-consolidated",
-       "shear step 1.5 kPa"});
+       "shearing 1.75 kPa", "shear step 1.5 kPa"});
   // The settle is offered again after each of its checks, the consolidation after each block of
-  // consolidation_time and the pre-shear after each third of its travel that does not end them.
-  EXPECT_EQ(stages, (std::vector<std::string>{"settling", "cell built", "consolidating",
-                                              "consolidated", "pre-shearing", "re-consolidated",
-                                              "shear step 2 kPa", "shear step 1.75 kPa",
-                                              "shear step 1.5 kPa", "shear step 1.25 kPa",
-                                              "shear step 1 kPa"}));
+  // consolidation_time, the pre-shear after each third of its travel that does not end them, and
+  // each step's shear every 10,000 steps while the head has not yielded.
+  EXPECT_EQ(stages,
+            (std::vector<std::string>{
+                "settling", "cell built", "consolidating", "consolidated", "pre-shearing",
+                "re-consolidated", "shearing 2 kPa", "shear step 2 kPa", "shearing 1.75 kPa",
+                "shear step 1.75 kPa", "shearing 1.5 kPa", "shear step 1.5 kPa",
+                "shearing 1.25 kPa", "shear step 1.25 kPa", "shearing 1 kPa", "shear step 1 kPa"}));
 }
 
 TEST(Checkpoint, TheDrumGoesOnFromItsBedTheAngleAndASpeedToTheSameBits) {
