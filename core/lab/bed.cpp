@@ -262,8 +262,7 @@ SettleProgress settle_start(const sim::World& w, const BedSpec& spec, double tim
   }
   s.chunk = spec.creep_window > 0.0 ? std::max<long>(1, std::lround(0.2 * spec.creep_window / w.dt))
                                     : std::max<long>(200, std::lround(0.002 * time_factor / w.dt));
-  s.steps0 = w.step_count;
-  s.time0 = w.time;
+  s.begun = {w.step_count, w.time, 0.0};
   return s;
 }
 
@@ -272,7 +271,7 @@ SettleProgress settle_start(const sim::World& w, const BedSpec& spec, double tim
 PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& limits,
                  double time_factor, const SettleCheckpoints& checkpoints) {
   SettleProgress at = checkpoints.resume ? *checkpoints.resume : settle_start(w, spec, time_factor);
-  const PhaseClock clock(at.steps0, at.time0, at.wall_seconds);
+  const PhaseClock clock(at.begun);
   const double max_time = spec.max_settle_time * time_factor;
   const auto& p = w.particles;
   double mass = 0.0, volume = 0.0;
@@ -307,7 +306,7 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
   // The creep rule's inertial number of the bed's height change, I_h = strain rate x
   // d sqrt(rho_p / sigma_ref) (GDR MiDi 2004, with the bed's strain rate for the shear rate).
   const double creep_time = mean_diameter(p) * std::sqrt(rho / quiet_stress);
-  const double t0 = at.time0;
+  const double t0 = at.begun.time0;
   SinkWatch sinking(at.checks);
   bool rest = false;
   while (!rest && w.time - t0 < t_end) {
@@ -321,7 +320,7 @@ PhaseCost settle(sim::World& w, const BedSpec& spec, const sim::HealthLimits& li
       rest = rest && sinking.strain_rate(spec.creep_window, bottom) * creep_time <
                          spec.creep_inertial_number;
     if (!rest && checkpoints.offer) {
-      at.wall_seconds = clock.wall_seconds();
+      at.begun = clock.mark();
       checkpoints.offer(at);
     }
   }

@@ -93,9 +93,7 @@ struct SettleCheck {
 struct SettleProgress {
   double bottom = 0.0, top = 0.0;  ///< the bed's lowest and highest point when it began (m)
   long chunk = 0;                  ///< steps between checks (from the time step it began with)
-  std::int64_t steps0 = 0;         ///< the world's step count and time when it began
-  double time0 = 0.0;
-  double wall_seconds = 0.0;  ///< its wall time so far, over the attempts that ran it
+  PhaseMark begun;
   std::vector<SettleCheck> checks;
 };
 
@@ -105,9 +103,7 @@ void record_fields(A& a, P& p) {
   a.field(p.bottom);
   a.field(p.top);
   a.field(p.chunk);
-  a.field(p.steps0);
-  a.field(p.time0);
-  a.field(p.wall_seconds);
+  a.field(p.begun);
   a.field(p.checks);
 }
 

@@ -54,12 +54,12 @@ PhaseClock::PhaseClock(const sim::World& world)
 
 PhaseClock::PhaseClock() : wall0_(std::chrono::steady_clock::now()) {}
 
-PhaseClock::PhaseClock(std::int64_t steps0, double time0, double wall_before)
-    : steps0_(steps0),
-      time0_(time0),
+PhaseClock::PhaseClock(const PhaseMark& mark)
+    : steps0_(mark.steps0),
+      time0_(mark.time0),
       wall0_(std::chrono::steady_clock::now() -
              std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                 std::chrono::duration<double>(wall_before))) {}
+                 std::chrono::duration<double>(mark.wall_seconds))) {}
 
 double PhaseClock::wall_seconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();

@@ -44,6 +44,14 @@ struct RunCost {
   void close(const sim::World& world);
 };
 
+/// Where a phase began (the world's step count and time) and its wall time so far, over the
+/// attempts that ran it: what a checkpoint inside the phase keeps of its clock.
+struct PhaseMark {
+  std::int64_t steps0 = 0;
+  double time0 = 0.0;
+  double wall_seconds = 0.0;
+};
+
 /// Times one phase on a world: steps, simulated time and wall time from construction to stop().
 class PhaseClock {
  public:
@@ -51,11 +59,12 @@ class PhaseClock {
   explicit PhaseClock(const sim::World& world);
   /// Starts at step 0, time 0: for the phase that creates the world.
   PhaseClock();
-  /// Goes on with a phase that began at `steps0` and `time0` and has run `wall_before` seconds
-  /// (in an earlier attempt, for a run resumed inside it).
-  PhaseClock(std::int64_t steps0, double time0, double wall_before);
+  /// Goes on with the phase of `mark` (in an earlier attempt, for a run resumed inside it).
+  explicit PhaseClock(const PhaseMark& mark);
   /// The phase's wall time so far.
   double wall_seconds() const;
+  /// Where the phase began and its wall time so far.
+  PhaseMark mark() const { return {steps0_, time0_, wall_seconds()}; }
   PhaseCost stop(const sim::World& world, std::string name, std::string target, bool reached) const;
 
  private:

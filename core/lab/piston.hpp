@@ -193,7 +193,7 @@ std::size_t start_piston_test(S& stages, const MaterialModel& material,
     stages.read_within(settle_fields);
     // The earlier attempt's wall time: the bed's phases up to the checkpoint.
     out.cost.wall_seconds +=
-        bed.filled.wall_seconds + bed.built.prepared.wall_seconds + progress.wall_seconds;
+        bed.filled.wall_seconds + bed.built.prepared.wall_seconds + progress.begun.wall_seconds;
     checkpoints.resume = &progress;
   } else {
     bed = begin_piston_bed(material, request, options);

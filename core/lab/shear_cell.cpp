@@ -287,24 +287,13 @@ bool at_pre_stress(const ShearCell& c, const ShearCellSettings& s, double sigma)
 
 /// Where the consolidation stands, for a checkpoint inside it: what the phase fixed when it
 /// began, its clock and the floor stress's block means so far (the servo is the cell's own).
+/// A record holds it as it is in memory (trivially copyable).
 struct Consolidating {
-  std::int64_t steps0 = 0;  ///< the world's step count and time when it began
-  double time0 = 0.0;
-  double wall_seconds = 0.0;  ///< its wall time so far, over the attempts that ran it
-  double limit = 0.0;         ///< its time limit (s), from the bed's height when it began
-  long steps = 0;             ///< the steps of that limit at the time step it began with
+  PhaseMark begun;
+  double limit = 0.0;  ///< its time limit (s), from the bed's height when it began
+  long steps = 0;      ///< the steps of that limit at the time step it began with
   BlockMeans stress{0.0, 0.0};
 };
-
-template <class A, RecordOf<Consolidating> C>
-void record_fields(A& a, C& c) {
-  a.field(c.steps0);
-  a.field(c.time0);
-  a.field(c.wall_seconds);
-  a.field(c.limit);
-  a.field(c.steps);
-  a.field(c.stress);
-}
 
 /// The checkpoint inside the consolidation, before the stage "consolidated".
 constexpr const char* kConsolidatingStage = "consolidating";
@@ -322,21 +311,20 @@ void consolidate(ShearCell& c, const ShearCellSettings& s, LabOutput& out,
   if (resume) {
     at = *resume;
   } else {
-    at.steps0 = c.w.step_count;
-    at.time0 = c.w.time;
+    at.begun = {c.w.step_count, c.w.time, 0.0};
     at.limit = s.consolidation_time + 2.0 * bed_height(c) / c.servo.max_speed;
     at.steps = std::max<long>(1, std::lround(at.limit / c.w.dt));
     at.stress = BlockMeans(c.w.time, s.consolidation_time);
     c.servo.target = c.sigma_pre;
     c.servo.reset();
   }
-  const PhaseClock clock(at.steps0, at.time0, at.wall_seconds);
+  const PhaseClock clock(at.begun);
   bool reached = false;
-  c.servo_steps(c.w, at.steps - (c.w.step_count - at.steps0), [&](sim::World& w) {
+  c.servo_steps(c.w, at.steps - (c.w.step_count - at.begun.steps0), [&](sim::World& w) {
     if (!at.stress.add(w.time, c.floor_stress(w))) return true;
     reached = at_pre_stress(c, s, at.stress.mean_a());
     if (!reached && offer) {
-      at.wall_seconds = clock.wall_seconds();
+      at.begun = clock.mark();
       offer(at);
     }
     return !reached;
@@ -353,11 +341,9 @@ void consolidate(ShearCell& c, const ShearCellSettings& s, LabOutput& out,
 /// Where the pre-shear stands, for a checkpoint inside it: what the phase fixed when it began, its
 /// clock, its thirds' means so far and the series it has recorded (the servo is the cell's own).
 struct PreShearing {
-  std::int64_t steps0 = 0;  ///< the world's step count and time when it began
-  double time0 = 0.0;
-  double wall_seconds = 0.0;  ///< its wall time so far, over the attempts that ran it
-  long steps = 0;             ///< the steps of max_pre_shear_travel at the time step it began with
-  long record = 0;            ///< steps between the series' rows
+  PhaseMark begun;
+  long steps = 0;   ///< the steps of max_pre_shear_travel at the time step it began with
+  long record = 0;  ///< steps between the series' rows
   BlockMeans thirds{0.0, 0.0};
   double previous_tau = 0.0;  ///< the shear stress of the third before
   PreShear last;              ///< the last third's means
@@ -366,9 +352,7 @@ struct PreShearing {
 
 template <class A, RecordOf<PreShearing> P>
 void record_fields(A& a, P& p) {
-  a.field(p.steps0);
-  a.field(p.time0);
-  a.field(p.wall_seconds);
+  a.field(p.begun);
   a.field(p.steps);
   a.field(p.record);
   a.field(p.thirds);
@@ -400,8 +384,7 @@ PreShear pre_shear(ShearCell& c, const ShearCellSettings& s, const RunOptions& o
     at = *resume;
   } else {
     w.walls[kHead].omega = {0, 0, c.omega};
-    at.steps0 = w.step_count;
-    at.time0 = w.time;
+    at.begun = {w.step_count, w.time, 0.0};
     at.steps = std::max<long>(1, std::lround(s.max_pre_shear_travel * c.d / s.tip_speed / w.dt));
     at.record = std::max<long>(1, std::lround(0.002 / w.dt));
     at.thirds = BlockMeans(w.time, window);  // shear stress and floor stress of each third
@@ -409,10 +392,10 @@ PreShear pre_shear(ShearCell& c, const ShearCellSettings& s, const RunOptions& o
     c.servo.target = c.sigma_pre;
     c.servo.reset();
   }
-  const PhaseClock clock(at.steps0, at.time0, at.wall_seconds);
+  const PhaseClock clock(at.begun);
   bool steady = false;
-  c.servo_steps(w, at.steps - (w.step_count - at.steps0), [&](sim::World& ww) {
-    const double t = ww.time - at.time0;
+  c.servo_steps(w, at.steps - (w.step_count - at.begun.steps0), [&](sim::World& ww) {
+    const double t = ww.time - at.begun.time0;
     const double tau = shear_stress(ww, c.r_head), sigma = c.floor_stress(ww);
     if (ww.step_count % at.record == 0)
       at.series.rows.push_back(
@@ -425,7 +408,7 @@ PreShear pre_shear(ShearCell& c, const ShearCellSettings& s, const RunOptions& o
         std::abs(at.last.tau - at.previous_tau) <= s.pre_shear_steadiness * std::abs(at.last.tau);
     at.previous_tau = at.last.tau;
     if (!steady && offer) {
-      at.wall_seconds = clock.wall_seconds();
+      at.begun = clock.mark();
       offer(at);
     }
     return !steady;
@@ -492,10 +475,8 @@ struct YieldStep {
 /// re-consolidated cell), its clock, the shear's start and steps, the head's turn so far and the
 /// windowed means (the servo is the cell's own).
 struct ShearStepping {
-  std::string world;        ///< the step's world's state
-  std::int64_t steps0 = 0;  ///< the world's step count and time when the step began
-  double time0 = 0.0;
-  double wall_seconds = 0.0;      ///< the step's wall time so far, over the attempts that ran it
+  std::string world;  ///< the step's world's state
+  PhaseMark begun;
   std::int64_t shear_steps0 = 0;  ///< the step count and time when the shear began
   double shear_time0 = 0.0;
   long steps = 0;      ///< the shear's steps at the time step it began with
@@ -507,9 +488,7 @@ struct ShearStepping {
 template <class A, RecordOf<ShearStepping> S>
 void record_fields(A& a, S& s) {
   a.field(s.world);
-  a.field(s.steps0);
-  a.field(s.time0);
-  a.field(s.wall_seconds);
+  a.field(s.begun);
   a.field(s.shear_steps0);
   a.field(s.shear_time0);
   a.field(s.steps);
@@ -546,12 +525,11 @@ YieldStep shear_step(ShearCell& c, const std::string& name, double step_kpa,
     at = *resume;
     v.restore_state(at.world);
   } else {
-    at.steps0 = v.step_count;
-    at.time0 = v.time;
+    at.begun = {v.step_count, v.time, 0.0};
     at.y.sigma_x = step_kpa * c.real_kpa * s.stress_scale;
     at.y.sigma = at.y.sigma_x;
   }
-  const PhaseClock step_clock(at.steps0, at.time0, at.wall_seconds);
+  const PhaseClock step_clock(at.begun);
   if (!resume) {
     c.servo_run(v, at.y.sigma_x, s.consolidation_time, {});
     at.shear_steps0 = v.step_count;
@@ -580,7 +558,7 @@ YieldStep shear_step(ShearCell& c, const std::string& name, double step_kpa,
     }
     const bool turning = at.angle * c.r_head < 1.5 * c.d;  // yielded: the tips moved 1.5 d
     if (turning && offer && (ww.step_count - at.shear_steps0) % kShearOfferSteps == 0) {
-      at.wall_seconds = step_clock.wall_seconds();
+      at.begun = step_clock.mark();
       offer(at, ww);
     }
     return turning;
@@ -647,7 +625,7 @@ LabOutput ShearCellTest::run(const MaterialModel& material, const Settings& valu
   auto resumed_at = [&](const std::string& stage, auto& kept) -> decltype(&kept) {
     if (!stages.resuming_within(stage)) return nullptr;
     stages.read_within([&](auto& a) { a.field(kept); });
-    out.cost.wall_seconds += kept.wall_seconds;  // the earlier attempt's, in the phase
+    out.cost.wall_seconds += kept.begun.wall_seconds;  // the earlier attempt's, in the phase
     return &kept;
   };
   std::size_t next = 0;
