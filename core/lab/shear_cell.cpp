@@ -24,7 +24,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 
 #include "core/common/line_fit.hpp"
 #include "core/common/rng.hpp"
@@ -428,12 +427,12 @@ PreShear pre_shear(ShearCell& c, const ShearCellSettings& s, const RunOptions& o
 /// The mean of the last `n` values pushed (and of a second quantity alongside), in a ring of
 /// its own: a checkpoint record holds it as it stands.
 struct WindowMeans {
-  long n = 1;
+  long n;
   std::vector<double> a, b;  ///< the last n values, the oldest at `next` once full
   long next = 0, count = 0;
   double sum_a = 0.0, sum_b = 0.0;
 
-  WindowMeans() = default;
+  WindowMeans() : WindowMeans(1) {}
   explicit WindowMeans(long size) : n(size), a(size), b(size) {}
   void push(double va, double vb) {
     sum_a += va;
