@@ -474,7 +474,7 @@ struct YieldStep {
 /// re-consolidated cell), its clock, the shear's start and steps, the head's turn so far and the
 /// windowed means (the servo is the cell's own).
 struct ShearStepping {
-  std::string world;  ///< the step's world's state
+  std::string world;  ///< the step's world's state (in a record only)
   PhaseMark begun;
   std::int64_t shear_steps0 = 0;  ///< the step count and time when the shear began
   double shear_time0 = 0.0;
@@ -523,6 +523,7 @@ YieldStep shear_step(ShearCell& c, const std::string& name, double step_kpa,
   if (resume) {
     at = *resume;
     v.restore_state(at.world);
+    at.world.clear();  // v holds it from here; a record takes it from v
   } else {
     at.begun = {v.step_count, v.time, 0.0};
     at.y.sigma_x = step_kpa * c.real_kpa * s.stress_scale;
