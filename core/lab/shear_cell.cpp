@@ -142,9 +142,14 @@ struct ShearCell {
   /// calling `each` after every step until it returns false.
   long servo_run(sim::World& world, double target, double seconds,
                  const std::function<bool(sim::World&)>& each) {
+    return servo_steps(world, servo_start(world, target, seconds), each);
+  }
+  /// Sets the floor servo to `target` afresh and returns the steps of `seconds` at the world's
+  /// time step: the start of a servo phase that a checkpoint may split.
+  long servo_start(const sim::World& world, double target, double seconds) {
     servo.target = target;
     servo.reset();
-    return servo_steps(world, std::max<long>(1, std::lround(seconds / world.dt)), each);
+    return std::max<long>(1, std::lround(seconds / world.dt));
   }
   /// Runs `world` for `steps` steps with the floor servo as it stands, calling `each` after every
   /// step until it returns false.
@@ -312,10 +317,8 @@ void consolidate(ShearCell& c, const ShearCellSettings& s, LabOutput& out,
   } else {
     at.begun = {c.w.step_count, c.w.time, 0.0};
     at.limit = s.consolidation_time + 2.0 * bed_height(c) / c.servo.max_speed;
-    at.steps = std::max<long>(1, std::lround(at.limit / c.w.dt));
+    at.steps = c.servo_start(c.w, c.sigma_pre, at.limit);
     at.stress = BlockMeans(c.w.time, s.consolidation_time);
-    c.servo.target = c.sigma_pre;
-    c.servo.reset();
   }
   const PhaseClock clock(at.begun);
   bool reached = false;
@@ -384,12 +387,10 @@ PreShear pre_shear(ShearCell& c, const ShearCellSettings& s, const RunOptions& o
   } else {
     w.walls[kHead].omega = {0, 0, c.omega};
     at.begun = {w.step_count, w.time, 0.0};
-    at.steps = std::max<long>(1, std::lround(s.max_pre_shear_travel * c.d / s.tip_speed / w.dt));
+    at.steps = c.servo_start(w, c.sigma_pre, s.max_pre_shear_travel * c.d / s.tip_speed);
     at.record = std::max<long>(1, std::lround(0.002 / w.dt));
     at.thirds = BlockMeans(w.time, window);  // shear stress and floor stress of each third
     at.series = {{"time", "normal_stress_kpa", "shear_stress_kpa", "tip_travel"}, {}};
-    c.servo.target = c.sigma_pre;
-    c.servo.reset();
   }
   const PhaseClock clock(at.begun);
   bool steady = false;
@@ -534,11 +535,8 @@ YieldStep shear_step(ShearCell& c, const std::string& name, double step_kpa,
     c.servo_run(v, at.y.sigma_x, s.consolidation_time, {});
     at.shear_steps0 = v.step_count;
     at.shear_time0 = v.time;
-    at.steps =
-        std::max<long>(1, std::lround((2.0 * s.torque_ramp_time + 1.5 * c.d / s.tip_speed) / v.dt));
+    at.steps = c.servo_start(v, at.y.sigma_x, 2.0 * s.torque_ramp_time + 1.5 * c.d / s.tip_speed);
     at.window = WindowMeans(std::max<long>(1, std::lround(0.5 * c.d / s.tip_speed / v.dt)));
-    c.servo.target = at.y.sigma_x;
-    c.servo.reset();
   }
   const double torque_pre = tau_pre * 2.0 * M_PI * std::pow(c.r_head, 3) / 3.0;
   const double t_max = std::max(torque_pre, 1e-12) * 2.0;
