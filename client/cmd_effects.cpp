@@ -1,17 +1,23 @@
 // `demcal effects ID [--format table|csv|json]`, `demcal calibrate ID [--verify [--wait]]`,
-// `demcal export ID|SPEC [--format csv|json|journal|liggghts|yaml] [-o FILE] [--lab-specs DIR]`:
+// `demcal export ID|SPEC [--format csv|json|journal|liggghts|yaml] [-o FILE] [--lab-specs DIR]
+// | [--job N]`:
 // analysis on the coordinator, on demand. The journal format writes the finished jobs as a
 // campaign journal (docs/journal.md), the liggghts format the calibrated material as a LIGGGHTS
 // input fragment, the yaml format the calibrated material as the `material:` block of a spec and,
-// with --lab-specs, one `demcal lab run` spec per test instance (docs/report.md).
+// with --lab-specs, one `demcal lab run` spec per test instance, or with --job, the `demcal lab
+// run` spec of one finished job (docs/report.md).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <thread>
 #include <variant>
+#include <vector>
 
 #include "client/commands.hpp"
 #include "client/embedded.hpp"
@@ -92,23 +98,46 @@ bool at_calibrated_set(const v1::JournalRun& run, const v1::CalibrateReply& cal)
   return true;
 }
 
+/// The campaign's finished runs, from its journal export.
+std::vector<v1::JournalRun> finished_runs(v1::CampaignService::Stub& stub,
+                                          const rpc::ChannelOptions& channel, std::int64_t id) {
+  std::string journal;
+  check(read_export(stub, channel, id, "journal", journal, false), "export");
+  std::vector<v1::JournalRun> out;
+  for (const auto& line : split_lines(journal)) {
+    const auto parsed = rpc::parse_journal_line(line);
+    if (const auto* run = std::get_if<v1::JournalRun>(&parsed)) out.push_back(*run);
+  }
+  return out;
+}
+
 /// The latest finished run of each test instance at the calibrated set (instance -> run): the
 /// verification that simulated the calibrated numbers.
 std::map<std::string, v1::JournalRun> verification_runs(v1::CampaignService::Stub& stub,
                                                         const rpc::ChannelOptions& channel,
                                                         std::int64_t id,
                                                         const v1::CalibrateReply& cal) {
-  std::string journal;
-  check(read_export(stub, channel, id, "journal", journal, false), "export");
   std::map<std::string, v1::JournalRun> out;
-  for (const auto& line : split_lines(journal)) {
-    const auto parsed = rpc::parse_journal_line(line);
-    const auto* run = std::get_if<v1::JournalRun>(&parsed);
-    if (!run || !at_calibrated_set(*run, cal)) continue;
-    auto& kept = out[run->instance()];
-    if (run->job_id() > kept.job_id()) kept = *run;
+  for (const auto& run : finished_runs(stub, channel, id)) {
+    if (!at_calibrated_set(run, cal)) continue;
+    auto& kept = out[run.instance()];
+    if (run.job_id() > kept.job_id()) kept = run;
   }
   return out;
+}
+
+/// The `demcal lab run` spec that simulates a finished run of test instance `instance` again: its
+/// settings, seed and parameters on the instance's material, one thread.
+lab::LabRunSpec rerun_spec(const v1::CampaignSpec& spec, const v1::LabTest& instance,
+                           const v1::JournalRun& finished) {
+  lab::LabRunSpec run;
+  run.test = instance.test();
+  run.options.threads = 1;
+  run.settings = lab::Settings(finished.settings().begin(), finished.settings().end());
+  run.options.seed = finished.seed();
+  run.material =
+      job_material(spec, &instance, {finished.parameters().begin(), finished.parameters().end()});
+  return run;
 }
 
 /// One `demcal lab run` spec per test instance, `DIR/<instance>.yaml`: the calibrated material
@@ -121,18 +150,18 @@ void write_lab_specs(v1::CampaignService::Stub& stub, const rpc::ChannelOptions&
   std::filesystem::create_directories(dir);
   for (const auto& t : spec.tests()) {
     const std::string name = instance_name(t);
-    lab::LabRunSpec run;
-    run.test = t.test();
-    run.options.threads = 1;
     const auto it = verified.find(name);
     const bool found = it != verified.end();
-    const auto& source = found ? it->second.settings() : t.settings();
-    run.settings = lab::Settings(source.begin(), source.end());
-    run.options.seed = found ? it->second.seed() : (t.seed() ? t.seed() : 1);
-    run.material =
-        found ? job_material(spec, &t,
-                             {it->second.parameters().begin(), it->second.parameters().end()})
-              : job_material(spec, &t, parameters);
+    lab::LabRunSpec run;
+    if (found) {
+      run = rerun_spec(spec, t, it->second);
+    } else {
+      run.test = t.test();
+      run.options.threads = 1;
+      run.settings = lab::Settings(t.settings().begin(), t.settings().end());
+      run.options.seed = t.seed() ? t.seed() : 1;
+      run.material = job_material(spec, &t, parameters);
+    }
     const auto file = std::filesystem::path(dir) / (name + ".yaml");
     std::ofstream(file) << "# demcal campaign " << id << ", test " << name
                         << (found ? ": the verification run (job " +
@@ -167,12 +196,54 @@ std::string yaml_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptio
          io::material_yaml(job_material(campaign.spec(), nullptr, parameters));
 }
 
+/// The finished run of job `job` in the campaign's journal; an InputError naming `--job` when the
+/// job has none (not a job of the campaign, or not finished).
+v1::JournalRun finished_job(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                            std::int64_t id, std::int64_t job) {
+  for (const auto& run : finished_runs(stub, channel, id))
+    if (run.job_id() == job) return run;
+  throw InputError("--job", "campaign " + std::to_string(id) + " has no finished job " +
+                                std::to_string(job) + " (`demcal status " + std::to_string(id) +
+                                " --jobs` lists its jobs and their states)");
+}
+
+/// The `demcal lab run` spec that simulates finished job `job` again, its stored metrics (17
+/// significant digits) and flags in the first comment lines, for comparison.
+std::string job_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                       std::int64_t id, std::int64_t job) {
+  v1::GetRequest get;
+  get.set_id(id);
+  v1::Campaign campaign;
+  check(stub.Get(rpc::make_context(channel, 60).get(), get, &campaign), "campaign");
+  const v1::JournalRun run = finished_job(stub, channel, id, job);
+  const auto& tests = campaign.spec().tests();
+  const auto instance = std::find_if(tests.begin(), tests.end(), [&](const v1::LabTest& t) {
+    return instance_name(t) == run.instance();
+  });
+  if (instance == tests.end())
+    throw InputError("--job", "job " + std::to_string(job) + " ran test instance '" +
+                                  run.instance() + "', which the campaign's spec does not have");
+  std::string out = "# demcal campaign " + std::to_string(id) + " '" + campaign.name() + "', job " +
+                    std::to_string(job) + " (" + run.instance() +
+                    "): simulates it again; its stored metrics:\n";
+  const std::map<std::string, double> metrics(run.metrics().begin(), run.metrics().end());
+  for (const auto& [name, value] : metrics) {
+    char line[160];
+    std::snprintf(line, sizeof line, "#   %s: %.17g\n", name.c_str(), value);
+    out += line;
+  }
+  const std::map<std::string, std::string> flags(run.flags().begin(), run.flags().end());
+  for (const auto& [name, why] : flags) out += "#   flagged " + name + ": " + why + "\n";
+  return out + lab::lab_run_yaml(rerun_spec(campaign.spec(), *instance, run));
+}
+
 struct ExportOptions {
   rpc::ChannelOptions channel;
   std::string campaign;  ///< a campaign id, or a spec on the embedded default
   std::string format = "json";
   std::string out;
   std::string lab_specs;  ///< yaml: the directory of one lab run spec per test instance
+  std::int64_t job = 0;   ///< yaml: the lab run spec of this finished job instead (0: none)
   bool series = false;    ///< json: each finished job's curves too
   std::string workdir;    ///< of a spec: its work directory
   LocalWorkers local;
@@ -187,6 +258,8 @@ void write_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& ch
   std::string content;
   if (o.format == "liggghts")
     content = liggghts_export(stub, channel, id);
+  else if (o.format == "yaml" && o.job > 0)
+    content = job_export(stub, channel, id, o.job);
   else if (o.format == "yaml")
     content = yaml_export(stub, channel, id, o.lab_specs);
   else
@@ -284,12 +357,22 @@ void add_analysis_commands(CLI::App& app) {
   exp->add_option("--lab-specs", e->lab_specs,
                   "yaml: also write one `demcal lab run` spec per test instance into this "
                   "directory (the calibrated material, the verification run's settings and seed)");
+  exp->add_option("--job", e->job,
+                  "yaml: instead, the `demcal lab run` spec that simulates this finished job "
+                  "again (its test, settings, seed and parameters; its stored metrics in a "
+                  "comment)")
+      ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
   exp->add_option("--workdir", e->workdir, "embedded: directory of the SQLite file");
   add_local_worker_options(*exp, e->local);
   exp->add_flag("-v,--verbose", e->verbose, "embedded: coordinator and worker logs");
   exp->callback([e] {
     if (!e->lab_specs.empty() && e->format != "yaml")
       throw InputError("--lab-specs", "only with --format yaml");
+    if (e->job > 0 && e->format != "yaml") throw InputError("--job", "only with --format yaml");
+    if (e->job > 0 && !e->lab_specs.empty())
+      throw InputError("--job",
+                       "not with --lab-specs (one writes a job's spec, the other the "
+                       "calibrated set's)");
     with_campaign(e->campaign, e->workdir, e->local, e->verbose, e->channel,
                   [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                       std::int64_t id) { write_export(stub, channel, id, *e); });

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -524,6 +526,88 @@ calibration: {rounds: 1, stages: 1}
               round["simulated"][at].get<double>())
         << instance;
   }
+  fs::remove_all(dir);
+}
+
+/// `demcal export --format yaml --job N`: the `demcal lab run` spec of one finished job of a
+/// campaign still without a calibration (a 2^2 packing campaign of 30 spheres, poured and grown,
+/// run with --no-verify). Run, the spec of a poured and of a grown job gives the stored solid
+/// fraction to the bit, and its first comment names the job and holds the stored value; a job
+/// that has not finished and the option outside the yaml format are refused, naming --job.
+TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAFinishedJobAgain) {
+  const fs::path dir = scratch_dir("job");
+  std::ofstream(dir / "tiny.yaml") << R"(name: tiny
+material:
+  particle_law:
+    normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 0.0005}}
+  density: 2500
+tests:
+  - test: packing
+    settings: {particles: 30}
+    seed: 4
+  - name: grown
+    test: packing
+    settings: {particles: 30}
+    preparation: {method: growth}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
+  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
+design: {type: full_factorial}
+measurements:
+  - {test: packing, metric: solid_fraction, value: 0.6, uncertainty: 0.02}
+)";
+  const std::string spec = (dir / "tiny.yaml").string();
+  const std::string work = " --workdir " + (dir / "work").string();
+  const auto run =
+      demcal::test::run_command(std::string(DEMCAL_BINARY_DIR) + "/client/demcal run " + spec +
+                                work + " --threads 1 --no-verify 2>&1");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const auto listed =
+      demcal::test::run_command(std::string(DEMCAL_BINARY_DIR) + "/client/demcal export " + spec +
+                                work + " --format json 2>/dev/null");
+  ASSERT_EQ(listed.exit_code, 0) << listed.out;
+  std::map<std::string, nlohmann::json> last_of;  // instance -> its last design job
+  const auto exported_jobs = nlohmann::json::parse(listed.out)["jobs"];
+  for (const auto& job : exported_jobs)
+    if (job["kind"] == "design" && job["state"] == "done") last_of[job["test"]] = job;
+  ASSERT_EQ(last_of.size(), 2u);
+
+  for (const auto& [instance, job] : last_of) {
+    const auto id = job["job_id"].get<std::int64_t>();
+    const fs::path file = dir / (instance + ".yaml");
+    const Result exported = demcal("export " + spec + work + " --format yaml --job " +
+                                   std::to_string(id) + " -o " + file.string());
+    ASSERT_EQ(exported.exit_code, 0) << exported.out;
+    std::ifstream in(file);
+    const std::string text{std::istreambuf_iterator<char>(in), {}};
+    const std::string first = text.substr(0, text.find('\n'));
+    EXPECT_NE(first.find("job " + std::to_string(id) + " (" + instance + ")"), std::string::npos)
+        << first;
+    char stored[80];
+    std::snprintf(stored, sizeof stored, "\n#   solid_fraction: %.17g\n",
+                  job["metrics"]["solid_fraction"].get<double>());
+    EXPECT_LT(text.find(stored), text.find("\ntest: packing")) << text;
+    const auto lab = demcal::lab::read_lab_run(demcal::io::YamlNode::load_file(file.string()));
+    EXPECT_EQ(lab.material.preparation.method == demcal::lab::PreparationMethod::kGrowth,
+              instance == "grown");
+    const auto rerun = demcal::test::run_command(
+        std::string(DEMCAL_BINARY_DIR) + "/client/demcal lab run " + file.string() + " --out " +
+        (dir / ("rerun-" + instance)).string() + " 2>/dev/null");
+    ASSERT_EQ(rerun.exit_code, 0) << rerun.out;
+    EXPECT_EQ(nlohmann::json::parse(rerun.out)["metrics"]["solid_fraction"].get<double>(),
+              job["metrics"]["solid_fraction"].get<double>())
+        << instance;
+  }
+
+  const Result unknown = demcal("export " + spec + work + " --format yaml --job 99");
+  EXPECT_NE(unknown.exit_code, 0);
+  EXPECT_NE(unknown.out.find("--job: campaign 1 has no finished job 99"), std::string::npos)
+      << unknown.out;
+  const Result csv = demcal("export " + spec + work + " --format csv --job 1");
+  EXPECT_NE(csv.exit_code, 0);
+  EXPECT_NE(csv.out.find("--job: only with --format yaml"), std::string::npos) << csv.out;
   fs::remove_all(dir);
 }
 
