@@ -451,14 +451,8 @@ phases:
   fs::remove_all(dir);
 }
 
-/// The embedded default's `demcal export --format yaml`: a tiny packing campaign (2^2 runs of
-/// 30 spheres, poured and grown, one verification round) is run and calibrated; the exported
-/// material block read back by the lab-run spec reader holds the calibrated values and the fixed
-/// one, and the lab run spec written for each test instance (the grown one with its own
-/// preparation) simulates the verified number again, to the bit.
-TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
-  const fs::path dir = scratch_dir("yaml");
-  std::ofstream(dir / "tiny.yaml") << R"(name: tiny
+/// A 2^2 packing campaign of 30 spheres, poured and grown, with one verification round.
+constexpr const char* kTinyPackingCampaign = R"(name: tiny
 material:
   particle_law:
     normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
@@ -483,6 +477,15 @@ measurements:
   - {test: grown, metric: solid_fraction, value: 0.6, uncertainty: 0.02}
 calibration: {rounds: 1, stages: 1}
 )";
+
+/// The embedded default's `demcal export --format yaml`: a tiny packing campaign (2^2 runs of
+/// 30 spheres, poured and grown, one verification round) is run and calibrated; the exported
+/// material block read back by the lab-run spec reader holds the calibrated values and the fixed
+/// one, and the lab run spec written for each test instance (the grown one with its own
+/// preparation) simulates the verified number again, to the bit.
+TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
+  const fs::path dir = scratch_dir("yaml");
+  std::ofstream(dir / "tiny.yaml") << kTinyPackingCampaign;
   const std::string spec = (dir / "tiny.yaml").string();
   const std::string work = " --workdir " + (dir / "work").string();
   const Result none = demcal("export " + spec + work + " --format yaml");
@@ -530,34 +533,13 @@ calibration: {rounds: 1, stages: 1}
 }
 
 /// `demcal export --format yaml --job N`: the `demcal lab run` spec of one finished job of a
-/// campaign still without a calibration (a 2^2 packing campaign of 30 spheres, poured and grown,
-/// run with --no-verify). Run, the spec of a poured and of a grown job gives the stored solid
-/// fraction to the bit, and its first comment names the job and holds the stored value; a job
-/// that has not finished and the option outside the yaml format are refused, naming --job.
+/// campaign still without a calibration (the tiny packing campaign, run with --no-verify). Run, the
+/// spec of a poured and of a grown job gives the stored solid fraction to the bit, and its first
+/// comment names the job and holds the stored value; a job that has not finished and the option
+/// outside the yaml format are refused, naming --job.
 TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAFinishedJobAgain) {
   const fs::path dir = scratch_dir("job");
-  std::ofstream(dir / "tiny.yaml") << R"(name: tiny
-material:
-  particle_law:
-    normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
-    tangential: {model: history, mu_s: 0.3}
-  sizes: {monodisperse: {radius: 0.0005}}
-  density: 2500
-tests:
-  - test: packing
-    settings: {particles: 30}
-    seed: 4
-  - name: grown
-    test: packing
-    settings: {particles: 30}
-    preparation: {method: growth}
-factors:
-  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
-  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
-design: {type: full_factorial}
-measurements:
-  - {test: packing, metric: solid_fraction, value: 0.6, uncertainty: 0.02}
-)";
+  std::ofstream(dir / "tiny.yaml") << kTinyPackingCampaign;
   const std::string spec = (dir / "tiny.yaml").string();
   const std::string work = " --workdir " + (dir / "work").string();
   const auto run =
