@@ -1,6 +1,6 @@
 // `demcal effects ID [--format table|csv|json]`, `demcal calibrate ID [--verify [--wait]]`,
-// `demcal export ID|SPEC [--format csv|json|journal|liggghts|yaml] [-o FILE] [--lab-specs DIR]
-// | [--job N]`:
+// `demcal export ID|SPEC [--format csv|json|journal|liggghts|yaml] [-o FILE]
+// [--lab-specs DIR | --job N]`:
 // analysis on the coordinator, on demand. The journal format writes the finished jobs as a
 // campaign journal (docs/journal.md), the liggghts format the calibrated material as a LIGGGHTS
 // input fragment, the yaml format the calibrated material as the `material:` block of a spec and,
