@@ -1,5 +1,8 @@
 // The `demcal` command line, run as a user runs it: real processes, real files, JSON parsed back.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -590,6 +593,63 @@ TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAFinishedJobAgain) {
   const Result csv = demcal("export " + spec + work + " --format csv --job 1");
   EXPECT_NE(csv.exit_code, 0);
   EXPECT_NE(csv.out.find("--job: only with --format yaml"), std::string::npos) << csv.out;
+  fs::remove_all(dir);
+}
+
+/// `scripts/campaign-snapshot WORKDIR PREFIX` (docs/data/campaigns/README.md) on the tiny packing
+/// campaign's work directory: refused while the store's lock is held, as a running coordinator
+/// holds it; then PREFIX.db.gz unpacks to a store with the same jobs and results, and the work
+/// directory's stage records are added to PREFIX.stages/ beside those already there, none
+/// replaced.
+TEST(Cli, CampaignSnapshotKeepsAStoppedStoreAndItsStageRecords) {
+  const fs::path dir = scratch_dir("snapshot");
+  std::ofstream(dir / "tiny.yaml") << kTinyPackingCampaign;
+  const fs::path work = dir / "work";
+  const auto run = demcal::test::run_command(
+      std::string(DEMCAL_BINARY_DIR) + "/client/demcal run " + (dir / "tiny.yaml").string() +
+      " --workdir " + work.string() + " --threads 1 --no-verify 2>&1");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  fs::create_directories(work / "stages");
+  std::ofstream(work / "stages" / "new.rec") << "new";
+  std::ofstream(work / "stages" / "kept.rec") << "from the work directory";
+  const fs::path prefix = dir / "kept" / "tiny";
+  fs::create_directories(dir / "kept" / "tiny.stages");
+  std::ofstream(dir / "kept" / "tiny.stages" / "kept.rec") << "committed before";
+  const std::string snapshot =
+      source("scripts/campaign-snapshot") + " " + work.string() + " " + prefix.string() + " 2>&1";
+
+  {  // a coordinator's lock on the store
+    const int fd = ::open((work / "campaign.db.lock").c_str(), O_RDWR | O_CREAT, 0600);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+    const auto refused = demcal::test::run_command(snapshot);
+    ::close(fd);
+    EXPECT_NE(refused.exit_code, 0);
+    EXPECT_NE(refused.out.find("is in use by a coordinator"), std::string::npos) << refused.out;
+    EXPECT_FALSE(fs::exists(prefix.string() + ".db.gz"));
+  }
+  const auto kept = demcal::test::run_command(snapshot);
+  ASSERT_EQ(kept.exit_code, 0) << kept.out;
+  EXPECT_NE(kept.out.find("added 1 stage record(s)"), std::string::npos) << kept.out;
+  EXPECT_NE(kept.out.find("jobs: done 8"), std::string::npos) << kept.out;
+
+  const std::string rows =
+      " \"select j.id, j.state, j.run_key, r.metrics_json from jobs j join results r on "
+      "r.job_id = j.id order by j.id\"";
+  const auto original =
+      demcal::test::run_command("sqlite3 " + (work / "campaign.db").string() + rows);
+  const auto unpacked = demcal::test::run_command("gunzip -c " + prefix.string() + ".db.gz > " +
+                                                  (dir / "copy.db").string() + " && sqlite3 " +
+                                                  (dir / "copy.db").string() + rows);
+  ASSERT_EQ(unpacked.exit_code, 0) << unpacked.out;
+  EXPECT_EQ(std::count(original.out.begin(), original.out.end(), '\n'), 8) << original.out;
+  EXPECT_EQ(unpacked.out, original.out);
+  auto text = [](const fs::path& file) {
+    std::ifstream in(file);
+    return std::string{std::istreambuf_iterator<char>(in), {}};
+  };
+  EXPECT_EQ(text(dir / "kept" / "tiny.stages" / "new.rec"), "new");
+  EXPECT_EQ(text(dir / "kept" / "tiny.stages" / "kept.rec"), "committed before");
   fs::remove_all(dir);
 }
 
