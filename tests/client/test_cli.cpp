@@ -538,8 +538,8 @@ TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
 /// `demcal export --format yaml --job N`: the `demcal lab run` spec of one finished job of a
 /// campaign still without a calibration (the tiny packing campaign, run with --no-verify). Run, the
 /// spec of a poured and of a grown job gives the stored solid fraction to the bit, and its first
-/// comment names the job and holds the stored value; a job that has not finished and the option
-/// outside the yaml format are refused, naming --job.
+/// comment names the job and holds the stored value; a job that has not finished, the option
+/// outside the yaml format and beside --lab-specs are refused, naming --job.
 TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAFinishedJobAgain) {
   const fs::path dir = scratch_dir("job");
   std::ofstream(dir / "tiny.yaml") << kTinyPackingCampaign;
@@ -593,6 +593,10 @@ TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAFinishedJobAgain) {
   const Result csv = demcal("export " + spec + work + " --format csv --job 1");
   EXPECT_NE(csv.exit_code, 0);
   EXPECT_NE(csv.out.find("--job: only with --format yaml"), std::string::npos) << csv.out;
+  const Result both =
+      demcal("export " + spec + work + " --format yaml --job 1 --lab-specs " + dir.string());
+  EXPECT_NE(both.exit_code, 0);
+  EXPECT_NE(both.out.find("--job: not with --lab-specs"), std::string::npos) << both.out;
   fs::remove_all(dir);
 }
 
