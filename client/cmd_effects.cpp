@@ -152,16 +152,12 @@ void write_lab_specs(v1::CampaignService::Stub& stub, const rpc::ChannelOptions&
     const std::string name = instance_name(t);
     const auto it = verified.find(name);
     const bool found = it != verified.end();
-    lab::LabRunSpec run;
-    if (found) {
-      run = rerun_spec(spec, t, it->second);
-    } else {
-      run.test = t.test();
-      run.options.threads = 1;
-      run.settings = lab::Settings(t.settings().begin(), t.settings().end());
-      run.options.seed = t.seed() ? t.seed() : 1;
-      run.material = job_material(spec, &t, parameters);
-    }
+    // Without a verification: the run the instance would make at the calibrated set.
+    v1::JournalRun planned;
+    *planned.mutable_settings() = t.settings();
+    planned.set_seed(t.seed() ? t.seed() : 1);
+    planned.mutable_parameters()->insert(parameters.begin(), parameters.end());
+    const lab::LabRunSpec run = rerun_spec(spec, t, found ? it->second : planned);
     const auto file = std::filesystem::path(dir) / (name + ".yaml");
     std::ofstream(file) << "# demcal campaign " << id << ", test " << name
                         << (found ? ": the verification run (job " +
