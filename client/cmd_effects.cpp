@@ -5,7 +5,7 @@
 // campaign journal (docs/journal.md), the liggghts format the calibrated material as a LIGGGHTS
 // input fragment, the yaml format the calibrated material as the `material:` block of a spec and,
 // with --lab-specs, one `demcal lab run` spec per test instance, or with --job, the `demcal lab
-// run` spec of one finished job (docs/report.md).
+// run` spec of one job, finished, failed or not yet run (docs/report.md).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -192,45 +192,66 @@ std::string yaml_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptio
          io::material_yaml(job_material(campaign.spec(), nullptr, parameters));
 }
 
-/// The finished run of job `job` in the campaign's journal; an InputError naming `--job` when the
-/// job has none (not a job of the campaign, or not finished).
-v1::JournalRun finished_job(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
-                            std::int64_t id, std::int64_t job) {
-  for (const auto& run : finished_runs(stub, channel, id))
-    if (run.job_id() == job) return run;
-  throw InputError("--job", "campaign " + std::to_string(id) + " has no finished job " +
+/// Job `job` of the campaign as the store holds it; an InputError naming `--job` when the
+/// campaign has no such job.
+v1::JobResult campaign_job(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                           std::int64_t id, std::int64_t job) {
+  v1::GetRequest req;
+  req.set_id(id);
+  v1::ResultsReply results;
+  check(stub.GetResults(rpc::make_context(channel, 60).get(), req, &results), "results");
+  for (const auto& j : results.jobs())
+    if (j.job_id() == job) return j;
+  throw InputError("--job", "campaign " + std::to_string(id) + " has no job " +
                                 std::to_string(job) + " (`demcal status " + std::to_string(id) +
                                 " --jobs` lists its jobs and their states)");
 }
 
-/// The `demcal lab run` spec that simulates finished job `job` again, its stored metrics (17
-/// significant digits) and flags in the first comment lines, for comparison.
+/// What a job's result is in its spec's first comment lines: its stored metrics (17 significant
+/// digits) and flags when it finished, its error when it failed, its state otherwise.
+std::string job_outcome_comment(const v1::JobResult& job) {
+  std::string out;
+  if (job.state() == "failed") return "#   failed: " + job.error() + "\n";
+  if (job.state() != "done") return "#   not finished: " + job.state() + "\n";
+  const std::map<std::string, double> metrics(job.metrics().begin(), job.metrics().end());
+  for (const auto& [name, value] : metrics) {
+    char line[160];
+    std::snprintf(line, sizeof line, "#   %s: %.17g\n", name.c_str(), value);
+    out += line;
+  }
+  const std::map<std::string, std::string> flags(job.flags().begin(), job.flags().end());
+  for (const auto& [name, why] : flags) out += "#   flagged " + name + ": " + why + "\n";
+  return out;
+}
+
+/// The `demcal lab run` spec that simulates job `job` (again): a finished job's stored metrics and
+/// flags, a failed job's error or an unfinished job's state in its first comment lines.
 std::string job_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                        std::int64_t id, std::int64_t job) {
   v1::GetRequest get;
   get.set_id(id);
   v1::Campaign campaign;
   check(stub.Get(rpc::make_context(channel, 60).get(), get, &campaign), "campaign");
-  const v1::JournalRun run = finished_job(stub, channel, id, job);
+  const v1::JobResult found = campaign_job(stub, channel, id, job);
   const auto& tests = campaign.spec().tests();
   const auto instance = std::find_if(tests.begin(), tests.end(), [&](const v1::LabTest& t) {
-    return instance_name(t) == run.instance();
+    return instance_name(t) == found.test();
   });
   if (instance == tests.end())
-    throw InputError("--job", "job " + std::to_string(job) + " ran test instance '" +
-                                  run.instance() + "', which the campaign's spec does not have");
-  std::string out = "# demcal campaign " + std::to_string(id) + " '" + campaign.name() + "', job " +
-                    std::to_string(job) + " (" + run.instance() +
-                    "): simulates it again; its stored metrics:\n";
-  const std::map<std::string, double> metrics(run.metrics().begin(), run.metrics().end());
-  for (const auto& [name, value] : metrics) {
-    char line[160];
-    std::snprintf(line, sizeof line, "#   %s: %.17g\n", name.c_str(), value);
-    out += line;
-  }
-  const std::map<std::string, std::string> flags(run.flags().begin(), run.flags().end());
-  for (const auto& [name, why] : flags) out += "#   flagged " + name + ": " + why + "\n";
-  return out + lab::lab_run_yaml(rerun_spec(campaign.spec(), *instance, run));
+    throw InputError("--job", "job " + std::to_string(job) + " runs test instance '" +
+                                  found.test() + "', which the campaign's spec does not have");
+  if (found.parameters().empty() && found.settings().empty())
+    throw InputError("--job", "job " + std::to_string(job) +
+                                  " was planned by an older build whose payload cannot be read");
+  v1::JournalRun run;
+  *run.mutable_settings() = found.settings();
+  *run.mutable_parameters() = found.parameters();
+  run.set_seed(found.seed());
+  return "# demcal campaign " + std::to_string(id) + " '" + campaign.name() + "', job " +
+         std::to_string(job) + " (" + found.test() + "): simulates it" +
+         (found.state() == "done" ? " again; its stored metrics" : "") + ":\n" +
+         job_outcome_comment(found) +
+         lab::lab_run_yaml(rerun_spec(campaign.spec(), *instance, run));
 }
 
 struct ExportOptions {
@@ -239,7 +260,7 @@ struct ExportOptions {
   std::string format = "json";
   std::string out;
   std::string lab_specs;  ///< yaml: the directory of one lab run spec per test instance
-  std::int64_t job = 0;   ///< yaml: the lab run spec of this finished job instead (0: none)
+  std::int64_t job = 0;   ///< yaml: the lab run spec of this job instead (0: none)
   bool series = false;    ///< json: each finished job's curves too
   std::string workdir;    ///< of a spec: its work directory
   LocalWorkers local;
@@ -354,9 +375,9 @@ void add_analysis_commands(CLI::App& app) {
                   "yaml: also write one `demcal lab run` spec per test instance into this "
                   "directory (the calibrated material, the verification run's settings and seed)");
   exp->add_option("--job", e->job,
-                  "yaml: instead, the `demcal lab run` spec that simulates this finished job "
-                  "again (its test, settings, seed and parameters; its stored metrics in a "
-                  "comment)")
+                  "yaml: instead, the `demcal lab run` spec that simulates this job (again): its "
+                  "test, settings, seed and parameters; in a comment its stored metrics, its "
+                  "error if it failed, or its state if it has not finished")
       ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
   exp->add_option("--workdir", e->workdir, "embedded: directory of the SQLite file");
   add_local_worker_options(*exp, e->local);

@@ -12,6 +12,7 @@
 
 #include "core/common/error.hpp"
 #include "core/doe/alias_structure.hpp"
+#include "rpc/material_convert.hpp"
 #include "server/plan_input.hpp"
 #include "server/stored_columns.hpp"
 
@@ -130,6 +131,24 @@ v1::Campaign campaign_message(const CampaignRow& row, const Counts& counts, doub
   return c;
 }
 
+namespace {
+
+/// What the job simulates, from its payload: its settings, parameters and seed; none when the
+/// payload (of a job planned by an older build) cannot be read.
+void add_job_run(const std::string& payload, v1::JobResult& r) {
+  v1::JobSpec spec;
+  try {
+    spec = job_from_payload(payload);
+  } catch (const std::exception&) {
+    return;
+  }
+  *r.mutable_settings() = spec.settings();
+  *r.mutable_parameters() = spec.parameters();
+  r.set_seed(rpc::job_seed(spec));
+}
+
+}  // namespace
+
 v1::JobResult job_message(const JobRow& job) {
   v1::JobResult r;
   r.set_job_id(job.id);
@@ -149,6 +168,7 @@ v1::JobResult job_message(const JobRow& job) {
   r.set_run_protocol(job.run_key.protocol);
   r.set_reused_from(job.reused_from);
   r.set_reused_journal(job.reused_journal);
+  add_job_run(job.payload, r);
   return r;
 }
 

@@ -535,12 +535,14 @@ TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
   fs::remove_all(dir);
 }
 
-/// `demcal export --format yaml --job N`: the `demcal lab run` spec of one finished job of a
-/// campaign still without a calibration (the tiny packing campaign, run with --no-verify). Run, the
-/// spec of a poured and of a grown job gives the stored solid fraction to the bit, and its first
-/// comment names the job and holds the stored value; a job that has not finished, the option
-/// outside the yaml format and beside --lab-specs are refused, naming --job.
-TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAFinishedJobAgain) {
+/// `demcal export --format yaml --job N`: the `demcal lab run` spec of one job of a campaign
+/// still without a calibration (the tiny packing campaign, run with --no-verify). Run, the spec of
+/// a grown job gives the stored solid fraction to the bit, and its first comment names the job and
+/// holds the stored value; the poured job, marked failed in the store afterwards, has its spec
+/// written all the same, its error in the comment, and that spec gives the solid fraction its run
+/// stored. A job the campaign does not have, the option outside the yaml format and beside
+/// --lab-specs are refused, naming --job.
+TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAJobAgain) {
   const fs::path dir = scratch_dir("job");
   std::ofstream(dir / "tiny.yaml") << kTinyPackingCampaign;
   const std::string spec = (dir / "tiny.yaml").string();
@@ -558,6 +560,12 @@ TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAFinishedJobAgain) {
   for (const auto& job : exported_jobs)
     if (job["kind"] == "design" && job["state"] == "done") last_of[job["test"]] = job;
   ASSERT_EQ(last_of.size(), 2u);
+  const std::string failure = "simulation failed (escaped_particles): marked by the test";
+  const auto marked = demcal::test::run_command(
+      "sqlite3 " + (dir / "work" / "campaign.db").string() +
+      " \"UPDATE jobs SET state = 'failed', " + "error = '" + failure + "' WHERE id = " +
+      std::to_string(last_of.at("packing")["job_id"].get<std::int64_t>()) + "\" 2>&1");
+  ASSERT_EQ(marked.exit_code, 0) << marked.out;
 
   for (const auto& [instance, job] : last_of) {
     const auto id = job["job_id"].get<std::int64_t>();
@@ -573,7 +581,8 @@ TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAFinishedJobAgain) {
     char stored[80];
     std::snprintf(stored, sizeof stored, "\n#   solid_fraction: %.17g\n",
                   job["metrics"]["solid_fraction"].get<double>());
-    EXPECT_LT(text.find(stored), text.find("\ntest: packing")) << text;
+    const std::string outcome = instance == "packing" ? "\n#   failed: " + failure + "\n" : stored;
+    EXPECT_LT(text.find(outcome), text.find("\ntest: packing")) << text;
     const auto lab = demcal::lab::read_lab_run(demcal::io::YamlNode::load_file(file.string()));
     EXPECT_EQ(lab.material.preparation.method == demcal::lab::PreparationMethod::kGrowth,
               instance == "grown");
@@ -588,8 +597,7 @@ TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAFinishedJobAgain) {
 
   const Result unknown = demcal("export " + spec + work + " --format yaml --job 99");
   EXPECT_NE(unknown.exit_code, 0);
-  EXPECT_NE(unknown.out.find("--job: campaign 1 has no finished job 99"), std::string::npos)
-      << unknown.out;
+  EXPECT_NE(unknown.out.find("--job: campaign 1 has no job 99"), std::string::npos) << unknown.out;
   const Result csv = demcal("export " + spec + work + " --format csv --job 1");
   EXPECT_NE(csv.exit_code, 0);
   EXPECT_NE(csv.out.find("--job: only with --format yaml"), std::string::npos) << csv.out;
