@@ -476,8 +476,8 @@ fixed:
   wall_law.tangential.mu_s: 0.25
 design: {type: full_factorial}
 measurements:
-  - {test: packing, metric: solid_fraction, value: 0.6, uncertainty: 0.02}
-  - {test: grown, metric: solid_fraction, value: 0.6, uncertainty: 0.02}
+  - {test: packing, metric: solid_fraction, value: 0.49, uncertainty: 0.01}
+  - {test: grown, metric: solid_fraction, value: 0.455, uncertainty: 0.01}
 calibration: {rounds: 1, stages: 1}
 )";
 
@@ -532,6 +532,38 @@ TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
               round["simulated"][at].get<double>())
         << instance;
   }
+
+  // With no finished run of an instance at the calibrated set (inside the box, so no design run
+  // is there: the grown verification job marked failed in the store), its spec is the run the
+  // instance would make there: the calibrated material with its preparation, the instance's own
+  // settings and seed.
+  const auto marked = demcal::test::run_command(
+      "sqlite3 " + (dir / "work" / "campaign.db").string() +
+      " \"UPDATE jobs SET state = 'failed', error = 'marked by the test' WHERE test = 'grown' AND "
+      "kind = 'verify'\" 2>&1");
+  ASSERT_EQ(marked.exit_code, 0) << marked.out;
+  const Result unverified =
+      demcal("export " + spec + work + " --format yaml --lab-specs " + (dir / "planned").string());
+  ASSERT_EQ(unverified.exit_code, 0) << unverified.out;
+  const auto first_line = [](const fs::path& file) {
+    std::ifstream in(file);
+    std::string line;
+    std::getline(in, line);
+    return line;
+  };
+  const fs::path planned = dir / "planned" / "grown.yaml";
+  EXPECT_NE(first_line(planned).find("test grown: no finished run at the calibrated set; the "
+                                     "test's own settings and seed"),
+            std::string::npos)
+      << first_line(planned);
+  EXPECT_NE(first_line(dir / "planned" / "packing.yaml").find("test packing: the verification run"),
+            std::string::npos);
+  const auto lab = demcal::lab::read_lab_run(demcal::io::YamlNode::load_file(planned.string()));
+  auto expected = material;
+  expected.preparation = demcal::lab::make_preparation("growth", {}, "preparation");
+  EXPECT_EQ(demcal::lab::material_identity(lab.material), demcal::lab::material_identity(expected));
+  EXPECT_EQ(lab.options.seed, 1u);
+  EXPECT_EQ(lab.settings.at("particles"), 30.0);
   fs::remove_all(dir);
 }
 
