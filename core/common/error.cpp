@@ -15,6 +15,8 @@ const char* to_string(SimulationFailure::Reason reason) {
       return "escaped_particles";
     case SimulationFailure::Reason::kUnstableTimeStep:
       return "unstable_time_step";
+    case SimulationFailure::Reason::kContactOutOfRange:
+      return "contact_out_of_range";
   }
   return "unknown";
 }

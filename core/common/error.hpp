@@ -26,7 +26,13 @@ class InputError : public std::runtime_error {
 /// a time step above the stability limit.
 class SimulationFailure : public std::runtime_error {
  public:
-  enum class Reason { kNotFinite, kEnergyExplosion, kEscaped, kUnstableTimeStep };
+  enum class Reason {
+    kNotFinite,
+    kEnergyExplosion,
+    kEscaped,
+    kUnstableTimeStep,
+    kContactOutOfRange
+  };
   SimulationFailure(Reason reason, const std::string& what)
       : std::runtime_error(what), reason_(reason) {}
   Reason reason() const { return reason_; }

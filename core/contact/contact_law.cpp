@@ -93,10 +93,16 @@ double ContactLaw::reached_stiffness(double r_eff, double delta_max) const {
 }
 
 double ContactLaw::attraction_energy(double r_eff) const {
+  const double work = std::visit([&](const auto& c) { return c.approach_work(r_eff); }, cohesion);
+  const double f = std::visit([&](const auto& c) { return c.contact_force(r_eff); }, cohesion);
+  return work + f * adhesion_overlap(r_eff);
+}
+
+double ContactLaw::adhesion_overlap(double r_eff) const {
   return std::visit(
       [&](const auto& n, const auto& c) {
         const double f = c.contact_force(r_eff);
-        return c.approach_work(r_eff) + (f > 0.0 ? f * n.overlap_at(f, r_eff) : 0.0);
+        return f > 0.0 ? n.overlap_at(f, r_eff) : 0.0;
       },
       normal, cohesion);
 }

@@ -59,6 +59,10 @@ struct ContactLaw {
   /// depth of the well the attraction pulls the pair into is below F times that overlap). Zero
   /// without a cohesion model.
   double attraction_energy(double r_eff) const;
+  /// The overlap (m) at which a fresh contact's repulsion carries the cohesion's contact force
+  /// (the van der Waals A_H r_eff / (6 D_min^2), seed 000 eq. 12): where the attraction alone
+  /// holds a pair of effective radius r_eff at rest. Zero without a cohesion model.
+  double adhesion_overlap(double r_eff) const;
   /// Builds a law from its spec; errors name the field path below `where`.
   static ContactLaw from_spec(const ContactLawSpec& spec, const std::string& where);
 };

@@ -1,6 +1,7 @@
 #pragma once
 // Checks that a simulation is still physical; a failing check is a typed SimulationFailure with
-// its reason (not_finite, energy_explosion, escaped_particles), never numbers.
+// its reason (not_finite, energy_explosion, escaped_particles, contact_out_of_range), never
+// numbers.
 #include <limits>
 
 #include "core/sim/world.hpp"
@@ -14,6 +15,14 @@ struct HealthLimits {
 };
 
 void check_health(const World& world, const HealthLimits& limits);
+
+/// Throws SimulationFailure(kContactOutOfRange) when a law of the world, between the smallest
+/// particles of its materials (or such a particle and a wall), holds a contact by its attraction
+/// alone at an overlap (ContactLaw::adhesion_overlap) as deep as the smaller particle's radius: a
+/// soft-sphere contact stands for a small overlap, and one that reaches a particle's centre makes
+/// neither force nor geometry of the pair meaningful (the bed collapses into itself and ejects
+/// particles). The message names the law, the force and the overlap in radii.
+void check_contact_range(const World& world);
 
 /// An upper bound of the kinetic energy the attraction of the world's laws can set free (J), for
 /// the energy limit of a cohesive bed, where it can far exceed the bed's potential energy (small

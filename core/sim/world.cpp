@@ -4,6 +4,7 @@
 
 #include "core/common/error.hpp"
 #include "core/sim/forces.hpp"
+#include "core/sim/health.hpp"
 #include "core/sim/time_step.hpp"
 #include "core/walls/reach.hpp"
 
@@ -60,6 +61,7 @@ void World::change_pair_law(int a, int b, const contact::ContactLaw& law) {
   pair_laws_[a * n_materials_ + b] = law;
   pair_laws_[b * n_materials_ + a] = law;
   check_time_step(*this);
+  check_contact_range(*this);
   rebuild_list();
 }
 
@@ -73,6 +75,7 @@ void World::change_wall_law(int wall_material, int particle_material,
   }
   wall_laws_[wall_material][particle_material] = law;
   check_time_step(*this);
+  check_contact_range(*this);
   // The new law's reach beyond contact may differ: list the walls' particles again.
   for (auto& reach : wall_reach) reach.valid = false;
 }
@@ -220,6 +223,7 @@ void World::prepare() {
         w.shape, row[particles.material.empty() ? 0 : particles.material[0]].history_size()));
   }
   check_time_step(*this);
+  check_contact_range(*this);
 
   double r_min = 1e300;
   for (double r : particles.radius) r_min = std::min(r_min, r);

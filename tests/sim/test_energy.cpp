@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/common/error.hpp"
 #include "core/common/rng.hpp"
 #include "core/particles/insertion.hpp"
 #include "core/sim/health.hpp"
@@ -124,6 +125,20 @@ TEST(SimEnergy, ElasticGasInClosedBoxConservesEnergy) {
     }
 }
 
+/// The law of the screening's finest, most adhesive corner (below) at a given simulated Young's
+/// modulus (Pa).
+contact::ContactLawSpec fine_adhesive_law(double youngs_modulus) {
+  contact::ContactLawSpec s;
+  s.normal = {"luding",
+              {{"youngs_modulus", youngs_modulus},
+               {"k2_ratio", 11},
+               {"phi_f", 0.11},
+               {"restitution", 0.65}}};
+  s.cohesion = {"van_der_waals", {{"hamaker", 1.5e-16}, {"d_min", 4e-9}, {"d_max", 1e-6}}};
+  s.tangential = {"history", {{"mu_s", 0.2}}};
+  return s;
+}
+
 // What a cohesive pair sets free: two spheres of the finest, most adhesive corner of seed 000's
 // screening (Table 17: r 5 um, A_H 1.5e-17 J, Y 10-50 MPa), coarse-grained by SF 10 (eq. 24-30:
 // r 50 um, A_H 1.5e-16 J, Y 0.5 MPa, D_min 4 nm, D_max 1 um, rho 1.545 kg/m^3), released at rest
@@ -134,14 +149,9 @@ TEST(SimEnergy, ElasticGasInClosedBoxConservesEnergy) {
 // sim::attraction_energy_bound, which the limits now add.
 TEST(SimEnergy, ACohesivePairSnapsTogetherWithinTheAttractionBound) {
   constexpr double kR = 5e-5, kRho = 1.545;
-  contact::ContactLawSpec s;
-  s.normal = {"luding",
-              {{"youngs_modulus", 5e5}, {"k2_ratio", 11}, {"phi_f", 0.11}, {"restitution", 0.65}}};
-  s.cohesion = {"van_der_waals", {{"hamaker", 1.5e-16}, {"d_min", 4e-9}, {"d_max", 1e-6}}};
-  s.tangential = {"history", {{"mu_s", 0.2}}};
   sim::World w;
   w.gravity = {};
-  w.set_pair_law(0, 0, contact::ContactLaw::from_spec(s, "law"));
+  w.set_pair_law(0, 0, contact::ContactLaw::from_spec(fine_adhesive_law(5e5), "law"));
   w.particles.add_sphere({0, 0, 0}, kR, kRho, 0);
   w.particles.add_sphere({2.0 * kR + 0.5e-6, 0, 0}, kR, kRho, 0);
   w.adaptive_safety = 0.2;
@@ -158,6 +168,62 @@ TEST(SimEnergy, ACohesivePairSnapsTogetherWithinTheAttractionBound) {
   const double weight_limit = 1e3 * w.particles.total_mass() * 9.81 * 4.0 * kR;
   EXPECT_GT(peak, 100.0 * weight_limit);
   EXPECT_LT(peak, sim::attraction_energy_bound(w));
+}
+
+/// The message of the SimulationFailure `f` throws, which must be contact_out_of_range.
+template <class F>
+std::string out_of_range_message(F&& f) {
+  try {
+    f();
+  } catch (const SimulationFailure& e) {
+    EXPECT_EQ(e.reason(), SimulationFailure::Reason::kContactOutOfRange) << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "no contact_out_of_range failure";
+  return "";
+}
+
+// The same corner at the low end of Table 17's Young's modulus (10 MPa; 0.1 MPa simulated), where
+// seed 000's LH220 screening lost its row 6: the van der Waals force at contact, A_H r_eff / (6
+// D_min^2) (eq. 12) = 7.81e-5 N, is carried by the Luding loading stiffness k1 = 4/3 Y r_eff
+// sqrt(delta') (eq. 3) = 0.667 N/m only at an overlap of 1.17e-4 m, 2.34 radii. The world
+// refuses the law before its first step, naming the overlap; at 0.5 MPa simulated (0.47 radii,
+// the pair above) it runs. A wall law of those numbers (r_eff = 2 r for a sphere on a plane:
+// the same overlap) is refused the same way.
+TEST(SimEnergy, ALawWhoseAttractionAloneOverlapsAPairBeyondItsRadiusIsRefused) {
+  constexpr double kR = 5e-5, kRho = 1.545;
+  const auto law = contact::ContactLaw::from_spec(fine_adhesive_law(1e5), "law");
+  const double force = 1.5e-16 * kR / (6.0 * 4e-9 * 4e-9);
+  const double k1 = 4.0 / 3.0 * 1e5 * kR * std::sqrt(0.01);
+  EXPECT_NEAR(law.adhesion_overlap(kR), force / k1, 1e-12 * force / k1);
+  EXPECT_NEAR(force / k1 / kR, 2.34, 0.01);
+  EXPECT_NEAR(
+      contact::ContactLaw::from_spec(fine_adhesive_law(5e5), "law").adhesion_overlap(kR) / kR,
+      0.469, 0.001);
+
+  sim::World pair;
+  pair.gravity = {};
+  pair.set_pair_law(0, 0, law);
+  pair.particles.add_sphere({0, 0, 0}, kR, kRho, 0);
+  pair.particles.add_sphere({2.0 * kR + 0.5e-6, 0, 0}, kR, kRho, 0);
+  pair.dt = 1e-7;
+  const std::string message = out_of_range_message([&] { sim::step(pair); });
+  EXPECT_NE(message.find("particle-particle (materials 0 and 0) law"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("an overlap of 2.34 radii"), std::string::npos) << message;
+  EXPECT_EQ(pair.time, 0.0);
+
+  contact::ContactLawSpec plain = fine_adhesive_law(1e5);
+  plain.cohesion = {"none", {}};
+  sim::World wall;
+  wall.set_pair_law(0, 0, contact::ContactLaw::from_spec(plain, "law"));
+  wall.set_wall_law(0, 0, law);
+  wall.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}, 0));
+  wall.particles.add_sphere({0, 0, 2.0 * kR}, kR, kRho, 0);
+  wall.dt = 1e-7;
+  const std::string on_wall = out_of_range_message([&] { sim::step(wall); });
+  EXPECT_NE(on_wall.find("particle-wall (wall 'floor') law"), std::string::npos) << on_wall;
+  EXPECT_NE(on_wall.find("an overlap of 2.34 radii"), std::string::npos) << on_wall;
 }
 
 }  // namespace
