@@ -210,9 +210,9 @@ v1::JobResult campaign_job(v1::CampaignService::Stub& stub, const rpc::ChannelOp
 /// What a job's result is in its spec's first comment lines: its stored metrics (17 significant
 /// digits) and flags when it finished, its error when it failed, its state otherwise.
 std::string job_outcome_comment(const v1::JobResult& job) {
-  std::string out;
   if (job.state() == "failed") return "#   failed: " + job.error() + "\n";
   if (job.state() != "done") return "#   not finished: " + job.state() + "\n";
+  std::string out;
   const std::map<std::string, double> metrics(job.metrics().begin(), job.metrics().end());
   for (const auto& [name, value] : metrics) {
     char line[160];
