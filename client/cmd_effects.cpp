@@ -32,14 +32,21 @@
 namespace demcal::cli {
 namespace {
 
-/// The spec's fixed parameters, then the calibrated set, as a LIGGGHTS fragment; what it
-/// cannot export exactly is warned about on standard error.
-std::string liggghts_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+/// Campaign `id` with its spec.
+v1::Campaign fetch_campaign(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                             std::int64_t id) {
   v1::GetRequest get;
   get.set_id(id);
   v1::Campaign campaign;
   check(stub.Get(rpc::make_context(channel, 60).get(), get, &campaign), "campaign");
+  return campaign;
+}
+
+/// The spec's fixed parameters, then the calibrated set, as a LIGGGHTS fragment; what it
+/// cannot export exactly is warned about on standard error.
+std::string liggghts_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                            std::int64_t id) {
+  const v1::Campaign campaign = fetch_campaign(stub, channel, id);
   v1::CalibrateRequest req;
   req.set_id(id);
   v1::CalibrateReply cal;
@@ -175,10 +182,7 @@ void write_lab_specs(v1::CampaignService::Stub& stub, const rpc::ChannelOptions&
 /// instance there as well.
 std::string yaml_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                         std::int64_t id, const std::string& lab_specs) {
-  v1::GetRequest get;
-  get.set_id(id);
-  v1::Campaign campaign;
-  check(stub.Get(rpc::make_context(channel, 60).get(), get, &campaign), "campaign");
+  const v1::Campaign campaign = fetch_campaign(stub, channel, id);
   const v1::CalibrateReply cal = verified_calibration(stub, channel, id);
   std::map<std::string, double> proposed;
   for (int i = 0; i < cal.factor_paths_size(); ++i)
@@ -228,10 +232,7 @@ std::string job_outcome_comment(const v1::JobResult& job) {
 /// flags, a failed job's error or an unfinished job's state in its first comment lines.
 std::string job_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                        std::int64_t id, std::int64_t job) {
-  v1::GetRequest get;
-  get.set_id(id);
-  v1::Campaign campaign;
-  check(stub.Get(rpc::make_context(channel, 60).get(), get, &campaign), "campaign");
+  const v1::Campaign campaign = fetch_campaign(stub, channel, id);
   const v1::JobResult found = campaign_job(stub, channel, id, job);
   const auto& tests = campaign.spec().tests();
   const auto instance = std::find_if(tests.begin(), tests.end(), [&](const v1::LabTest& t) {
