@@ -16,7 +16,6 @@
 #include <map>
 #include <memory>
 #include <thread>
-#include <variant>
 #include <vector>
 
 #include "client/commands.hpp"
@@ -26,7 +25,6 @@
 #include "client/service_client.hpp"
 #include "core/common/error.hpp"
 #include "core/lab/lab_run_yaml.hpp"
-#include "rpc/journal_line.hpp"
 #include "rpc/material_convert.hpp"
 
 namespace demcal::cli {
@@ -94,62 +92,66 @@ lab::MaterialModel job_material(const v1::CampaignSpec& spec, const v1::LabTest*
   return rpc::job_material(job);
 }
 
-/// Whether a run was simulated at the calibrated set: every factor at its calibrated value.
-bool at_calibrated_set(const v1::JournalRun& run, const v1::CalibrateReply& cal) {
+/// Whether a job simulates the calibrated set: every factor at its calibrated value.
+bool at_calibrated_set(const v1::JobResult& job, const v1::CalibrateReply& cal) {
   for (int i = 0; i < cal.factor_paths_size(); ++i) {
-    const auto it = run.parameters().find(cal.factor_paths(i));
+    const auto it = job.parameters().find(cal.factor_paths(i));
     const double v = cal.proposed_values(i);
-    if (it == run.parameters().end() || std::abs(it->second - v) > 1e-12 * std::abs(v))
+    if (it == job.parameters().end() || std::abs(it->second - v) > 1e-12 * std::abs(v))
       return false;
   }
   return true;
 }
 
-/// The campaign's finished runs, from its journal export.
-std::vector<v1::JournalRun> finished_runs(v1::CampaignService::Stub& stub,
-                                          const rpc::ChannelOptions& channel, std::int64_t id) {
-  std::string journal;
-  check(read_export(stub, channel, id, "journal", journal, false), "export");
-  std::vector<v1::JournalRun> out;
-  for (const auto& line : split_lines(journal)) {
-    const auto parsed = rpc::parse_journal_line(line);
-    if (const auto* run = std::get_if<v1::JournalRun>(&parsed)) out.push_back(*run);
+/// The campaign's jobs as the store holds them, each with what it simulates.
+std::vector<v1::JobResult> campaign_jobs(v1::CampaignService::Stub& stub,
+                                         const rpc::ChannelOptions& channel, std::int64_t id) {
+  v1::GetRequest req;
+  req.set_id(id);
+  v1::ResultsReply results;
+  check(stub.GetResults(rpc::make_context(channel, 60).get(), req, &results), "results");
+  return {results.jobs().begin(), results.jobs().end()};
+}
+
+/// The latest finished job of each test instance at the calibrated set (instance -> job): the
+/// verification that simulated the calibrated numbers, or a design run at the same point.
+std::map<std::string, v1::JobResult> verification_runs(v1::CampaignService::Stub& stub,
+                                                       const rpc::ChannelOptions& channel,
+                                                       std::int64_t id,
+                                                       const v1::CalibrateReply& cal) {
+  std::map<std::string, v1::JobResult> out;
+  for (const auto& job : campaign_jobs(stub, channel, id)) {
+    if (job.state() != "done" || !at_calibrated_set(job, cal)) continue;
+    auto& kept = out[job.test()];
+    if (job.job_id() > kept.job_id()) kept = job;
   }
   return out;
 }
 
-/// The latest finished run of each test instance at the calibrated set (instance -> run): the
-/// verification that simulated the calibrated numbers.
-std::map<std::string, v1::JournalRun> verification_runs(v1::CampaignService::Stub& stub,
-                                                        const rpc::ChannelOptions& channel,
-                                                        std::int64_t id,
-                                                        const v1::CalibrateReply& cal) {
-  std::map<std::string, v1::JournalRun> out;
-  for (const auto& run : finished_runs(stub, channel, id)) {
-    if (!at_calibrated_set(run, cal)) continue;
-    auto& kept = out[run.instance()];
-    if (run.job_id() > kept.job_id()) kept = run;
-  }
-  return out;
-}
-
-/// The `demcal lab run` spec that simulates a finished run of test instance `instance` again: its
+/// The `demcal lab run` spec that simulates a job of test instance `instance` (again): its
 /// settings, seed and parameters on the instance's material, one thread.
 lab::LabRunSpec rerun_spec(const v1::CampaignSpec& spec, const v1::LabTest& instance,
-                           const v1::JournalRun& finished) {
+                           const v1::JobResult& job) {
   lab::LabRunSpec run;
   run.test = instance.test();
   run.options.threads = 1;
-  run.settings = lab::Settings(finished.settings().begin(), finished.settings().end());
-  run.options.seed = finished.seed();
-  run.material =
-      job_material(spec, &instance, {finished.parameters().begin(), finished.parameters().end()});
+  run.settings = lab::Settings(job.settings().begin(), job.settings().end());
+  run.options.seed = job.seed();
+  run.material = job_material(spec, &instance, {job.parameters().begin(), job.parameters().end()});
   return run;
 }
 
+/// What the spec of a test instance at the calibrated set simulates, for its first comment line.
+std::string calibrated_run_origin(const v1::JobResult* job) {
+  if (!job) return "no finished run at the calibrated set; the test's own settings and seed";
+  const std::string id = "job " + std::to_string(job->job_id());
+  return job->kind() == "verify" ? "the verification run (" + id + ")"
+                                 : id + ", a " + job->kind() + " run at the calibrated set";
+}
+
 /// One `demcal lab run` spec per test instance, `DIR/<instance>.yaml`: the calibrated material
-/// and the settings and seed of the instance's verification run (the instance's own when no
-/// finished run is at the calibrated set), one thread.
+/// and the settings and seed of the instance's latest finished run at the calibrated set (its
+/// verification), or the instance's own when it has none, one thread.
 void write_lab_specs(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                      std::int64_t id, const v1::CampaignSpec& spec, const v1::CalibrateReply& cal,
                      const std::map<std::string, double>& parameters, const std::string& dir) {
@@ -158,20 +160,16 @@ void write_lab_specs(v1::CampaignService::Stub& stub, const rpc::ChannelOptions&
   for (const auto& t : spec.tests()) {
     const std::string name = instance_name(t);
     const auto it = verified.find(name);
-    const bool found = it != verified.end();
-    // Without a verification: the run the instance would make at the calibrated set.
-    v1::JournalRun planned;
+    const v1::JobResult* found = it != verified.end() ? &it->second : nullptr;
+    // Without one: the run the instance would make at the calibrated set.
+    v1::JobResult planned;
     *planned.mutable_settings() = t.settings();
     planned.set_seed(t.seed() ? t.seed() : 1);
     planned.mutable_parameters()->insert(parameters.begin(), parameters.end());
-    const lab::LabRunSpec run = rerun_spec(spec, t, found ? it->second : planned);
+    const lab::LabRunSpec run = rerun_spec(spec, t, found ? *found : planned);
     const auto file = std::filesystem::path(dir) / (name + ".yaml");
-    std::ofstream(file) << "# demcal campaign " << id << ", test " << name
-                        << (found ? ": the verification run (job " +
-                                        std::to_string(it->second.job_id()) + ")"
-                                  : ": no finished run at the calibrated set; the test's own "
-                                    "settings and seed")
-                        << "\n"
+    std::ofstream(file) << "# demcal campaign " << id << ", test " << name << ": "
+                        << calibrated_run_origin(found) << "\n"
                         << lab::lab_run_yaml(run);
     std::cerr << "wrote " << file.string() << "\n";
   }
@@ -200,11 +198,7 @@ std::string yaml_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptio
 /// campaign has no such job.
 v1::JobResult campaign_job(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                            std::int64_t id, std::int64_t job) {
-  v1::GetRequest req;
-  req.set_id(id);
-  v1::ResultsReply results;
-  check(stub.GetResults(rpc::make_context(channel, 60).get(), req, &results), "results");
-  for (const auto& j : results.jobs())
+  for (const auto& j : campaign_jobs(stub, channel, id))
     if (j.job_id() == job) return j;
   throw InputError("--job", "campaign " + std::to_string(id) + " has no job " +
                                 std::to_string(job) + " (`demcal status " + std::to_string(id) +
@@ -244,15 +238,11 @@ std::string job_export(v1::CampaignService::Stub& stub, const rpc::ChannelOption
   if (found.parameters().empty() && found.settings().empty())
     throw InputError("--job", "job " + std::to_string(job) +
                                   " was planned by an older build whose payload cannot be read");
-  v1::JournalRun run;
-  *run.mutable_settings() = found.settings();
-  *run.mutable_parameters() = found.parameters();
-  run.set_seed(found.seed());
   return "# demcal campaign " + std::to_string(id) + " '" + campaign.name() + "', job " +
          std::to_string(job) + " (" + found.test() + "): simulates it" +
          (found.state() == "done" ? " again; its stored metrics" : "") + ":\n" +
          job_outcome_comment(found) +
-         lab::lab_run_yaml(rerun_spec(campaign.spec(), *instance, run));
+         lab::lab_run_yaml(rerun_spec(campaign.spec(), *instance, found));
 }
 
 struct ExportOptions {
