@@ -51,8 +51,8 @@ std::vector<double> smallest_radius(const particles::ParticleStore& p, int mater
   return r;
 }
 
-/// Throws when `law` holds a contact of effective radius r_eff at an overlap of `radius` or
-/// deeper; `what` names the contact.
+/// Throws when `law` holds a pair of effective radius r_eff at an overlap of `radius` or deeper;
+/// `what` names the pair's materials.
 void check_adhesion_overlap(const contact::ContactLaw& law, double r_eff, double radius,
                             const std::string& what) {
   const double overlap = law.adhesion_overlap(r_eff);
@@ -61,9 +61,9 @@ void check_adhesion_overlap(const contact::ContactLaw& law, double r_eff, double
       std::visit([&](const auto& c) { return c.contact_force(r_eff); }, law.cohesion);
   throw SimulationFailure(
       SimulationFailure::Reason::kContactOutOfRange,
-      "the " + what + " law's attraction at contact (" + message_number(force, 4) +
-          " N) holds a particle of radius " + message_number(radius, 4) + " m at an overlap of " +
-          message_number(overlap / radius, 3) +
+      "the particle-particle law of " + what + ": its attraction at contact (" +
+          message_number(force, 4) + " N) holds a particle of radius " + message_number(radius, 4) +
+          " m at an overlap of " + message_number(overlap / radius, 3) +
           " radii under the law's repulsion: outside the range of a soft-sphere contact (an "
           "overlap below the radius); a larger radius, a weaker attraction or a stiffer law "
           "brings it back");
@@ -76,16 +76,10 @@ void check_contact_range(const World& w) {
   for (int a = 0; a < w.materials(); ++a)
     for (int b = a; b < w.materials(); ++b) {
       if (r[a] == 0.0 || r[b] == 0.0) continue;
-      check_adhesion_overlap(
-          w.pair_law(a, b), 2.0 * r[a] * r[b] / (r[a] + r[b]), std::min(r[a], r[b]),
-          "particle-particle (materials " + std::to_string(a) + " and " + std::to_string(b) + ")");
+      check_adhesion_overlap(w.pair_law(a, b), 2.0 * r[a] * r[b] / (r[a] + r[b]),
+                             std::min(r[a], r[b]),
+                             "materials " + std::to_string(a) + " and " + std::to_string(b));
     }
-  for (const auto& wall : w.walls)
-    for (int a = 0; a < w.materials(); ++a)
-      if (r[a] > 0.0)
-        // A particle-wall contact's effective radius is 2 R* = 2 r.
-        check_adhesion_overlap(w.wall_law(wall.material, a), 2.0 * r[a], r[a],
-                               "particle-wall (wall '" + wall.name + "')");
 }
 
 double attraction_energy_bound(const World& w) {

@@ -16,12 +16,14 @@ struct HealthLimits {
 
 void check_health(const World& world, const HealthLimits& limits);
 
-/// Throws SimulationFailure(kContactOutOfRange) when a law of the world, between the smallest
-/// particles of its materials (or such a particle and a wall), holds a contact by its attraction
-/// alone at an overlap (ContactLaw::adhesion_overlap) as deep as the smaller particle's radius: a
-/// soft-sphere contact stands for a small overlap, and one that reaches a particle's centre makes
-/// neither force nor geometry of the pair meaningful (the bed collapses into itself and ejects
-/// particles). The message names the law, the force and the overlap in radii.
+/// Throws SimulationFailure(kContactOutOfRange) when a particle-particle law of the world, between
+/// the smallest particles of its materials, holds a pair by its attraction alone at an overlap
+/// (ContactLaw::adhesion_overlap) as deep as the smaller particle's radius: a soft-sphere contact
+/// stands for a small overlap, and one that reaches a particle's centre makes neither force nor
+/// geometry of the pair meaningful (the bed collapses into itself and ejects particles). The
+/// message names the materials, the force and the overlap in radii. Wall laws are not checked: a
+/// test's device may hold particles harder than any contact of the material (the tensile test's
+/// adhesive piston, seed 000 eq. 34).
 void check_contact_range(const World& world);
 
 /// An upper bound of the kinetic energy the attraction of the world's laws can set free (J), for

@@ -189,7 +189,8 @@ std::string out_of_range_message(F&& f) {
 // sqrt(delta') (eq. 3) = 0.667 N/m only at an overlap of 1.17e-4 m, 2.34 radii. The world
 // refuses the law before its first step, naming the overlap; at 0.5 MPa simulated (0.47 radii,
 // the pair above) it runs. A wall law of those numbers (r_eff = 2 r for a sphere on a plane:
-// the same overlap) is refused the same way.
+// the same overlap) is not checked: a test's device, such as the tensile test's adhesive piston
+// (eq. 34), may hold particles harder than the material's contacts.
 TEST(SimEnergy, ALawWhoseAttractionAloneOverlapsAPairBeyondItsRadiusIsRefused) {
   constexpr double kR = 5e-5, kRho = 1.545;
   const auto law = contact::ContactLaw::from_spec(fine_adhesive_law(1e5), "law");
@@ -208,7 +209,7 @@ TEST(SimEnergy, ALawWhoseAttractionAloneOverlapsAPairBeyondItsRadiusIsRefused) {
   pair.particles.add_sphere({2.0 * kR + 0.5e-6, 0, 0}, kR, kRho, 0);
   pair.dt = 1e-7;
   const std::string message = out_of_range_message([&] { sim::step(pair); });
-  EXPECT_NE(message.find("particle-particle (materials 0 and 0) law"), std::string::npos)
+  EXPECT_NE(message.find("the particle-particle law of materials 0 and 0"), std::string::npos)
       << message;
   EXPECT_NE(message.find("an overlap of 2.34 radii"), std::string::npos) << message;
   EXPECT_EQ(pair.time, 0.0);
@@ -221,9 +222,8 @@ TEST(SimEnergy, ALawWhoseAttractionAloneOverlapsAPairBeyondItsRadiusIsRefused) {
   wall.walls.push_back(walls::make_wall("floor", walls::Plane{{0, 0, 0}, {0, 0, 1}}, 0));
   wall.particles.add_sphere({0, 0, 2.0 * kR}, kR, kRho, 0);
   wall.dt = 1e-7;
-  const std::string on_wall = out_of_range_message([&] { sim::step(wall); });
-  EXPECT_NE(on_wall.find("particle-wall (wall 'floor') law"), std::string::npos) << on_wall;
-  EXPECT_NE(on_wall.find("an overlap of 2.34 radii"), std::string::npos) << on_wall;
+  sim::step(wall);
+  EXPECT_GT(wall.time, 0.0);
 }
 
 }  // namespace
