@@ -75,7 +75,6 @@ void World::change_wall_law(int wall_material, int particle_material,
   }
   wall_laws_[wall_material][particle_material] = law;
   check_time_step(*this);
-  check_contact_range(*this);
   // The new law's reach beyond contact may differ: list the walls' particles again.
   for (auto& reach : wall_reach) reach.valid = false;
 }

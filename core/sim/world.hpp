@@ -103,9 +103,9 @@ class World {
   const contact::ContactLaw& wall_law(int wall_material, int particle_material) const;
   int materials() const { return n_materials_; }
 
-  /// Checks the laws, the time step against the stability limit, the laws' range against the
-  /// particles (check_contact_range), builds the neighbour list and
-  /// computes the forces of the current configuration (contact history starts afresh).
+  /// Checks the laws, the time step against the stability limit, the particle-particle laws'
+  /// range against the particles (check_contact_range), builds the neighbour list and computes
+  /// the forces of the current configuration (contact history starts afresh).
   /// Called by step() when needed; call it again after adding or removing particles or walls.
   void prepare();
   bool prepared() const { return prepared_; }
