@@ -1,5 +1,6 @@
 #include "client/campaign_journal.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 #include <map>
@@ -7,7 +8,9 @@
 
 #include "client/service_client.hpp"
 #include "core/common/error.hpp"
+#include "core/lab/bed.hpp"
 #include "rpc/journal_line.hpp"
+#include "rpc/material_convert.hpp"
 
 namespace demcal::cli {
 namespace {
@@ -35,6 +38,24 @@ std::string other_protocols(const std::vector<v1::JournalRun>& runs,
             std::to_string(coordinator_protocol(reply, test)) + ")";
   }
   return text;
+}
+
+/// Whether the current build refuses to simulate `run`'s material (lab::check_contact_range),
+/// built as campaign `spec` builds it for the run's test instance; its reason, or empty. A run of
+/// an instance the spec does not have is not checked: its material cannot be rebuilt here.
+std::string refusal(const v1::JournalRun& run, const v1::CampaignSpec& spec) {
+  const auto& tests = spec.tests();
+  const auto instance = std::find_if(tests.begin(), tests.end(), [&](const v1::LabTest& t) {
+    return rpc::instance_name(t) == run.instance() && t.test() == run.test();
+  });
+  if (instance == tests.end()) return "";
+  try {
+    lab::check_contact_range(
+        rpc::job_material(spec, &*instance, {run.parameters().begin(), run.parameters().end()}));
+  } catch (const SimulationFailure& e) {
+    return e.what();
+  }
+  return "";
 }
 
 }  // namespace
@@ -85,15 +106,27 @@ void CampaignJournal::append_export(const std::string& content) {
 }
 
 void import_journal(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
-                    const CampaignJournal& journal, std::ostream& out) {
+                    const CampaignJournal& journal, const v1::CampaignSpec& spec,
+                    std::ostream& out) {
+  std::vector<const v1::JournalRun*> offered;
+  std::size_t refused = 0;
+  std::string reason;
+  for (const auto& run : journal.runs()) {
+    const std::string why = refusal(run, spec);
+    if (why.empty()) {
+      offered.push_back(&run);
+    } else if (refused++ == 0) {
+      reason = run.source() + ": " + why;
+    }
+  }
   constexpr std::size_t kBatchBytes = std::size_t(1) << 20;
   v1::ImportRunsReply total;
-  for (std::size_t first = 0; first < journal.runs().size();) {
+  for (std::size_t first = 0; first < offered.size();) {
     v1::ImportRunsRequest batch;
     std::size_t bytes = 0;
-    for (; first < journal.runs().size() && bytes < kBatchBytes; ++first) {
-      bytes += journal.runs()[first].ByteSizeLong();
-      *batch.add_runs() = journal.runs()[first];
+    for (; first < offered.size() && bytes < kBatchBytes; ++first) {
+      bytes += offered[first]->ByteSizeLong();
+      *batch.add_runs() = *offered[first];
     }
     v1::ImportRunsReply reply;
     check(stub.ImportRuns(rpc::make_context(channel, 120).get(), batch, &reply), "import");
@@ -109,6 +142,10 @@ void import_journal(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& 
     out << "journal " << journal.path().string() << ": " << total.other_protocol()
         << " run(s) not taken: simulated under another version of their test's protocol ("
         << other_protocols(journal.runs(), total) << "), whose results may differ\n";
+  if (refused > 0)
+    out << "journal " << journal.path().string() << ": " << refused
+        << " run(s) not taken: their material is one this build refuses to simulate (the first, "
+        << reason << ")\n";
 }
 
 JournalKeeper::JournalKeeper(CampaignJournal& journal, v1::CampaignService::Stub& stub,

@@ -51,10 +51,14 @@ class CampaignJournal {
 };
 
 /// Offers the journal's runs to the coordinator (ImportRuns, in batches of about 1 MiB) and says
-/// on `out` what became of them: how many were new or held already, and how many were not taken
-/// because they were simulated under another lab protocol version.
+/// on `out` what became of them: how many were new or held already, how many were not taken
+/// because they were simulated under another lab protocol version, and how many were not offered
+/// because this build refuses their material (a run of an instance of `spec` whose material fails
+/// lab::check_contact_range: a result an older build simulated is not used where this one would
+/// fail the run).
 void import_journal(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
-                    const CampaignJournal& journal, std::ostream& out);
+                    const CampaignJournal& journal, const v1::CampaignSpec& spec,
+                    std::ostream& out);
 
 /// Keeps the journal of campaign `id` up to date while it lives: following the campaign's
 /// progress (Watch, again every half second once the campaign no longer runs, since a calibration

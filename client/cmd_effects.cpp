@@ -76,22 +76,6 @@ v1::CalibrateReply verified_calibration(v1::CampaignService::Stub& stub,
   return cal;
 }
 
-/// A test instance's name in the campaign: its `name`, else its test.
-std::string instance_name(const v1::LabTest& t) {
-  return t.name().empty() ? t.test() : t.name();
-}
-
-/// The material a job of the campaign runs: the spec's material (with the instance's own wall law
-/// and bed preparation, if any) and `parameters` (fixed values, factors and tied paths) set on it.
-lab::MaterialModel job_material(const v1::CampaignSpec& spec, const v1::LabTest* instance,
-                                const std::map<std::string, double>& parameters) {
-  v1::JobSpec job;
-  *job.mutable_material() =
-      instance ? rpc::instance_material(spec.material(), *instance) : spec.material();
-  job.mutable_parameters()->insert(parameters.begin(), parameters.end());
-  return rpc::job_material(job);
-}
-
 /// Whether a job simulates the calibrated set: every factor at its calibrated value.
 bool at_calibrated_set(const v1::JobResult& job, const v1::CalibrateReply& cal) {
   for (int i = 0; i < cal.factor_paths_size(); ++i) {
@@ -137,7 +121,8 @@ lab::LabRunSpec rerun_spec(const v1::CampaignSpec& spec, const v1::LabTest& inst
   run.options.threads = 1;
   run.settings = lab::Settings(job.settings().begin(), job.settings().end());
   run.options.seed = job.seed();
-  run.material = job_material(spec, &instance, {job.parameters().begin(), job.parameters().end()});
+  run.material =
+      rpc::job_material(spec, &instance, {job.parameters().begin(), job.parameters().end()});
   return run;
 }
 
@@ -158,7 +143,7 @@ void write_lab_specs(v1::CampaignService::Stub& stub, const rpc::ChannelOptions&
   const auto verified = verification_runs(stub, channel, id, cal);
   std::filesystem::create_directories(dir);
   for (const auto& t : spec.tests()) {
-    const std::string name = instance_name(t);
+    const std::string name = rpc::instance_name(t);
     const auto it = verified.find(name);
     const v1::JobResult* found = it != verified.end() ? &it->second : nullptr;
     // Without one: the run the instance would make at the calibrated set.
@@ -191,7 +176,7 @@ std::string yaml_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptio
   return "# demcal campaign " + std::to_string(id) + " '" + campaign.name() +
          "': the calibrated material (" +
          (cal.conclusion().empty() ? cal.verification_state() : cal.conclusion()) + ")\n" +
-         io::material_yaml(job_material(campaign.spec(), nullptr, parameters));
+         io::material_yaml(rpc::job_material(campaign.spec(), nullptr, parameters));
 }
 
 /// Job `job` of the campaign as the store holds it; an InputError naming `--job` when the
@@ -230,7 +215,7 @@ std::string job_export(v1::CampaignService::Stub& stub, const rpc::ChannelOption
   const v1::JobResult found = campaign_job(stub, channel, id, job);
   const auto& tests = campaign.spec().tests();
   const auto instance = std::find_if(tests.begin(), tests.end(), [&](const v1::LabTest& t) {
-    return instance_name(t) == found.test();
+    return rpc::instance_name(t) == found.test();
   });
   if (instance == tests.end())
     throw InputError("--job", "job " + std::to_string(job) + " runs test instance '" +

@@ -40,7 +40,7 @@ void run_embedded(const RunOptions& opt) {
   auto* stub = &service.stub();
   const auto& channel = service.channel();
   text << "work directory: " << workdir.string() << " (SQLite: " << service.db() << ")\n";
-  if (journal) import_journal(*stub, channel, *journal, text);
+  if (journal) import_journal(*stub, channel, *journal, file.spec, text);
   const std::int64_t id = service.submit_or_resume(file, text);
   if (journal) service.keep_journal(*journal, id);
   if (!opt.http.empty())

@@ -34,7 +34,7 @@ void add_submit_command(CLI::App& app) {
     std::optional<CampaignJournal> journal;
     if (!o->journal.empty()) journal.emplace(o->journal);
     auto stub = campaign_stub(o->channel);
-    if (journal) import_journal(*stub, o->channel, *journal, std::cout);
+    if (journal) import_journal(*stub, o->channel, *journal, file.spec, std::cout);
     v1::SubmitRequest req;
     *req.mutable_spec() = file.spec;
     v1::SubmitReply reply;

@@ -275,6 +275,19 @@ lab::MaterialModel job_material(const v1::JobSpec& job) {
       std::map<std::string, double>(job.parameters().begin(), job.parameters().end()));
 }
 
+std::string instance_name(const v1::LabTest& t) {
+  return t.name().empty() ? t.test() : t.name();
+}
+
+lab::MaterialModel job_material(const v1::CampaignSpec& spec, const v1::LabTest* instance,
+                                const std::map<std::string, double>& parameters) {
+  v1::JobSpec job;
+  *job.mutable_material() =
+      instance ? instance_material(spec.material(), *instance) : spec.material();
+  job.mutable_parameters()->insert(parameters.begin(), parameters.end());
+  return job_material(job);
+}
+
 std::uint64_t job_seed(const v1::JobSpec& job) {
   return job.seed() ? job.seed() : 1;
 }

@@ -32,6 +32,10 @@ v1::Preparation to_preparation_message(const lab::PreparationSpec& preparation);
 /// InputError as to_material_model.
 v1::CampaignSpec canonical_spec(const v1::CampaignSpec& spec);
 
+/// The name of a test instance, which its responses and jobs carry ("<name>.<metric>"): its
+/// `name`, or the lab test's when it has none.
+std::string instance_name(const v1::LabTest& test);
+
 /// The material a test instance runs with: `material` with the instance's own wall law and bed
 /// preparation, if any.
 v1::Material instance_material(const v1::Material& material, const v1::LabTest& test);
@@ -39,6 +43,12 @@ v1::Material instance_material(const v1::Material& material, const v1::LabTest& 
 /// The material of a job: its base material with the job's parameters set (factor values and
 /// fixed parameters).
 lab::MaterialModel job_material(const v1::JobSpec& job);
+
+/// The material a job of campaign `spec` runs: the spec's material (with the instance's own wall
+/// law and bed preparation, if `instance` is set) and `parameters` (fixed values, factors and tied
+/// paths) set on it.
+lab::MaterialModel job_material(const v1::CampaignSpec& spec, const v1::LabTest* instance,
+                                const std::map<std::string, double>& parameters);
 
 /// The simulation seed of a job: its seed, or 1 when it has none.
 std::uint64_t job_seed(const v1::JobSpec& job);

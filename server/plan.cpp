@@ -59,7 +59,7 @@ void check_instances(const v1::CampaignSpec& spec) {
   for (int i = 0; i < spec.tests_size(); ++i) {
     const auto& t = spec.tests(i);
     const std::string where = "spec." + idx("tests", i);
-    const std::string name = instance_name(t);
+    const std::string name = rpc::instance_name(t);
     if (!t.name().empty()) check_instance_name(t.name(), where + ".name");
     if (!seen.insert(name).second)
       throw InputError(where + (t.name().empty() ? ".test" : ".name"),

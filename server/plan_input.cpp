@@ -30,7 +30,7 @@ lab::MaterialModel instance_model(const v1::CampaignSpec& spec, const v1::LabTes
 PlannedInstance read_instance(const v1::CampaignSpec& spec, int i) {
   const auto& t = spec.tests(i);
   const lab::Settings settings = rpc::to_settings(t.settings());
-  return {instance_name(t),
+  return {rpc::instance_name(t),
           t.test(),
           settings,
           settings,
@@ -57,10 +57,6 @@ double option(double v, double fallback, double lo, double hi, const std::string
 }
 
 }  // namespace
-
-std::string instance_name(const v1::LabTest& t) {
-  return t.name().empty() ? t.test() : t.name();
-}
 
 CampaignPlan read_plan_input(const v1::CampaignSpec& spec) {
   CampaignPlan plan;

@@ -10,10 +10,6 @@
 
 namespace demcal::server {
 
-/// The name of a test instance, which its responses carry ("<name>.<metric>"): its `name`, or the
-/// lab test's when it has none.
-std::string instance_name(const v1::LabTest& test);
-
 /// The plan's structure from the spec; InputError naming the field of a material or an option
 /// out of range. Design, responses, targets and fidelity are not filled in.
 CampaignPlan read_plan_input(const v1::CampaignSpec& spec);

@@ -91,6 +91,11 @@ sim::World make_material_world(const MaterialModel& material, const RunOptions& 
   return w;
 }
 
+void check_contact_range(const MaterialModel& material) {
+  const double r = particles::min_radius(material.simulated_sizes());
+  sim::check_pair_range(material.simulated_particle_law(), r, r, "the material");
+}
+
 double expected_solid_volume(const particles::SizeDistribution& sizes, double count,
                              std::uint64_t seed) {
   constexpr int kSamples = 2000;

@@ -52,6 +52,11 @@ enum WallMaterial : std::uint16_t {
 /// every lab wall material; the lab tests add their walls and particles.
 sim::World make_material_world(const MaterialModel& material, const RunOptions& options);
 
+/// The contact range check a world of the material makes at its start (sim::check_contact_range),
+/// on the material alone: its simulated particle law between two of its smallest particles.
+/// Throws SimulationFailure(kContactOutOfRange).
+void check_contact_range(const MaterialModel& material);
+
 /// An insertion request for `count` particles of the material (its simulated sizes and density,
 /// and its clump shape if not spherical) into `region`.
 particles::InsertRequest material_insert_request(const MaterialModel& material,

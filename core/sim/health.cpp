@@ -51,10 +51,12 @@ std::vector<double> smallest_radius(const particles::ParticleStore& p, int mater
   return r;
 }
 
-/// Throws when `law` holds a pair of effective radius r_eff at an overlap of `radius` or deeper;
-/// `what` names the pair's materials.
-void check_adhesion_overlap(const contact::ContactLaw& law, double r_eff, double radius,
-                            const std::string& what) {
+}  // namespace
+
+void check_pair_range(const contact::ContactLaw& law, double r_i, double r_j,
+                      const std::string& what) {
+  const double r_eff = 2.0 * r_i * r_j / (r_i + r_j);
+  const double radius = std::min(r_i, r_j);
   const double overlap = law.adhesion_overlap(r_eff);
   if (overlap < radius) return;
   const double force =
@@ -69,17 +71,13 @@ void check_adhesion_overlap(const contact::ContactLaw& law, double r_eff, double
           "brings it back");
 }
 
-}  // namespace
-
 void check_contact_range(const World& w) {
   const auto r = smallest_radius(w.particles, w.materials());
   for (int a = 0; a < w.materials(); ++a)
-    for (int b = a; b < w.materials(); ++b) {
-      if (r[a] == 0.0 || r[b] == 0.0) continue;
-      check_adhesion_overlap(w.pair_law(a, b), 2.0 * r[a] * r[b] / (r[a] + r[b]),
-                             std::min(r[a], r[b]),
-                             "materials " + std::to_string(a) + " and " + std::to_string(b));
-    }
+    for (int b = a; b < w.materials(); ++b)
+      if (r[a] > 0.0 && r[b] > 0.0)
+        check_pair_range(w.pair_law(a, b), r[a], r[b],
+                         "materials " + std::to_string(a) + " and " + std::to_string(b));
 }
 
 double attraction_energy_bound(const World& w) {

@@ -3,6 +3,7 @@
 // its reason (not_finite, energy_explosion, escaped_particles, contact_out_of_range), never
 // numbers.
 #include <limits>
+#include <string>
 
 #include "core/sim/world.hpp"
 
@@ -25,6 +26,11 @@ void check_health(const World& world, const HealthLimits& limits);
 /// test's device may hold particles harder than any contact of the material (the tensile test's
 /// adhesive piston, seed 000 eq. 34).
 void check_contact_range(const World& world);
+
+/// The check of check_contact_range for one law between particles of radii r_i and r_j; `what`
+/// names the pair's materials in the message.
+void check_pair_range(const contact::ContactLaw& law, double r_i, double r_j,
+                      const std::string& what);
 
 /// An upper bound of the kinetic energy the attraction of the world's laws can set free (J), for
 /// the energy limit of a cohesive bed, where it can far exceed the bed's potential energy (small

@@ -2,8 +2,9 @@
 // campaign in one store takes the first's results instead of leasing its jobs; `demcal run
 // --journal` interrupted and resumed in a fresh work directory gives the uninterrupted run's
 // effects to the bit with no run simulated twice; a journal of another spec gives exactly the runs
-// whose keys match; runs of another version of their test's protocol are not taken; lines cut short
-// are dropped and malformed lines refused with their file and line.
+// whose keys match; runs of another version of their test's protocol, or of a material the build
+// refuses, are not taken; lines cut short are dropped and malformed lines refused with their file
+// and line.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -330,6 +331,40 @@ TEST_F(Journal, RunsOfAnotherLabProtocolVersionAreNotTaken) {
   EXPECT_EQ(file_lines(journal).size(), 6u);
   ASSERT_EQ(run(path("a.yaml"), "third", journal, err), 0) << err;
   EXPECT_EQ(simulated_and_reused("third"), std::make_pair(0, 4));
+}
+
+// A run an older build simulated of a material this build refuses (lab::check_contact_range) is
+// not offered to the coordinator: the journal's packing run is changed to A_H 1e-14 J on its
+// 0.5 mm Hertz spheres (their van der Waals attraction at contact pressing a pair 7.4 radii
+// deep) and to an impossible solid fraction; a campaign going on from that journal simulates the
+// job again instead of taking it, and says why, naming the line.
+TEST_F(Journal, RunsOfAMaterialThisBuildRefusesAreNotTaken) {
+  std::string spec = packing_spec("a", 0.75);
+  const std::string friction = "    tangential: {model: history, mu_s: 0.3}\n";
+  spec.replace(
+      spec.find(friction), friction.size(),
+      friction + "    cohesion: {model: van_der_waals, hamaker: 1.0e-20, d_max: 1.0e-7}\n");
+  std::ofstream(path("a.yaml")) << spec;
+  const std::string journal = path("a.jsonl");
+  std::string err;
+  ASSERT_EQ(run(path("a.yaml"), "a", journal, err), 0) << err;
+  auto lines = file_lines(journal);
+  ASSERT_EQ(lines.size(), 5u);
+  auto changed = nlohmann::json::parse(lines[2]);
+  changed["parameters"]["particle_law.cohesion.hamaker"] = 1e-14;
+  changed["metrics"]["solid_fraction"] = 0.999;
+  lines[2] = changed.dump();
+  write_lines(journal, lines);
+  ASSERT_EQ(run(path("a.yaml"), "again", journal, err), 0) << err;
+  EXPECT_NE(err.find("1 run(s) not taken: their material is one this build refuses to simulate "
+                     "(the first, " +
+                     journal + ":3: the particle-particle law of the material: its attraction"),
+            std::string::npos)
+      << err;
+  for (const auto& job : stored_jobs("again")) {
+    EXPECT_EQ(job.reused, job.run_key != changed.at("run_key")) << job.run_key;
+    EXPECT_EQ(job.metrics.find("0.999"), std::string::npos) << job.metrics;
+  }
 }
 
 TEST_F(Journal, ALineCutShortIsDroppedAndAMalformedLineIsRefusedWithItsFileAndLine) {
