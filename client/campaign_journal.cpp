@@ -42,7 +42,8 @@ std::string other_protocols(const std::vector<v1::JournalRun>& runs,
 
 /// Whether the current build refuses to simulate `run`'s material (lab::check_contact_range),
 /// built as campaign `spec` builds it for the run's test instance; its reason, or empty. A run of
-/// an instance the spec does not have is not checked: its material cannot be rebuilt here.
+/// an instance the spec does not have, or whose parameters do not apply to the spec's material
+/// (a run of another spec), is not checked: its material cannot be rebuilt here.
 std::string refusal(const v1::JournalRun& run, const v1::CampaignSpec& spec) {
   const auto& tests = spec.tests();
   const auto instance = std::find_if(tests.begin(), tests.end(), [&](const v1::LabTest& t) {
@@ -54,6 +55,8 @@ std::string refusal(const v1::JournalRun& run, const v1::CampaignSpec& spec) {
         rpc::job_material(spec, &*instance, {run.parameters().begin(), run.parameters().end()}));
   } catch (const SimulationFailure& e) {
     return e.what();
+  } catch (const InputError&) {
+    return "";
   }
   return "";
 }

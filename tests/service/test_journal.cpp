@@ -367,6 +367,22 @@ TEST_F(Journal, RunsOfAMaterialThisBuildRefusesAreNotTaken) {
   }
 }
 
+// A run whose parameters do not apply to this spec's material (a path of another spec's laws)
+// cannot be checked here and is offered as it is: the run goes on and takes it by its key.
+TEST_F(Journal, ARunWhoseMaterialThisSpecCannotBuildIsOfferedUnchecked) {
+  ASSERT_NO_FATAL_FAILURE(run_a());
+  const std::string journal = path("a.jsonl");
+  auto lines = file_lines(journal);
+  auto changed = nlohmann::json::parse(lines[2]);
+  changed["parameters"]["particle_law.cohesion.hamaker"] = 1e-14;
+  lines[2] = changed.dump();
+  write_lines(journal, lines);
+  std::string err;
+  ASSERT_EQ(run(path("a.yaml"), "again", journal, err), 0) << err;
+  EXPECT_EQ(err.find("refuses to simulate"), std::string::npos) << err;
+  EXPECT_EQ(simulated_and_reused("again"), std::make_pair(0, 4));
+}
+
 TEST_F(Journal, ALineCutShortIsDroppedAndAMalformedLineIsRefusedWithItsFileAndLine) {
   ASSERT_NO_FATAL_FAILURE(run_a());
   const std::string journal = path("a.jsonl");
