@@ -1,6 +1,5 @@
 #include "client/campaign_journal.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <iostream>
 #include <map>
@@ -45,14 +44,11 @@ std::string other_protocols(const std::vector<v1::JournalRun>& runs,
 /// an instance the spec does not have, or whose parameters do not apply to the spec's material
 /// (a run of another spec), is not checked: its material cannot be rebuilt here.
 std::string refusal(const v1::JournalRun& run, const v1::CampaignSpec& spec) {
-  const auto& tests = spec.tests();
-  const auto instance = std::find_if(tests.begin(), tests.end(), [&](const v1::LabTest& t) {
-    return rpc::instance_name(t) == run.instance() && t.test() == run.test();
-  });
-  if (instance == tests.end()) return "";
+  const v1::LabTest* instance = rpc::find_instance(spec, run.instance());
+  if (!instance || instance->test() != run.test()) return "";
   try {
     lab::check_contact_range(
-        rpc::job_material(spec, &*instance, {run.parameters().begin(), run.parameters().end()}));
+        rpc::job_material(spec, instance, {run.parameters().begin(), run.parameters().end()}));
   } catch (const SimulationFailure& e) {
     return e.what();
   } catch (const InputError&) {

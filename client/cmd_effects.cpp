@@ -213,11 +213,8 @@ std::string job_export(v1::CampaignService::Stub& stub, const rpc::ChannelOption
                        std::int64_t id, std::int64_t job) {
   const v1::Campaign campaign = fetch_campaign(stub, channel, id);
   const v1::JobResult found = campaign_job(stub, channel, id, job);
-  const auto& tests = campaign.spec().tests();
-  const auto instance = std::find_if(tests.begin(), tests.end(), [&](const v1::LabTest& t) {
-    return rpc::instance_name(t) == found.test();
-  });
-  if (instance == tests.end())
+  const v1::LabTest* instance = rpc::find_instance(campaign.spec(), found.test());
+  if (!instance)
     throw InputError("--job", "job " + std::to_string(job) + " runs test instance '" +
                                   found.test() + "', which the campaign's spec does not have");
   if (found.parameters().empty() && found.settings().empty())

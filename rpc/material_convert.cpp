@@ -279,6 +279,12 @@ std::string instance_name(const v1::LabTest& t) {
   return t.name().empty() ? t.test() : t.name();
 }
 
+const v1::LabTest* find_instance(const v1::CampaignSpec& spec, const std::string& name) {
+  for (const auto& t : spec.tests())
+    if (instance_name(t) == name) return &t;
+  return nullptr;
+}
+
 lab::MaterialModel job_material(const v1::CampaignSpec& spec, const v1::LabTest* instance,
                                 const std::map<std::string, double>& parameters) {
   v1::JobSpec job;

@@ -36,6 +36,9 @@ v1::CampaignSpec canonical_spec(const v1::CampaignSpec& spec);
 /// `name`, or the lab test's when it has none.
 std::string instance_name(const v1::LabTest& test);
 
+/// The test instance of `spec` named `name` (instance_name); null when the spec has none.
+const v1::LabTest* find_instance(const v1::CampaignSpec& spec, const std::string& name);
+
 /// The material a test instance runs with: `material` with the instance's own wall law and bed
 /// preparation, if any.
 v1::Material instance_material(const v1::Material& material, const v1::LabTest& test);
