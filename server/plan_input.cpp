@@ -113,6 +113,10 @@ diagnose::Options diagnose_options(const v1::DiagnoseOptions& o, const std::stri
     throw InputError(where + ".replicates", "must be 0 (the default, 1) or in [1, " +
                                                 std::to_string(kMaxDiagnosisReplicates) + "]");
   if (o.replicates() > 0) out.replicates = o.replicates();
+  if (o.rows() == "nested")
+    out.nested = true;
+  else if (!o.rows().empty() && o.rows() != "all")
+    throw InputError(where + ".rows", "unknown '" + o.rows() + "' (all or nested)");
   return out;
 }
 

@@ -79,7 +79,7 @@ Json diagnosis_json(const diagnose::Options& o) {
   return {{"candidates", o.candidates},   {"aspect_ratio_max", o.aspect_ratio_max},
           {"rolling_max", o.rolling_max}, {"sigma_g_max", o.sigma_g_max},
           {"fixed_span", o.fixed_span},   {"margin", o.margin},
-          {"replicates", o.replicates}};
+          {"replicates", o.replicates},   {"nested", o.nested}};
 }
 
 void diagnosis_from(const Json& j, diagnose::Options& o) {
@@ -90,6 +90,8 @@ void diagnosis_from(const Json& j, diagnose::Options& o) {
   o.fixed_span = j.at("fixed_span");
   o.margin = j.at("margin");
   o.replicates = j.at("replicates");
+  // Plans stored before the option existed repeat every factorial run.
+  o.nested = j.value("nested", false);
 }
 
 /// The design, its responses, targets and fidelity axis: what every form of the plan holds.

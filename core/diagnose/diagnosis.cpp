@@ -88,9 +88,26 @@ Eigen::MatrixXd factorial_rows(const Eigen::MatrixXd& x) {
   return out;
 }
 
-/// The base factorial runs crossed with a new factor at the given coded levels.
-Eigen::MatrixXd crossed(const Eigen::MatrixXd& design, const std::vector<double>& levels) {
-  const Eigen::MatrixXd f = factorial_rows(design);
+/// The base runs a model extension repeats at its new factor's other levels: every factorial
+/// run, or with `nested` the fraction nested in them that still estimates every main effect.
+/// Against the base design's two-factor model that fraction keeps the new factor's main effect,
+/// its square and its interaction with every base factor clear (a base main effect's alias in
+/// the fraction is a two-factor interaction the base design estimates), at half the runs or less.
+Eigen::MatrixXd crossing_rows(const Problem& p) {
+  if (!p.options.nested || p.nested_rows.empty()) return factorial_rows(p.design);
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(p.nested_rows.size()), p.design.cols());
+  for (std::size_t i = 0; i < p.nested_rows.size(); ++i) {
+    const Eigen::Index r = p.nested_rows[i];
+    if (r < 0 || r >= p.design.rows() || !is_factorial(p.design, r))
+      throw InputError("diagnose.rows", "nested row " + std::to_string(r + 1) +
+                                            " is not a factorial run of the design");
+    out.row(Eigen::Index(i)) = p.design.row(r);
+  }
+  return out;
+}
+
+/// Base runs crossed with a new factor at the given coded levels.
+Eigen::MatrixXd crossed(const Eigen::MatrixXd& f, const std::vector<double>& levels) {
   Eigen::MatrixXd out(f.rows() * Eigen::Index(levels.size()), f.cols() + 1);
   Eigen::Index r = 0;
   for (double level : levels)
@@ -118,7 +135,7 @@ Plan new_factor_plan(const Problem& p, std::string id, std::string cause,
   std::vector<double> levels;
   if (plan.base_coded > -1.0 + 1e-9) levels.push_back(-1.0);
   if (plan.base_coded < 1.0 - 1e-9) levels.push_back(1.0);
-  plan.new_rows = crossed(p.design, levels);
+  plan.new_rows = crossed(crossing_rows(p), levels);
   // A run at the middle of the new factor (the design centre otherwise) lets the model bend
   // along it: a new physical parameter seldom acts linearly over its whole range.
   if (std::abs(plan.base_coded) > 1e-9) {

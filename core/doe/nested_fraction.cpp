@@ -89,4 +89,8 @@ std::vector<int> nested_fraction(const Design& design, int min_runs) {
   return rows;
 }
 
+std::vector<int> main_effect_fraction(const Design& design) {
+  return nested_fraction(design, design.factors() + 1);
+}
+
 }  // namespace demcal::doe

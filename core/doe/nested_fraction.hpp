@@ -16,4 +16,9 @@ namespace demcal::doe {
 /// fraction; all of them when no halving keeps `min_runs` runs at resolution III or more.
 std::vector<int> nested_fraction(const Design& design, int min_runs);
 
+/// The smallest nested fraction that still estimates every main effect: at least k + 1 runs at
+/// resolution III or more (a multi-fidelity campaign's default high rows; the diagnosis's
+/// model extensions with `rows: nested`).
+std::vector<int> main_effect_fraction(const Design& design);
+
 }  // namespace demcal::doe

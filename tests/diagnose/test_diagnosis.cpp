@@ -72,12 +72,13 @@ Eigen::MatrixXd base_design() {
 }
 
 Problem make_problem(const Simulator& sim, const std::vector<std::string>& responses,
-                     const std::vector<Measurement>& measurements) {
+                     const std::vector<Measurement>& measurements,
+                     const Eigen::MatrixXd& design = base_design()) {
   Problem p;
   const char* paths[3] = {kA, kB, kC};
   for (int f = 0; f < 3; ++f)
     p.factors.push_back({paths[f], doe::Factor{paths[f], kLow[f], kHigh[f]}});
-  p.design = base_design();
+  p.design = design;
   p.responses = responses;
   p.results.resize(p.design.rows(), Eigen::Index(responses.size()));
   for (Eigen::Index r = 0; r < p.design.rows(); ++r) {
@@ -817,6 +818,67 @@ TEST(Diagnosis, HiddenValueOfAFixedParameterIsNamedAndRecovered) {
   EXPECT_LT(c->verified_rms, 0.7 * r.baseline_verified_rms);
   // The cause states the fixed value as given, not rounded to six decimals.
   EXPECT_NE(c->cause.find(std::string(kWallHamaker) + " = 5e-19"), std::string::npos) << c->cause;
+}
+
+/// The full 2^3 in standard order (A fastest), then a centre run; its half I = ABC (rows 2, 3,
+/// 5 and 8, 1-based) is the smallest fraction nested in it that estimates every main effect.
+Eigen::MatrixXd full_design() {
+  Eigen::MatrixXd d(9, 3);
+  for (int r = 0; r < 8; ++r) d.row(r) << (r & 1 ? 1 : -1), (r & 2 ? 1 : -1), (r & 4 ? 1 : -1);
+  d.row(8).setZero();
+  return d;
+}
+const std::vector<int> kHalfAbc = {1, 2, 4, 7};
+
+/// The fixed wall's truth with the wall's Hamaker constant acting more where A is high and B
+/// low: its interactions with the base factors are what a crossed half must still see.
+Responses fixed_wall_interacting_truth(const Parameters& p, const Switches& s) {
+  Responses y = fixed_wall_truth(p, s);
+  const auto [a, b, c] = coded_point(p);
+  const auto it = p.find(kWallHamaker);
+  const double decades =
+      std::log10((it != p.end() ? it->second : kFixedWallHamaker) / kFixedWallHamaker);
+  y[kSf] += 0.01 * a * decades;
+  y[kCn] -= 0.15 * b * decades;
+  return y;
+}
+
+TEST(Diagnosis, ModelExtensionsOnTheNestedFractionRunHalfTheRunsAndRecoverTheHiddenValue) {
+  auto truth_point = natural_point(0.3, -0.2, 0.1);
+  truth_point[kWallHamaker] = kTrueWallHamaker;
+  const Simulator sim = fixed_wall_interacting_truth;
+  const auto ms = targets_at(sim(truth_point, {}), {kSf, kCn});
+  const std::string id = std::string("fixed:") + kWallHamaker;
+  Problem p = make_problem(sim, {kSf, kCn}, ms, full_design());
+  p.fixed[kWallHamaker] = kFixedWallHamaker;
+  p.options.fixed_span = 10.0;
+  p.options.candidates = {id};
+  p.nested_rows = kHalfAbc;
+
+  // Without `nested` the candidate repeats all 8 factorial runs at both ends: 16 runs.
+  EXPECT_EQ(of_group(diagnose::advance(p, {}).requests, id).size(), 16u);
+  const Report all = drive(p, sim).step.report;
+
+  p.options.nested = true;
+  const auto first = of_group(diagnose::advance(p, {}).requests, id);
+  ASSERT_EQ(first.size(), 8u);
+  for (const auto& run : first) {
+    const auto [a, b, c] = coded_point(run.parameters);
+    EXPECT_NEAR(a * b * c, 1.0, 1e-9) << "row " << run.row << " is not in the half I = ABC";
+  }
+  const Report nested = drive(p, sim).step.report;
+  for (const Report* r : {&all, &nested}) {
+    EXPECT_EQ(r->named_cause, id) << r->conclusion;
+    const CandidateOutcome* c = candidate(*r, id);
+    ASSERT_NE(c, nullptr);
+    EXPECT_NEAR(c->proposed.at(kWallHamaker) / kTrueWallHamaker, 1.0, 0.1);
+    EXPECT_LT(c->verified_rms, 0.01);
+  }
+  EXPECT_EQ(candidate(nested, id)->runs, 8);
+
+  // A row that is no factorial run of the design cannot be crossed.
+  p.nested_rows = {1, 8};
+  EXPECT_THROW(diagnose::advance(p, {}), InputError);
 }
 
 // --- e) inputs that cannot be diagnosed -----------------------------------------------------

@@ -144,6 +144,63 @@ diagnose: {candidates: [coarse_graining]}
   }
 }
 
+TEST_F(Service, NestedRowsHalveACandidatesRunsOnAMainEffectFraction) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  const std::string spec = R"(name: nested
+material:
+  particle_law:
+    normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
+    cohesion: {model: van_der_waals, hamaker: 1.0e-16, d_max: 4.4e-10}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 0.0005}}
+  density: 2500
+  real_median_radius: 0.00025
+tests:
+  - test: packing
+    settings: {particles: 30}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
+  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
+  - {path: particle_law.normal.youngs_modulus, low: 1.0e6, high: 4.0e6}
+design: {type: full_factorial}
+measurements:
+  - {metric: solid_fraction, value: 0.6}
+diagnose: {candidates: [coarse_graining], rows: nested}
+)";
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(spec, &id).ok());
+  for (int k = 0; k < 8; ++k)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+      (*c.mutable_metrics())["solid_fraction"] =
+          0.5 + 0.1 * job.parameters().at("particle_law.tangential.mu_s");
+      (*c.mutable_metrics())["coordination_number"] = 4.0 + 0.1 * k;
+    }));
+  v1::DiagnoseRequest diagnose;
+  diagnose.set_id(id);
+  v1::DiagnoseReply reply;
+  ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), diagnose, &reply).ok());
+  // The baseline, the half of the 2^3 at the powder's radius, and the middle run: 1 + 4 + 1,
+  // where every factorial run would be 1 + 8 + 1.
+  ASSERT_EQ(reply.jobs_queued(), 1 + 4 + 1);
+  std::set<int> products;
+  std::set<std::vector<int>> corners;
+  for (int k = 0; k < reply.jobs_queued(); ++k) {
+    v1::LeaseReply lease;
+    ASSERT_NO_FATAL_FAILURE(lease_as("fake", lease));
+    ASSERT_TRUE(lease.has_job());
+    const auto& p = lease.job().parameters();
+    if (!p.count("sizes.scale") || std::abs(p.at("sizes.scale") - 0.5) > 1e-9) continue;
+    const std::vector<int> corner{p.at("particle_law.tangential.mu_s") > 0.3 ? 1 : -1,
+                                  p.at("particle_law.normal.restitution") > 0.4 ? 1 : -1,
+                                  p.at("particle_law.normal.youngs_modulus") > 2.5e6 ? 1 : -1};
+    corners.insert(corner);
+    products.insert(corner[0] * corner[1] * corner[2]);
+  }
+  // Four distinct corners of one half, I = ABC or I = -ABC: every main effect estimable.
+  EXPECT_EQ(corners.size(), 4u);
+  EXPECT_EQ(products.size(), 1u);
+}
+
 TEST_F(Service, CentrePointsDifferCurvatureIsTestedAndTheCalibrationRoundsAreShownAsJson) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;

@@ -77,6 +77,7 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
       {tiny_spec(30, 0, "", "diagnose: {sigma_g_max: 1.0}\n"), "spec.diagnose.sigma_g_max"},
       {tiny_spec(30, 0, "", "diagnose: {fixed_span: -3}\n"), "spec.diagnose.fixed_span"},
       {tiny_spec(30, 0, "", "diagnose: {margin: 7}\n"), "spec.diagnose.margin"},
+      {tiny_spec(30, 0, "", "diagnose: {rows: some}\n"), "spec.diagnose.rows"},
       {[] {
          auto s = tiny_spec(30);
          s.replace(s.find("  - test: packing\n"), 18, "  - test: packing\n    threads: 100000\n");
