@@ -23,6 +23,7 @@ struct DiagnoseOptions {
   bool verbose = false, wait = true;
   std::string format = "table";
   std::uint64_t seed = 1;
+  std::string journal;  ///< embedded: the campaign journal taken from and kept; empty: none
 };
 
 /// A relative error as a percentage; "-" while it waits for a simulation.
@@ -128,9 +129,12 @@ void report(const v1::DiagnoseReply& reply, const std::string& format) {
 }
 
 void run(const DiagnoseOptions& o) {
-  with_campaign(o.campaign, o.workdir, o.local, o.verbose, o.channel,
-                [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
-                    std::int64_t id) { report(drive(stub, channel, id, o), o.format); });
+  with_campaign(
+      o.campaign, o.workdir, o.local, o.verbose, o.channel,
+      [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
+        report(drive(stub, channel, id, o), o.format);
+      },
+      o.journal);
 }
 
 }  // namespace
@@ -150,6 +154,9 @@ void add_diagnose_command(CLI::App& app) {
   cmd->add_option("--seed", o->seed, "calibration multi-start seed")->capture_default_str();
   cmd->add_option("--format", o->format, "table or json")->check(CLI::IsMember({"table", "json"}));
   cmd->add_flag("-v,--verbose", o->verbose, "embedded: coordinator and worker logs");
+  cmd->add_option("--journal", o->journal,
+                  "embedded: campaign journal whose runs are taken instead of simulated, each job "
+                  "finished appended (docs/journal.md)");
   cmd->callback([o] { run(*o); });
 }
 

@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <random>
 
 #include "core/common/error.hpp"
@@ -62,15 +63,22 @@ std::filesystem::path work_directory(const std::string& spec, const std::string&
 
 void with_campaign(const std::string& campaign, const std::string& workdir,
                    const LocalWorkers& local, bool verbose, const rpc::ChannelOptions& channel,
-                   const CampaignAction& act) {
+                   const CampaignAction& act, const std::string& journal) {
   if (std::filesystem::is_regular_file(campaign)) {
     const SpecFile file = read_campaign_spec(campaign);
+    // Read before anything starts: a journal with a bad line refuses the command.
+    std::optional<CampaignJournal> runs;
+    if (!journal.empty()) runs.emplace(journal);
     EmbeddedService service(work_directory(campaign, workdir), local, verbose);
+    if (runs) import_journal(service.stub(), service.channel(), *runs, file.spec, std::cerr);
     const std::int64_t id = service.submit_or_resume(file, std::cerr);
+    if (runs) service.keep_journal(*runs, id);
     watch_campaign(service.stub(), service.channel(), id, std::cerr);
     act(service.stub(), service.channel(), id);
     return;
   }
+  if (!journal.empty())
+    throw CLI::ValidationError("--journal", "only with a spec file (the embedded default)");
   std::int64_t id = 0;
   try {
     id = std::stoll(campaign);

@@ -281,6 +281,49 @@ TEST_F(Journal, AnInterruptedCampaignGoesOnElsewhereFromItsJournalToTheSameEffec
   EXPECT_EQ(output("second").at("effects"), output("whole").at("effects"));
 }
 
+TEST_F(Journal, ADiagnosisKeepsItsRunsInTheJournalAndGoesOnFromItElsewhere) {
+  const std::string spec = path("diag.yaml");
+  std::ofstream(spec) << packing_spec("diag", 0.75) << R"(measurements:
+  - {metric: solid_fraction, value: 0.6, uncertainty: 0.02}
+  - {metric: coordination_number, value: 5.5}
+diagnose: {candidates: [curvature]}
+)";
+  const std::string journal = path("diag.jsonl");
+  auto diagnose = [&](const std::string& work, const std::string& where) {
+    Process p({DEMCAL_CLI_BIN, "diagnose", spec, "--workdir", path(work), "--workers", "1",
+               "--threads", "1", "--format", "json", "--journal", where},
+              path(work + ".json"), path(work + ".err"));
+    return p.wait_exit(120);
+  };
+  ASSERT_EQ(diagnose("first", journal), 0) << file_lines(path("first.err")).back();
+  // The design's four runs, the baseline, the candidate's axial and centre runs and its
+  // verifications: every run the diagnosis simulated is a run of the journal (a verification at
+  // a point already run takes that run's result).
+  const auto first = stored_jobs("first");
+  std::set<std::string> distinct;
+  for (const auto& job : first) distinct.insert(job.run_key);
+  const auto keys = journal_keys(journal);
+  EXPECT_GE(first.size(), 4u + 1u + 5u + 1u);
+  EXPECT_EQ(std::set<std::string>(keys.begin(), keys.end()), distinct);
+  EXPECT_EQ(simulated_and_reused("first").first, static_cast<int>(distinct.size()));
+
+  // Elsewhere, from the journal: nothing is simulated again and the report is the same.
+  ASSERT_EQ(diagnose("second", journal), 0);
+  const auto [simulated, reused] = simulated_and_reused("second");
+  EXPECT_EQ(simulated, 0);
+  EXPECT_EQ(reused, static_cast<int>(first.size()));
+  EXPECT_EQ(output("second"), output("first"));
+  EXPECT_EQ(journal_keys(journal), keys);
+
+  // A journal is the embedded default's: with a campaign id it is refused.
+  Process by_id({DEMCAL_CLI_BIN, "diagnose", "1", "--journal", journal}, path("id.out"),
+                path("id.err"));
+  EXPECT_NE(by_id.wait_exit(30), 0);
+  std::ifstream in(path("id.err"));
+  const std::string err((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(err.find("--journal"), std::string::npos) << err;
+}
+
 TEST_F(Journal, AJournalOfAnotherSpecGivesExactlyTheRunsWhoseKeysMatch) {
   ASSERT_NO_FATAL_FAILURE(run_a());
   const std::string journal = path("a.jsonl");
