@@ -83,7 +83,7 @@ diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRo
   for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
   describe_size(plan, p);
   p.options = plan.diagnosis;
-  if (p.options.nested) p.nested_rows = doe::main_effect_fraction(plan.design);
+  if (p.options.nested) p.nested_rows = doe::main_effect_half(plan.design);
   p.options.seed = seed ? seed : 1;
   return p;
 }

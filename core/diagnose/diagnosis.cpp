@@ -89,10 +89,10 @@ Eigen::MatrixXd factorial_rows(const Eigen::MatrixXd& x) {
 }
 
 /// The base runs a model extension repeats at its new factor's other levels: every factorial
-/// run, or with `nested` the fraction nested in them that still estimates every main effect.
-/// Against the base design's two-factor model that fraction keeps the new factor's main effect,
-/// its square and its interaction with every base factor clear (a base main effect's alias in
-/// the fraction is a two-factor interaction the base design estimates), at half the runs or less.
+/// run, or with `nested` the half of them chosen for a main-effect model (Problem::nested_rows).
+/// The base runs estimate the base model; on the half, whose runs estimate every main effect,
+/// the new factor's main effect, its square (with the middle run) and its interaction with every
+/// base factor are estimable on top of it, at half the runs.
 Eigen::MatrixXd crossing_rows(const Problem& p) {
   if (!p.options.nested || p.nested_rows.empty()) return factorial_rows(p.design);
   Eigen::MatrixXd out(static_cast<Eigen::Index>(p.nested_rows.size()), p.design.cols());

@@ -93,8 +93,8 @@ struct Options {
   /// lab seeds (offsets 0..replicates - 1) and its metrics averaged: the noise of a verified
   /// error falls as 1 / sqrt(replicates), at that many times the verification runs.
   int replicates = 1;
-  /// The model extensions repeat only the fraction of the base factorial runs nested in them
-  /// that still estimates every main effect (`Problem::nested_rows`), not all of them.
+  /// The model extensions repeat only half the base factorial runs, chosen for a main-effect
+  /// model (`Problem::nested_rows`), not all of them.
   bool nested = false;
 };
 
@@ -126,8 +126,8 @@ struct Problem {
   std::map<std::string, double> bond_scaled;
   std::map<std::string, double> fixed;  ///< parameters held fixed (path -> value)
   std::map<std::string, std::pair<double, double>> valid;  ///< valid range of each path
-  /// Rows (0-based) of `design` that form the fraction nested in its factorial runs that still
-  /// estimates every main effect (doe::nested_fraction); used when `options.nested`.
+  /// Rows (0-based) of `design`: half its factorial runs, chosen for a main-effect model
+  /// (doe::main_effect_half); used when `options.nested`.
   std::vector<int> nested_rows;
   Options options;
 };

@@ -1,5 +1,6 @@
 #include "core/doe/nested_fraction.hpp"
 
+#include <algorithm>
 #include <optional>
 
 #include "core/doe/alias_structure.hpp"
@@ -91,6 +92,54 @@ std::vector<int> nested_fraction(const Design& design, int min_runs) {
 
 std::vector<int> main_effect_fraction(const Design& design) {
   return nested_fraction(design, design.factors() + 1);
+}
+
+namespace {
+
+/// log det of X'X for the main-effect model on `rows` (a tiny ridge keeps a singular start
+/// comparable: every exchange that makes it regular is an improvement).
+double main_effect_log_det(const Design& d, const std::vector<int>& rows) {
+  Eigen::MatrixXd x(Eigen::Index(rows.size()), d.factors() + 1);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    x(Eigen::Index(i), 0) = 1.0;
+    x.row(Eigen::Index(i)).tail(d.factors()) = d.coded.row(rows[i]);
+  }
+  const Eigen::MatrixXd info =
+      x.transpose() * x + 1e-9 * Eigen::MatrixXd::Identity(x.cols(), x.cols());
+  return 2.0 * Eigen::MatrixXd(info.llt().matrixL()).diagonal().array().log().sum();
+}
+
+}  // namespace
+
+std::vector<int> main_effect_half(const Design& design) {
+  const std::vector<int> all = factorial_rows(design);
+  const std::size_t size = std::max<std::size_t>((all.size() + 1) / 2, design.factors() + 1);
+  if (size >= all.size()) return all;
+  const std::vector<int> regular = nested_fraction(design, static_cast<int>(size));
+  if (regular.size() == size) return regular;
+  std::vector<int> in(all.begin(), all.begin() + std::ptrdiff_t(size));
+  std::vector<int> out(all.begin() + std::ptrdiff_t(size), all.end());
+  double best = main_effect_log_det(design, in);
+  // Each pass makes the best single exchange; a strict gain ends the search in finitely many.
+  for (bool improved = true; improved;) {
+    improved = false;
+    std::size_t bi = 0, bo = 0;
+    for (std::size_t i = 0; i < in.size(); ++i)
+      for (std::size_t o = 0; o < out.size(); ++o) {
+        std::swap(in[i], out[o]);
+        const double v = main_effect_log_det(design, in);
+        std::swap(in[i], out[o]);
+        if (v > best + 1e-9) {
+          best = v;
+          bi = i;
+          bo = o;
+          improved = true;
+        }
+      }
+    if (improved) std::swap(in[bi], out[bo]);
+  }
+  std::sort(in.begin(), in.end());
+  return in;
 }
 
 }  // namespace demcal::doe

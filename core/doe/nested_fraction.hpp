@@ -21,4 +21,13 @@ std::vector<int> nested_fraction(const Design& design, int min_runs);
 /// model extensions with `rows: nested`).
 std::vector<int> main_effect_fraction(const Design& design);
 
+/// Half the first replicate's factorial runs (rounded up, at least k + 1) for a main-effect
+/// model: the regular half of resolution III or more where one exists (nested_fraction), else
+/// the half whose main-effect information matrix X'X (intercept and k main effects) has the
+/// largest determinant found by exchanging one run at a time from the first half (Fedorov's
+/// exchange, Atkinson, Donev and Tobias 2007, Optimum Experimental Designs, ch. 12). A 2^(5-1)
+/// of resolution V has no regular half of resolution III (any word added to ABCDE leaves a word
+/// of two letters or fewer), but has non-regular halves that estimate every main effect.
+std::vector<int> main_effect_half(const Design& design);
+
 }  // namespace demcal::doe

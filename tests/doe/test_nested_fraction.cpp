@@ -3,6 +3,7 @@
 // main effect, at the best resolution a half of a half can keep.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 
 #include "core/doe/alias_structure.hpp"
@@ -67,6 +68,47 @@ TEST(NestedFraction, ADesignWithNoSmallerFractionGivesAllItsFactorialRuns) {
   replicate_runs(d, 2);
   const auto rows = nested_fraction(d, 4);
   EXPECT_EQ(rows, (std::vector<int>{0, 1, 2, 3}));  // the first replicate's factorial runs
+}
+
+/// log det of X'X of the main-effect model (intercept and k main effects) on `rows`.
+double log_det(const Design& d, const std::vector<int>& rows) {
+  Eigen::MatrixXd x(Eigen::Index(rows.size()), d.factors() + 1);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    x(Eigen::Index(i), 0) = 1.0;
+    x.row(Eigen::Index(i)).tail(d.factors()) = d.coded.row(rows[i]);
+  }
+  return std::log((x.transpose() * x).determinant());
+}
+
+TEST(NestedFraction, AResolutionFiveHalfFractionOfFiveFactorsHasOnlyANonRegularHalf) {
+  Design d = fractional_factorial(5, "E=ABCD");
+  add_centre_points(d, 1);
+  // No regular half keeps resolution III: the nested fraction is the whole design.
+  EXPECT_EQ(nested_fraction(d, 6).size(), 16u);
+  const auto half = main_effect_half(d);
+  ASSERT_EQ(half.size(), 8u);
+  EXPECT_EQ(std::set<int>(half.begin(), half.end()).size(), 8u);
+  for (const int r : half) EXPECT_LT(r, 16) << "the centre run is no factorial run";
+  // Every main effect estimable, and no half of the 16 runs does better (all 12,870 tried).
+  const double found = log_det(d, half);
+  ASSERT_TRUE(std::isfinite(found));
+  double best = -1e300;
+  for (int mask = 0; mask < (1 << 16); ++mask) {
+    if (__builtin_popcount(unsigned(mask)) != 8) continue;
+    std::vector<int> rows;
+    for (int r = 0; r < 16; ++r)
+      if (mask & (1 << r)) rows.push_back(r);
+    const double v = log_det(d, rows);
+    if (std::isfinite(v)) best = std::max(best, v);
+  }
+  EXPECT_NEAR(found, best, 1e-9);
+}
+
+TEST(NestedFraction, TheMainEffectHalfIsTheRegularHalfWhereOneExists) {
+  EXPECT_EQ(main_effect_half(full_factorial(3)), nested_fraction(full_factorial(3), 4));
+  const Design lactose = fractional_factorial(8, "F=ABC G=ABD H=ACDE");
+  EXPECT_EQ(main_effect_half(lactose), nested_fraction(lactose, 9));
+  EXPECT_EQ(main_effect_half(lactose).size(), 16u);
 }
 
 }  // namespace
