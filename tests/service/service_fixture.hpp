@@ -214,6 +214,22 @@ class Service : public ::testing::Test {
     ASSERT_TRUE(st.ok()) << st.error_message();
   }
 
+  /// Completes the `design_jobs` design jobs of a packing campaign with fake metrics (the solid
+  /// fraction rising with mu_s), then calls Diagnose once: the runs it queues first.
+  void finish_design_and_diagnose(std::int64_t id, int design_jobs, v1::DiagnoseReply& reply) {
+    for (int k = 0; k < design_jobs; ++k)
+      ASSERT_NO_FATAL_FAILURE(
+          complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+            (*c.mutable_metrics())["solid_fraction"] =
+                0.5 + 0.1 * job.parameters().at("particle_law.tangential.mu_s");
+            (*c.mutable_metrics())["coordination_number"] = 4.0 + 0.1 * k;
+          }));
+    v1::DiagnoseRequest diagnose;
+    diagnose.set_id(id);
+    const auto st = campaigns_->Diagnose(ctx().get(), diagnose, &reply);
+    ASSERT_TRUE(st.ok()) << st.error_message();
+  }
+
   bool campaign_done(std::int64_t id) {
     v1::GetRequest req;
     req.set_id(id);

@@ -59,15 +59,10 @@ TEST_F(Service, DiagnoseOrVerifyOnACancelledCampaignIsRefusedAndQueuesNothing) {
   for (const auto& j : r.jobs()) EXPECT_EQ(j.state(), "cancelled");
 }
 
-// The coordinator's coarse_graining runs (docs/diagnosis.md): a cohesive material of radius
-// 0.5 mm stating the powder's median radius 0.25 mm. Its four design runs finished (fake
-// metrics), one Diagnose call queues the candidate's runs: the factorial rows at half the
-// radius and the middle row at 1 / sqrt(2) of it, each with the Hamaker constant of the
-// particle law and of the wall law (a copy of it) at the same Bond number, A_H (r / 0.5 mm)^2.
-// A test instance with a wall law of its own keeps its walls' adhesion.
-TEST_F(Service, CoarseGrainingRunsHoldTheBondNumberInBothLaws) {
-  start_server(/*lease=*/30, /*heartbeat=*/5);
-  const std::string spec = R"(
+/// A cohesive packing of 30 spheres of radius 0.5 mm whose material states the powder's median
+/// radius 0.25 mm: the coarse_graining candidate applies to it.
+std::string coarse_grained_packing() {
+  return R"(
 material:
   particle_law:
     normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
@@ -79,6 +74,17 @@ material:
 tests:
   - test: packing
     settings: {particles: 30})";
+}
+
+// The coordinator's coarse_graining runs (docs/diagnosis.md): a cohesive material of radius
+// 0.5 mm stating the powder's median radius 0.25 mm. Its four design runs finished (fake
+// metrics), one Diagnose call queues the candidate's runs: the factorial rows at half the
+// radius and the middle row at 1 / sqrt(2) of it, each with the Hamaker constant of the
+// particle law and of the wall law (a copy of it) at the same Bond number, A_H (r / 0.5 mm)^2.
+// A test instance with a wall law of its own keeps its walls' adhesion.
+TEST_F(Service, CoarseGrainingRunsHoldTheBondNumberInBothLaws) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  const std::string spec = coarse_grained_packing();
   auto rest = [](const std::string& second_factor) {
     return R"(
 factors:
@@ -109,17 +115,8 @@ diagnose: {candidates: [coarse_graining]}
                            (own_walls ? own_wall_law : "") + factors,
                        &id)
                     .ok());
-    for (int k = 0; k < 4; ++k)
-      ASSERT_NO_FATAL_FAILURE(
-          complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
-            (*c.mutable_metrics())["solid_fraction"] =
-                0.5 + 0.1 * job.parameters().at("particle_law.tangential.mu_s");
-            (*c.mutable_metrics())["coordination_number"] = 4.0 + 0.1 * k;
-          }));
-    v1::DiagnoseRequest diagnose;
-    diagnose.set_id(id);
     v1::DiagnoseReply reply;
-    ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), diagnose, &reply).ok());
+    ASSERT_NO_FATAL_FAILURE(finish_design_and_diagnose(id, 4, reply));
     ASSERT_EQ(reply.jobs_queued(), 1 + 5);  // the baseline and the candidate's runs
     std::multiset<double> scales;
     for (int k = 0; k < reply.jobs_queued(); ++k) {
@@ -146,18 +143,7 @@ diagnose: {candidates: [coarse_graining]}
 
 TEST_F(Service, NestedRowsHalveACandidatesRunsOnAMainEffectFraction) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
-  const std::string spec = R"(name: nested
-material:
-  particle_law:
-    normal: {model: hertz, youngs_modulus: 2.0e6, restitution: 0.3}
-    cohesion: {model: van_der_waals, hamaker: 1.0e-16, d_max: 4.4e-10}
-    tangential: {model: history, mu_s: 0.3}
-  sizes: {monodisperse: {radius: 0.0005}}
-  density: 2500
-  real_median_radius: 0.00025
-tests:
-  - test: packing
-    settings: {particles: 30}
+  const std::string spec = "name: nested" + coarse_grained_packing() + R"(
 factors:
   - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
   - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
@@ -169,16 +155,8 @@ diagnose: {candidates: [coarse_graining], rows: nested}
 )";
   std::int64_t id = 0;
   ASSERT_TRUE(submit(spec, &id).ok());
-  for (int k = 0; k < 8; ++k)
-    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
-      (*c.mutable_metrics())["solid_fraction"] =
-          0.5 + 0.1 * job.parameters().at("particle_law.tangential.mu_s");
-      (*c.mutable_metrics())["coordination_number"] = 4.0 + 0.1 * k;
-    }));
-  v1::DiagnoseRequest diagnose;
-  diagnose.set_id(id);
   v1::DiagnoseReply reply;
-  ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), diagnose, &reply).ok());
+  ASSERT_NO_FATAL_FAILURE(finish_design_and_diagnose(id, 8, reply));
   // The baseline, the half of the 2^3 at the powder's radius, and the middle run: 1 + 4 + 1,
   // where every factorial run would be 1 + 8 + 1.
   ASSERT_EQ(reply.jobs_queued(), 1 + 4 + 1);
