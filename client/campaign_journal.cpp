@@ -1,5 +1,7 @@
 #include "client/campaign_journal.hpp"
 
+#include <google/protobuf/util/json_util.h>
+
 #include <chrono>
 #include <iostream>
 #include <map>
@@ -39,16 +41,30 @@ std::string other_protocols(const std::vector<v1::JournalRun>& runs,
   return text;
 }
 
+/// The spec a header line names (CampaignSpec as JSON), or none when it cannot be read so.
+std::optional<v1::CampaignSpec> header_spec(const v1::JournalHeader& header) {
+  v1::CampaignSpec spec;
+  google::protobuf::util::JsonParseOptions options;
+  options.ignore_unknown_fields = true;
+  if (!google::protobuf::util::JsonStringToMessage(header.spec(), &spec, options).ok())
+    return std::nullopt;
+  return spec;
+}
+
 /// Whether the current build refuses to simulate `run`'s material (lab::check_contact_range),
-/// built as campaign `spec` builds it for the run's test instance; its reason, or empty. A run of
-/// an instance the spec does not have, or whose parameters do not apply to the spec's material
-/// (a run of another spec), is not checked: its material cannot be rebuilt here.
-std::string refusal(const v1::JournalRun& run, const v1::CampaignSpec& spec) {
-  const v1::LabTest* instance = rpc::find_instance(spec, run.instance());
+/// built as the campaign that wrote it built it (`own`, its header's spec), or else as `spec`
+/// builds it, for the run's test instance; its reason, or empty. A run of an instance neither
+/// spec has, or whose parameters do not apply to that spec's material, is not checked: its
+/// material cannot be rebuilt here.
+std::string refusal(const v1::JournalRun& run, const v1::CampaignSpec* own,
+                    const v1::CampaignSpec& spec) {
+  const v1::CampaignSpec* from = own;
+  const v1::LabTest* instance = from ? rpc::find_instance(*from, run.instance()) : nullptr;
+  if (!instance) instance = rpc::find_instance(*(from = &spec), run.instance());
   if (!instance || instance->test() != run.test()) return "";
   try {
     lab::check_contact_range(
-        rpc::job_material(spec, instance, {run.parameters().begin(), run.parameters().end()}));
+        rpc::job_material(*from, instance, {run.parameters().begin(), run.parameters().end()}));
   } catch (const SimulationFailure& e) {
     return e.what();
   } catch (const InputError&) {
@@ -72,6 +88,7 @@ void CampaignJournal::take(const std::string& text, std::size_t line) {
   auto parsed = rpc::parse_journal_line(text);
   if (std::holds_alternative<v1::JournalHeader>(parsed)) {
     header_ = text;
+    specs_.push_back(header_spec(std::get<v1::JournalHeader>(parsed)));
     return;
   }
   if (line == 1)
@@ -82,6 +99,7 @@ void CampaignJournal::take(const std::string& text, std::size_t line) {
   if (!held_.insert({run.run_key(), run.protocol()}).second) return;
   run.set_source(file_.where(line));
   runs_.push_back(std::move(run));
+  run_segment_.push_back(specs_.size() - 1);
 }
 
 void CampaignJournal::append_export(const std::string& content) {
@@ -110,8 +128,9 @@ void import_journal(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& 
   std::vector<const v1::JournalRun*> offered;
   std::size_t refused = 0;
   std::string reason;
-  for (const auto& run : journal.runs()) {
-    const std::string why = refusal(run, spec);
+  for (std::size_t i = 0; i < journal.runs().size(); ++i) {
+    const auto& run = journal.runs()[i];
+    const std::string why = refusal(run, journal.spec_of(i), spec);
     if (why.empty()) {
       offered.push_back(&run);
     } else if (refused++ == 0) {

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <mutex>
+#include <optional>
 #include <ostream>
 #include <set>
 #include <string>
@@ -31,6 +32,12 @@ class CampaignJournal {
   const std::filesystem::path& path() const { return file_.path(); }
   /// The runs read, each with its source (FILE:LINE).
   const std::vector<v1::JournalRun>& runs() const { return runs_; }
+  /// The spec of the campaign that wrote runs()[i]: its segment's header's; null when that
+  /// header's spec cannot be read as a campaign spec (another build's, say).
+  const v1::CampaignSpec* spec_of(std::size_t i) const {
+    const auto& spec = specs_[run_segment_[i]];
+    return spec ? &*spec : nullptr;
+  }
   /// Whether the journal has a line of this run key written under this lab protocol version.
   bool holds(const std::string& run_key, int protocol) const {
     return held_.count({run_key, protocol}) > 0;
@@ -46,8 +53,10 @@ class CampaignJournal {
 
   JsonLinesFile file_;
   std::vector<v1::JournalRun> runs_;
-  std::set<std::pair<std::string, int>> held_;  ///< run key, protocol of every run line
-  std::string header_;                          ///< the latest header line of the file
+  std::vector<std::optional<v1::CampaignSpec>> specs_;  ///< of each header line, in order
+  std::vector<std::size_t> run_segment_;                ///< of each run: its header's index
+  std::set<std::pair<std::string, int>> held_;          ///< run key, protocol of every run line
+  std::string header_;                                  ///< the latest header line of the file
 };
 
 /// Offers the journal's runs to the coordinator (ImportRuns, in batches of about 1 MiB) and says

@@ -408,6 +408,21 @@ TEST_F(Journal, RunsOfAMaterialThisBuildRefusesAreNotTaken) {
     EXPECT_EQ(job.reused, job.run_key != changed.at("run_key")) << job.run_key;
     EXPECT_EQ(job.metrics.find("0.999"), std::string::npos) << job.metrics;
   }
+  // A spec that names its instance otherwise plans the same runs (an instance's name is no part
+  // of a run key) but has no instance of the journal's name: the run is checked against the spec
+  // its journal segment was written by, and is not taken either.
+  std::string renamed = spec;
+  const std::string instance = "  - test: packing\n";
+  renamed.replace(renamed.find(instance), instance.size(), instance + "    name: bed\n");
+  std::ofstream(path("b.yaml")) << renamed;
+  ASSERT_EQ(run(path("b.yaml"), "renamed", journal, err), 0) << err;
+  EXPECT_NE(err.find("1 run(s) not taken: their material is one this build refuses"),
+            std::string::npos)
+      << err;
+  for (const auto& job : stored_jobs("renamed")) {
+    EXPECT_EQ(job.reused, job.run_key != changed.at("run_key")) << job.run_key;
+    EXPECT_EQ(job.metrics.find("0.999"), std::string::npos) << job.metrics;
+  }
 }
 
 // A run whose parameters do not apply to this spec's material (a path of another spec's laws)
