@@ -157,7 +157,7 @@ void plan_targets(const v1::CampaignSpec& spec, CampaignPlan& plan) {
 /// nested in the design that still estimates every main effect when it is smaller than the
 /// design (else the centre point alone; a design without centre points: that fraction).
 std::vector<int> default_high_rows(const doe::Design& d) {
-  const std::vector<int> fraction = doe::main_effect_fraction(d);
+  const std::vector<int> fraction = doe::nested_fraction(d, d.factors() + 1);
   std::vector<int> rows;
   int factorial = 0, centre = -1;
   for (int r = 0; r < d.runs(); ++r) {

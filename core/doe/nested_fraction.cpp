@@ -90,10 +90,6 @@ std::vector<int> nested_fraction(const Design& design, int min_runs) {
   return rows;
 }
 
-std::vector<int> main_effect_fraction(const Design& design) {
-  return nested_fraction(design, design.factors() + 1);
-}
-
 namespace {
 
 /// log det of X'X for the main-effect model on `rows` (a tiny ridge keeps a singular start

@@ -16,11 +16,6 @@ namespace demcal::doe {
 /// fraction; all of them when no halving keeps `min_runs` runs at resolution III or more.
 std::vector<int> nested_fraction(const Design& design, int min_runs);
 
-/// The smallest nested fraction that still estimates every main effect: at least k + 1 runs at
-/// resolution III or more (a multi-fidelity campaign's default high rows; the diagnosis's
-/// model extensions with `rows: nested`).
-std::vector<int> main_effect_fraction(const Design& design);
-
 /// Half the first replicate's factorial runs (rounded up, at least k + 1) for a main-effect
 /// model: the regular half of resolution III or more where one exists (nested_fraction), else
 /// the half whose main-effect information matrix X'X (intercept and k main effects) has the
