@@ -1,7 +1,5 @@
 #include "client/campaign_journal.hpp"
 
-#include <google/protobuf/util/json_util.h>
-
 #include <chrono>
 #include <iostream>
 #include <map>
@@ -12,6 +10,7 @@
 #include "core/lab/bed.hpp"
 #include "rpc/journal_line.hpp"
 #include "rpc/material_convert.hpp"
+#include "server/stored_columns.hpp"
 
 namespace demcal::cli {
 namespace {
@@ -41,14 +40,14 @@ std::string other_protocols(const std::vector<v1::JournalRun>& runs,
   return text;
 }
 
-/// The spec a header line names (CampaignSpec as JSON), or none when it cannot be read so.
+/// The spec a header line names (the coordinator's stored spec JSON), or none when this build
+/// cannot read it (another build's fields).
 std::optional<v1::CampaignSpec> header_spec(const v1::JournalHeader& header) {
-  v1::CampaignSpec spec;
-  google::protobuf::util::JsonParseOptions options;
-  options.ignore_unknown_fields = true;
-  if (!google::protobuf::util::JsonStringToMessage(header.spec(), &spec, options).ok())
+  try {
+    return server::spec_from_json(header.spec());
+  } catch (const InputError&) {
     return std::nullopt;
-  return spec;
+  }
 }
 
 /// Whether the current build refuses to simulate `run`'s material (lab::check_contact_range),
@@ -58,13 +57,13 @@ std::optional<v1::CampaignSpec> header_spec(const v1::JournalHeader& header) {
 /// material cannot be rebuilt here.
 std::string refusal(const v1::JournalRun& run, const v1::CampaignSpec* own,
                     const v1::CampaignSpec& spec) {
-  const v1::CampaignSpec* from = own;
-  const v1::LabTest* instance = from ? rpc::find_instance(*from, run.instance()) : nullptr;
-  if (!instance) instance = rpc::find_instance(*(from = &spec), run.instance());
+  const v1::LabTest* instance = own ? rpc::find_instance(*own, run.instance()) : nullptr;
+  const v1::CampaignSpec& from = instance ? *own : spec;
+  if (!instance) instance = rpc::find_instance(spec, run.instance());
   if (!instance || instance->test() != run.test()) return "";
   try {
     lab::check_contact_range(
-        rpc::job_material(*from, instance, {run.parameters().begin(), run.parameters().end()}));
+        rpc::job_material(from, instance, {run.parameters().begin(), run.parameters().end()}));
   } catch (const SimulationFailure& e) {
     return e.what();
   } catch (const InputError&) {

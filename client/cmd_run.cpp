@@ -40,9 +40,7 @@ void run_embedded(const RunOptions& opt) {
   auto* stub = &service.stub();
   const auto& channel = service.channel();
   text << "work directory: " << workdir.string() << " (SQLite: " << service.db() << ")\n";
-  if (journal) import_journal(*stub, channel, *journal, file.spec, text);
-  const std::int64_t id = service.submit_or_resume(file, text);
-  if (journal) service.keep_journal(*journal, id);
+  const std::int64_t id = service.submit_or_resume(file, text, journal ? &*journal : nullptr);
   if (!opt.http.empty())
     std::cerr << "live report page: " << service.serve_http(opt.http, id) << std::endl;
   text << std::flush;

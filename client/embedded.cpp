@@ -70,9 +70,7 @@ void with_campaign(const std::string& campaign, const std::string& workdir,
     std::optional<CampaignJournal> runs;
     if (!journal.empty()) runs.emplace(journal);
     EmbeddedService service(work_directory(campaign, workdir), local, verbose);
-    if (runs) import_journal(service.stub(), service.channel(), *runs, file.spec, std::cerr);
-    const std::int64_t id = service.submit_or_resume(file, std::cerr);
-    if (runs) service.keep_journal(*runs, id);
+    const std::int64_t id = service.submit_or_resume(file, std::cerr, runs ? &*runs : nullptr);
     watch_campaign(service.stub(), service.channel(), id, std::cerr);
     act(service.stub(), service.channel(), id);
     return;
@@ -161,10 +159,6 @@ void EmbeddedService::stop_on_signal(int sig) {
   if (keeper_) keeper_->sync();
 }
 
-void EmbeddedService::keep_journal(CampaignJournal& journal, std::int64_t id) {
-  keeper_ = std::make_unique<JournalKeeper>(journal, *stub_, channel_, id);
-}
-
 EmbeddedService::~EmbeddedService() {
   signalled_service = nullptr;
   if (http_) http_->stop();
@@ -189,7 +183,15 @@ void EmbeddedService::refuse_if_another_spec(std::int64_t id, const SpecFile& fi
                            "or the spec it was submitted with to resume it");
 }
 
-std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostream& out) {
+std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostream& out,
+                                               CampaignJournal* journal) {
+  if (journal) import_journal(*stub_, channel_, *journal, file.spec, out);
+  const std::int64_t id = submit_or_resume_campaign(file, out);
+  if (journal) keeper_ = std::make_unique<JournalKeeper>(*journal, *stub_, channel_, id);
+  return id;
+}
+
+std::int64_t EmbeddedService::submit_or_resume_campaign(const SpecFile& file, std::ostream& out) {
   v1::ListReply list;
   check(stub_->List(rpc::make_context(channel_, 30).get(), {}, &list), "list");
   std::int64_t id = 0;

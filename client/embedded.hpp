@@ -45,16 +45,17 @@ class EmbeddedService {
   /// The campaign of the spec's name in this work directory (the newest one not cancelled),
   /// or the spec submitted now (its design summary printed to `out`). Returns its id. A campaign
   /// of that name submitted with another spec is not resumed: InputError naming the directory.
-  std::int64_t submit_or_resume(const SpecFile& file, std::ostream& out);
+  /// With a `journal`, its runs are offered to the coordinator first (import_journal, its report
+  /// on `out`), and it is kept up to date with the campaign's finished jobs while this service
+  /// lives (JournalKeeper), with a last update once its workers have stopped, also on a stop
+  /// signal.
+  std::int64_t submit_or_resume(const SpecFile& file, std::ostream& out,
+                                CampaignJournal* journal = nullptr);
 
   /// Serves the live report page on `address` (HOST:PORT, loopback or with the embedded
   /// token) while this service lives. Returns the page's URL of campaign `id`, the token in
   /// its fragment (never sent to the server by a browser).
   std::string serve_http(const std::string& address, std::int64_t id);
-
-  /// Keeps `journal` up to date with campaign `id`'s finished jobs while this service lives
-  /// (JournalKeeper), with a last update once its workers have stopped, also on a stop signal.
-  void keep_journal(CampaignJournal& journal, std::int64_t id);
 
   /// SIGINT or SIGTERM `sig` (Ctrl-C, the end of a batch allocation): the workers give their
   /// leases back at once, uncounted, and return; the journal kept, if any, is brought up to
@@ -65,6 +66,8 @@ class EmbeddedService {
  private:
   /// Throws InputError unless campaign `id` was submitted with the spec of `file`.
   void refuse_if_another_spec(std::int64_t id, const SpecFile& file);
+  /// submit_or_resume without a journal.
+  std::int64_t submit_or_resume_campaign(const SpecFile& file, std::ostream& out);
 
   std::filesystem::path workdir_;
   std::string db_;

@@ -102,7 +102,7 @@ double main_effect_log_det(const Design& d, const std::vector<int>& rows) {
   }
   const Eigen::MatrixXd info =
       x.transpose() * x + 1e-9 * Eigen::MatrixXd::Identity(x.cols(), x.cols());
-  return 2.0 * Eigen::MatrixXd(info.llt().matrixL()).diagonal().array().log().sum();
+  return 2.0 * info.llt().matrixLLT().diagonal().array().log().sum();
 }
 
 }  // namespace
