@@ -9,6 +9,8 @@ namespace {
 
 /// Lab seeds per diagnosis verification at most: each multiplies its verification runs.
 constexpr int kMaxDiagnosisReplicates = 16;
+/// Verification rounds a diagnosis candidate at most: each is one more set simulated.
+constexpr int kMaxDiagnosisRounds = 10;
 
 /// The model of a test instance: the campaign's with the instance's wall law and preparation;
 /// errors in those name the instance's field.
@@ -113,6 +115,10 @@ diagnose::Options diagnose_options(const v1::DiagnoseOptions& o, const std::stri
     throw InputError(where + ".replicates", "must be 0 (the default, 1) or in [1, " +
                                                 std::to_string(kMaxDiagnosisReplicates) + "]");
   if (o.replicates() > 0) out.replicates = o.replicates();
+  if (o.rounds() < 0 || o.rounds() > kMaxDiagnosisRounds)
+    throw InputError(where + ".rounds", "must be 0 (the default, 3) or in [1, " +
+                                            std::to_string(kMaxDiagnosisRounds) + "]");
+  if (o.rounds() > 0) out.rounds = o.rounds();
   if (o.rows() == "nested")
     out.nested = true;
   else if (!o.rows().empty() && o.rows() != "all")

@@ -76,10 +76,15 @@ void calibration_from(const Json& j, CampaignPlan& p) {
 }
 
 Json diagnosis_json(const diagnose::Options& o) {
-  return {{"candidates", o.candidates},   {"aspect_ratio_max", o.aspect_ratio_max},
-          {"rolling_max", o.rolling_max}, {"sigma_g_max", o.sigma_g_max},
-          {"fixed_span", o.fixed_span},   {"margin", o.margin},
-          {"replicates", o.replicates},   {"nested", o.nested}};
+  return {{"candidates", o.candidates},
+          {"aspect_ratio_max", o.aspect_ratio_max},
+          {"rolling_max", o.rolling_max},
+          {"sigma_g_max", o.sigma_g_max},
+          {"fixed_span", o.fixed_span},
+          {"margin", o.margin},
+          {"replicates", o.replicates},
+          {"nested", o.nested},
+          {"rounds", o.rounds}};
 }
 
 void diagnosis_from(const Json& j, diagnose::Options& o) {
@@ -92,6 +97,8 @@ void diagnosis_from(const Json& j, diagnose::Options& o) {
   o.replicates = j.at("replicates");
   // Plans stored before the option existed repeat every factorial run.
   o.nested = j.value("nested", false);
+  // ... and verify up to the default number of rounds.
+  o.rounds = j.value("rounds", diagnose::Options{}.rounds);
 }
 
 /// The design, its responses, targets and fidelity axis: what every form of the plan holds.

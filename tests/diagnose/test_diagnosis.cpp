@@ -416,6 +416,30 @@ TEST(Diagnosis, CandidateKeepsItsBestVerifiedRoundWhenLaterRoundsMissMore) {
   EXPECT_EQ(r.named_cause, "rolling") << r.conclusion;
 }
 
+TEST(Diagnosis, ACandidateVerifiesAtMostItsRoundsOfTheOptions) {
+  // The drift above makes every round miss its tolerance, so a candidate goes on for as many
+  // rounds as it is given: one here.
+  auto truth_point = natural_point(0.2, -0.3, 0.1);
+  truth_point[kMuR] = kTrueMuR;
+  const Simulator sim = rolling_truth;
+  const auto ms = targets_at(sim(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  int verifications = 0;
+  const Disturbance drift = [&](const RunRequest& r, Responses& y) {
+    if (r.group != "rolling/verify") return;
+    y[kCn] *= 1.03;
+    ++verifications;
+  };
+  Problem p = make_problem(sim, {kSf, kCn}, ms);
+  p.options.rounds = 1;
+  const Report r = drive(p, sim, 30, drift).step.report;
+  const CandidateOutcome* c = candidate(r, "rolling");
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(r.state, "done");
+  EXPECT_EQ(c->rounds, 1);
+  EXPECT_EQ(verifications, 1);
+  EXPECT_GT(c->verified_rms, p.options.converged);
+}
+
 TEST(Diagnosis, HiddenClusterShapeIsNamedAndItsSpreadRecovered) {
   auto truth_point = natural_point(-0.3, 0.2, 0.4);
   truth_point[kSpread] = 0.6;

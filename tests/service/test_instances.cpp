@@ -291,6 +291,24 @@ design: {type: full_factorial}
 )";
 }
 
+TEST(TestInstances, TheDiagnosisOptionsOfTheSpecReadBackFromTheStoredPlan) {
+  const auto file = cli::parse_campaign_spec(
+      drums_spec() + "diagnose: {candidates: [rolling], rows: nested, rounds: 2}\n", "d.yaml");
+  std::vector<server::NewJob> jobs;
+  server::CampaignRow row;
+  row.spec_json = server::to_json(file.spec);
+  row.design_json = server::plan_to_json(server::plan_campaign(file.spec, jobs));
+  const auto stored = server::stored_plan(row).diagnosis;
+  EXPECT_EQ(stored.candidates, std::vector<std::string>{"rolling"});
+  EXPECT_TRUE(stored.nested);
+  EXPECT_EQ(stored.rounds, 2);
+  // A plan stored before the rounds were an option verifies as many as the default.
+  auto earlier = nlohmann::json::parse(row.design_json);
+  earlier["diagnosis"].erase("rounds");
+  row.design_json = earlier.dump();
+  EXPECT_EQ(server::stored_plan(row).diagnosis.rounds, diagnose::Options{}.rounds);
+}
+
 TEST(TestInstances, AnInstanceBuildsItsBedItsOwnWay) {
   const std::string grown = "    preparation: {method: growth, solid_fraction: 0.55}";
   const auto file = cli::parse_campaign_spec(grown_compression_spec(grown), "g.yaml");

@@ -78,6 +78,7 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
       {tiny_spec(30, 0, "", "diagnose: {fixed_span: -3}\n"), "spec.diagnose.fixed_span"},
       {tiny_spec(30, 0, "", "diagnose: {margin: 7}\n"), "spec.diagnose.margin"},
       {tiny_spec(30, 0, "", "diagnose: {rows: some}\n"), "spec.diagnose.rows"},
+      {tiny_spec(30, 0, "", "diagnose: {rounds: 11}\n"), "spec.diagnose.rounds"},
       {[] {
          auto s = tiny_spec(30);
          s.replace(s.find("  - test: packing\n"), 18, "  - test: packing\n    threads: 100000\n");
