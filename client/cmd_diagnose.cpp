@@ -60,7 +60,8 @@ void print_metrics(std::ostream& out, const v1::DiagnosisReport& r) {
   }
   const auto& b = r.baseline();
   out << "baseline RMS error: predicted " << pct(b.has_predicted_rms(), b.predicted_rms())
-      << ", verified " << pct(b.has_verified_rms(), b.verified_rms()) << ", held out "
+      << ", verified " << pct(b.has_verified_rms(), b.verified_rms())
+      << (b.has_verified_rms_se() ? " +- " + pct(true, b.verified_rms_se()) : "") << ", held out "
       << pct(b.has_holdout_rms(), b.holdout_rms()) << "\n";
 }
 

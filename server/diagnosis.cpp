@@ -148,6 +148,7 @@ v1::DiagnosisCandidate candidate_message(const diagnose::CandidateOutcome& c) {
   out.set_reaches_all(c.reaches_all);
   if (std::isfinite(c.predicted_rms)) out.set_predicted_rms(c.predicted_rms);
   if (std::isfinite(c.verified_rms)) out.set_verified_rms(c.verified_rms);
+  if (std::isfinite(c.verified_rms_se)) out.set_verified_rms_se(c.verified_rms_se);
   out.set_rounds(c.rounds);
   out.set_best_round(c.best_round);
   if (std::isfinite(c.design_misprediction)) out.set_design_misprediction(c.design_misprediction);
@@ -155,6 +156,7 @@ v1::DiagnosisCandidate candidate_message(const diagnose::CandidateOutcome& c) {
     if (std::isfinite(v)) (*out.mutable_simulated())[k] = v;
   if (std::isfinite(c.holdout_rms)) out.set_holdout_rms(c.holdout_rms);
   out.set_explains(c.explains);
+  out.set_within_noise(c.within_noise);
   out.set_evidence(c.evidence);
   return out;
 }
@@ -170,6 +172,7 @@ v1::DiagnosisReport report_message(const diagnose::Report& r) {
   b->mutable_proposed()->insert(r.baseline_proposed.begin(), r.baseline_proposed.end());
   if (std::isfinite(r.baseline_predicted_rms)) b->set_predicted_rms(r.baseline_predicted_rms);
   if (std::isfinite(r.baseline_verified_rms)) b->set_verified_rms(r.baseline_verified_rms);
+  if (std::isfinite(r.baseline_verified_rms_se)) b->set_verified_rms_se(r.baseline_verified_rms_se);
   if (std::isfinite(r.baseline_holdout_rms)) b->set_holdout_rms(r.baseline_holdout_rms);
   for (const auto& c : r.conflicts) {
     auto* m = out.add_conflicts();

@@ -426,6 +426,11 @@ std::string percent(double x) {
   return s.str();
 }
 
+/// An error with its standard error where the replicates give one: "12.3 % +- 1.2 %".
+std::string with_se(double x, double se) {
+  return std::isfinite(se) ? percent(x) + " +- " + percent(se) : percent(x);
+}
+
 std::vector<Conflict> conflicts(const Problem& p, const Fitted& joint) {
   std::vector<Conflict> out;
   std::vector<std::size_t> calibrated;
@@ -466,6 +471,25 @@ std::map<std::string, double> replicate_mean(const Problem& p, const GroupResult
     for (const auto& [metric, value] : g->at(row)) mean[metric] += value / n;
   }
   return mean;
+}
+
+/// The standard error of a replicated verification's RMS error (rows first .. first +
+/// replicates - 1): the standard deviation of each replicate's own RMS error over
+/// sqrt(replicates); pending with one replicate, while one is pending or when one failed.
+double replicate_rms_se(const Problem& p, const std::vector<calib::MetricTarget>& targets,
+                        const GroupResults* g, int first) {
+  const int n = p.options.replicates;
+  if (n < 2) return kPending;
+  std::vector<double> each;
+  for (int row = first; row < first + n; ++row) {
+    if (!g || !g->count(row)) return kPending;
+    each.push_back(rms_error(p, targets, g->at(row), false));
+  }
+  double mean = 0.0;
+  for (const double e : each) mean += e / n;
+  double ss = 0.0;
+  for (const double e : each) ss += (e - mean) * (e - mean);
+  return std::sqrt(ss / (n - 1) / n);  // NaN when a replicate's error is
 }
 
 /// The replicated verification runs of one point: rows first .. first + replicates - 1.
@@ -518,6 +542,7 @@ std::vector<MetricRow> baseline_rows(const Problem& p, const Fitted& base,
 struct VerifiedPoint {
   std::map<std::string, double> proposed, simulated;
   double predicted_rms = kPending, verified_rms = kPending, holdout_rms = kPending;
+  double verified_rms_se = kPending;
   bool reaches_all = false;
   std::map<std::string, double> rescaled = {};  ///< the plan's rescaled parameters at `proposed`
 };
@@ -534,6 +559,7 @@ void keep_if_best(const VerifiedPoint& point, int round, CandidateOutcome& c) {
   c.simulated = point.simulated;
   c.predicted_rms = point.predicted_rms;
   c.verified_rms = point.verified_rms;
+  c.verified_rms_se = point.verified_rms_se;
   c.holdout_rms = point.holdout_rms;
   c.reaches_all = point.reaches_all;
 }
@@ -568,6 +594,8 @@ bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
     }
     point.verified_rms = rms_error(p, base.all, point.simulated, false);
     point.holdout_rms = rms_error(p, base.all, point.simulated, true);
+    point.verified_rms_se =
+        replicate_rms_se(p, base.all, find_group(groups, plan.id + "/verify"), first);
     c.rounds = round;
     if (!std::isfinite(point.verified_rms)) {  // a failed run ends the rounds
       if (c.best_round == 0) c.state = "failed";
@@ -641,12 +669,18 @@ void rank_candidates(const Problem& p, Report& rep) {
   const double base_rms = rep.baseline_verified_rms;
   for (auto& c : rep.candidates) {
     if (c.state != "verified") continue;
-    c.explains = std::isfinite(base_rms) && c.verified_rms < (1.0 - p.options.margin) * base_rms;
+    const bool cut =
+        std::isfinite(base_rms) && c.verified_rms < (1.0 - p.options.margin) * base_rms;
+    // Unknown without replicates: then the margin alone decides.
+    const double noise = std::hypot(rep.baseline_verified_rms_se, c.verified_rms_se);
+    c.within_noise = cut && base_rms - c.verified_rms <= p.options.noise_z * noise;
+    c.explains = cut && !c.within_noise;
     std::ostringstream e;
-    e << "verified RMS error " << percent(c.verified_rms) << " against " << percent(base_rms)
-      << " for the baseline (predicted " << percent(c.predicted_rms) << ", " << c.rounds
-      << " verification round" << (c.rounds == 1 ? "" : "s") << ", the best is round "
-      << c.best_round << "); the base model mispredicted "
+    e << "verified RMS error " << with_se(c.verified_rms, c.verified_rms_se) << " against "
+      << with_se(base_rms, rep.baseline_verified_rms_se) << " for the baseline (predicted "
+      << percent(c.predicted_rms) << ", " << c.rounds << " verification round"
+      << (c.rounds == 1 ? "" : "s") << ", the best is round " << c.best_round
+      << "); the base model mispredicted "
       << "its runs by " << percent(c.design_misprediction);
     if (std::isfinite(c.holdout_rms))
       e << "; held-out " << percent(c.holdout_rms) << " against "
@@ -658,6 +692,9 @@ void rank_candidates(const Problem& p, Report& rep) {
     for (const auto& [path, value] : c.rescaled)
       e << "; simulated with " << path << " = " << value << " (the same Bond number)";
     e << (c.reaches_all ? "; its box reaches every target" : "; some target stays out of reach");
+    if (c.within_noise)
+      e << "; its cut is within " << p.options.noise_z << " standard errors of the difference ("
+        << percent(noise) << "): the seeds' noise";
     c.evidence = e.str();
   }
 }
@@ -719,7 +756,16 @@ void name_cause(const Problem& p, bool all_verified, Report& rep) {
                         percent(named->verified_rms) + ": " + rivals;
   } else {
     rep.conclusion = "no candidate cuts the verified error (" + percent(rep.baseline_verified_rms) +
-                     ") by " + percent(p.options.margin) + " or more: none is named";
+                     ") by " + percent(p.options.margin) + " or more" +
+                     (p.options.replicates > 1 ? " beyond the seeds' noise" : "") +
+                     ": none is named";
+    std::string noisy;
+    for (const auto& c : rep.candidates)
+      if (c.within_noise)
+        noisy += (noisy.empty() ? "" : ", ") + c.id + " " + percent(c.verified_rms);
+    if (!noisy.empty())
+      rep.conclusion += "; cut by the margin but within " + number(p.options.noise_z) +
+                        " standard errors of the difference: " + noisy;
   }
 }
 
@@ -745,6 +791,7 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
   request_replicates(p, "baseline", 1, {}, rep.baseline_proposed, step.requests);
   if (!base_sim.empty()) {
     rep.baseline_verified_rms = rms_error(p, base.all, base_sim, false);
+    rep.baseline_verified_rms_se = replicate_rms_se(p, base.all, find_group(groups, "baseline"), 1);
     rep.baseline_holdout_rms = rms_error(p, base.all, base_sim, true);
   }
   // 2. Candidates: augmented designs, then their calibrations verified.

@@ -78,6 +78,9 @@ struct Options {
   double sigma_g_max = 1.5;             ///< size_distribution: sigma_g from 1 (one size) to this
   double fixed_span = 2.0;              ///< fixed:<p>: from v / span to v * span
   double margin = 0.3;  ///< a named cause cuts the verified RMS error by at least this fraction
+  /// ... and, where replicates give both errors a standard error, by more than this many
+  /// standard errors of the difference: a cut within the seeds' noise names nothing.
+  double noise_z = 2.0;
   int starts = 16;
   std::uint64_t seed = 1;
   /// Ridge toward the design centre in every calibration (calib::CalibrationOptions): 1e-4
@@ -183,6 +186,9 @@ struct CandidateOutcome {
   /// proposed and predicted_rms are the round being verified).
   int best_round = 0;
   double predicted_rms = kPending, verified_rms = kPending;
+  /// The standard error of verified_rms from its replicates (Options::replicates >= 2; else
+  /// pending): the standard deviation of the replicates' own RMS errors over sqrt(replicates).
+  double verified_rms_se = kPending;
   /// Relative RMS misprediction of its augmented runs by the base model: what the base design
   /// did not see (ranks the remedies: an aliased interaction shows in the fold-over runs,
   /// curvature in the axial runs).
@@ -190,6 +196,9 @@ struct CandidateOutcome {
   std::map<std::string, double> simulated;  ///< verified metrics
   double holdout_rms = kPending;
   bool explains = false;
+  /// Cuts the baseline's verified error by the margin, but by no more than `noise_z` standard
+  /// errors of the difference: not told from the seeds' noise, so it does not explain.
+  bool within_noise = false;
   std::string evidence;
 };
 
@@ -198,6 +207,7 @@ struct Report {
   std::vector<MetricRow> metrics;
   std::map<std::string, double> baseline_proposed;
   double baseline_predicted_rms = kPending, baseline_verified_rms = kPending;
+  double baseline_verified_rms_se = kPending;  ///< as CandidateOutcome::verified_rms_se
   double baseline_holdout_rms = kPending;
   std::vector<Conflict> conflicts;
   std::vector<CandidateOutcome> candidates;  ///< ranked once verified (best first)

@@ -486,10 +486,11 @@
     if (d.named_cause) s.appendChild(el('p', { class: 'named' }, 'Named cause: ' + d.named_cause));
     if ((r.rivals || []).length) s.appendChild(el('p', {}, 'Not told apart from it by these data (verified within the margin of its error): ' + r.rivals.join(', ')));
     const b = r.baseline || {};
-    s.appendChild(el('p', {}, 'Baseline RMS error: predicted ' + pct(b.predicted_rms) + ', verified ' + pct(b.verified_rms) + ', held out ' + pct(b.holdout_rms)));
+    const withSe = (v, se) => pct(v) + (typeof se === 'number' ? ' ± ' + pct(se) : '');
+    s.appendChild(el('p', {}, 'Baseline RMS error: predicted ' + pct(b.predicted_rms) + ', verified ' + withSe(b.verified_rms, b.verified_rms_se) + ', held out ' + pct(b.holdout_rms)));
     const cands = r.candidates || [];
     s.appendChild(table(['candidate', 'runs', 'predicted', 'verified', 'round (best/done)', 'held out', 'explains', 'cause', 'state'], cands.map((c) => [
-      c.id, c.runs, pct(c.predicted_rms), pct(c.verified_rms), (c.best_round || 0) + '/' + (c.rounds || 0), pct(c.holdout_rms), c.explains ? 'yes' : 'no', c.cause, c.state,
+      c.id, c.runs, pct(c.predicted_rms), withSe(c.verified_rms, c.verified_rms_se), (c.best_round || 0) + '/' + (c.rounds || 0), pct(c.holdout_rms), c.explains ? 'yes' : 'no', c.cause, c.state,
     ])));
     const bars = [{ model: 'baseline', verified_rms: b.verified_rms }].concat(cands.map((c) => ({ model: c.id, verified_rms: c.verified_rms })))
       .filter((x) => typeof x.verified_rms === 'number');

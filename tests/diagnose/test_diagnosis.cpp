@@ -998,5 +998,64 @@ TEST(Diagnosis, ReplicatedVerificationsAverageTheirSeeds) {
   }
 }
 
+TEST(Diagnosis, ACutWithinTheSeedsNoiseNamesNothing) {
+  // Three lab seeds of every verification put the coordination number at 1 - s, 1 and 1 + s
+  // times its value: the mean is the noise-free one, so the rolling candidate's cut of the
+  // verified error is the same at every s; the spread of the replicates' own errors grows with
+  // s. A small s names rolling resistance; a large one leaves the cut within two standard
+  // errors of the difference, and nothing is named.
+  auto truth_point = natural_point(0.2, -0.3, 0.1);
+  truth_point[kMuR] = kTrueMuR;
+  const auto ms =
+      targets_at(rolling_truth(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  for (const double spread : {0.002, 0.5}) {
+    SCOPED_TRACE(spread);
+    const Disturbance noise = [spread](const RunRequest& r, Responses& y) {
+      const bool verification =
+          r.group == "baseline" || r.group.find("/verify") != std::string::npos;
+      if (verification) y[kCn] *= 1.0 + spread * (r.replicate - 1);
+    };
+    Problem p = make_problem(rolling_truth, {kSf, kCn}, ms);
+    p.options.replicates = 3;
+    const Report r = drive(p, rolling_truth, 30, noise).step.report;
+    ASSERT_EQ(r.state, "done");
+    const CandidateOutcome* rolling = candidate(r, "rolling");
+    ASSERT_NE(rolling, nullptr);
+    ASSERT_TRUE(std::isfinite(r.baseline_verified_rms_se));
+    ASSERT_TRUE(std::isfinite(rolling->verified_rms_se));
+    EXPECT_GT(r.baseline_verified_rms_se, 0.0);
+    EXPECT_LT(rolling->verified_rms, (1.0 - p.options.margin) * r.baseline_verified_rms);
+    const double difference =
+        std::hypot(r.baseline_verified_rms_se, rolling->verified_rms_se) * p.options.noise_z;
+    const bool beyond = r.baseline_verified_rms - rolling->verified_rms > difference;
+    EXPECT_EQ(beyond, spread < 0.1);
+    EXPECT_EQ(rolling->explains, beyond);
+    EXPECT_EQ(rolling->within_noise, !beyond);
+    if (beyond) {
+      EXPECT_EQ(r.named_cause, "rolling") << r.conclusion;
+    } else {
+      EXPECT_EQ(r.named_cause, "") << r.conclusion;
+      EXPECT_NE(r.conclusion.find("within 2 standard errors of the difference: rolling"),
+                std::string::npos)
+          << r.conclusion;
+    }
+  }
+}
+
+TEST(Diagnosis, AVerificationOnOneSeedHasNoStandardError) {
+  auto truth_point = natural_point(0.2, -0.3, 0.1);
+  truth_point[kMuR] = kTrueMuR;
+  const auto ms =
+      targets_at(rolling_truth(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  const Report r = drive(make_problem(rolling_truth, {kSf, kCn}, ms), rolling_truth).step.report;
+  ASSERT_EQ(r.state, "done");
+  EXPECT_FALSE(std::isfinite(r.baseline_verified_rms_se));
+  const CandidateOutcome* rolling = candidate(r, "rolling");
+  ASSERT_NE(rolling, nullptr);
+  EXPECT_FALSE(std::isfinite(rolling->verified_rms_se));
+  EXPECT_FALSE(rolling->within_noise);
+  EXPECT_EQ(r.named_cause, "rolling") << r.conclusion;
+}
+
 }  // namespace
 }  // namespace demcal::diagnose
