@@ -461,30 +461,36 @@ std::vector<Conflict> conflicts(const Problem& p, const Fitted& joint) {
   return out;
 }
 
-/// The mean of a replicated verification: rows first .. first + replicates - 1 of a group, each
-/// metric averaged (NaN when a replicate failed); empty while one is pending.
-std::map<std::string, double> replicate_mean(const Problem& p, const GroupResults* g, int first) {
-  const int n = p.options.replicates;
-  std::map<std::string, double> mean;
-  for (int row = first; row < first + n; ++row) {
+/// The runs of a replicated verification, one metric map each.
+using ReplicateRuns = std::vector<const std::map<std::string, double>*>;
+
+/// Rows first .. first + replicates - 1 of a group; empty while one is pending.
+ReplicateRuns replicate_rows(const Problem& p, const GroupResults* g, int first) {
+  ReplicateRuns rows;
+  for (int row = first; row < first + p.options.replicates; ++row) {
     if (!g || !g->count(row)) return {};
-    for (const auto& [metric, value] : g->at(row)) mean[metric] += value / n;
+    rows.push_back(&g->at(row));
   }
+  return rows;
+}
+
+/// Their mean, each metric averaged (NaN when a replicate failed); empty while one is pending.
+std::map<std::string, double> replicate_mean(const ReplicateRuns& rows) {
+  std::map<std::string, double> mean;
+  for (const auto* row : rows)
+    for (const auto& [metric, value] : *row) mean[metric] += value / double(rows.size());
   return mean;
 }
 
-/// The standard error of a replicated verification's RMS error (rows first .. first +
-/// replicates - 1): the standard deviation of each replicate's own RMS error over
-/// sqrt(replicates); pending with one replicate, while one is pending or when one failed.
+/// The standard error of their RMS error: the standard deviation of each replicate's own RMS
+/// error over sqrt(replicates); pending with one replicate, while one is pending or when one
+/// failed.
 double replicate_rms_se(const Problem& p, const std::vector<calib::MetricTarget>& targets,
-                        const GroupResults* g, int first) {
-  const int n = p.options.replicates;
-  if (n < 2) return kPending;
+                        const ReplicateRuns& rows) {
+  const double n = double(rows.size());
+  if (rows.size() < 2) return kPending;
   std::vector<double> each;
-  for (int row = first; row < first + n; ++row) {
-    if (!g || !g->count(row)) return kPending;
-    each.push_back(rms_error(p, targets, g->at(row), false));
-  }
+  for (const auto* row : rows) each.push_back(rms_error(p, targets, *row, false));
   double mean = 0.0;
   for (const double e : each) mean += e / n;
   double ss = 0.0;
@@ -581,7 +587,8 @@ bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
     const int first = (round - 1) * p.options.replicates + 1;
     request_replicates(p, plan.id + "/verify", first, plan.switches,
                        run_parameters(plan, point.proposed), requests);
-    point.simulated = replicate_mean(p, find_group(groups, plan.id + "/verify"), first);
+    const auto replicates = replicate_rows(p, find_group(groups, plan.id + "/verify"), first);
+    point.simulated = replicate_mean(replicates);
     if (point.simulated.empty()) {
       if (c.best_round == 0) {  // nothing verified yet: show what is being verified
         c.proposed = point.proposed;
@@ -594,8 +601,7 @@ bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
     }
     point.verified_rms = rms_error(p, base.all, point.simulated, false);
     point.holdout_rms = rms_error(p, base.all, point.simulated, true);
-    point.verified_rms_se =
-        replicate_rms_se(p, base.all, find_group(groups, plan.id + "/verify"), first);
+    point.verified_rms_se = replicate_rms_se(p, base.all, replicates);
     c.rounds = round;
     if (!std::isfinite(point.verified_rms)) {  // a failed run ends the rounds
       if (c.best_round == 0) c.state = "failed";
@@ -693,8 +699,8 @@ void rank_candidates(const Problem& p, Report& rep) {
       e << "; simulated with " << path << " = " << value << " (the same Bond number)";
     e << (c.reaches_all ? "; its box reaches every target" : "; some target stays out of reach");
     if (c.within_noise)
-      e << "; its cut is within " << p.options.noise_z << " standard errors of the difference ("
-        << percent(noise) << "): the seeds' noise";
+      e << "; its cut is within " << number(p.options.noise_z)
+        << " standard errors of the difference (" << percent(noise) << "): the seeds' noise";
     c.evidence = e.str();
   }
 }
@@ -785,13 +791,14 @@ Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups
       p, p.factors, fit_targets(p, p.design, p.results, doe::ModelKind::kTwoFactor));
   rep.baseline_proposed = natural_point(p.factors, base.result.natural);
   rep.baseline_predicted_rms = std::sqrt(base.result.objective);
-  const auto base_sim = replicate_mean(p, find_group(groups, "baseline"), 1);
+  const auto base_replicates = replicate_rows(p, find_group(groups, "baseline"), 1);
+  const auto base_sim = replicate_mean(base_replicates);
   rep.metrics = baseline_rows(p, base, base_sim);
   rep.conflicts = conflicts(p, base);
   request_replicates(p, "baseline", 1, {}, rep.baseline_proposed, step.requests);
   if (!base_sim.empty()) {
     rep.baseline_verified_rms = rms_error(p, base.all, base_sim, false);
-    rep.baseline_verified_rms_se = replicate_rms_se(p, base.all, find_group(groups, "baseline"), 1);
+    rep.baseline_verified_rms_se = replicate_rms_se(p, base.all, base_replicates);
     rep.baseline_holdout_rms = rms_error(p, base.all, base_sim, true);
   }
   // 2. Candidates: augmented designs, then their calibrations verified.

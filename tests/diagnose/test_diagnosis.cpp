@@ -241,6 +241,13 @@ std::vector<Measurement> targets_at(const Responses& y, const std::vector<std::s
   return out;
 }
 
+/// Targets of the rolling truth at a hidden mu_r (kTrueMuR) off the base box's line.
+std::vector<Measurement> hidden_rolling_targets() {
+  auto truth_point = natural_point(0.2, -0.3, 0.1);
+  truth_point[kMuR] = kTrueMuR;
+  return targets_at(rolling_truth(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+}
+
 // --- a) a linear truth inside the box ------------------------------------------------------
 
 /// Envelope over the box of 0 + ba A + bb B + bc C as the base 2^(3-1) model predicts it: the
@@ -389,10 +396,8 @@ TEST(Diagnosis, CandidateKeepsItsBestVerifiedRoundWhenLaterRoundsMissMore) {
   // The rolling candidate's verification runs drift away from the truth, a little in round 1
   // and ten times more in rounds 2 and 3 (as a surrogate refitted on a miss can propose worse
   // points): the outcome is round 1's point and error, and it is still named.
-  auto truth_point = natural_point(0.2, -0.3, 0.1);
-  truth_point[kMuR] = kTrueMuR;
   const Simulator sim = rolling_truth;
-  const auto ms = targets_at(sim(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  const auto ms = hidden_rolling_targets();
   std::map<int, Responses> verified;
   std::map<int, Parameters> at;
   const Disturbance drift = [&](const RunRequest& r, Responses& y) {
@@ -419,10 +424,8 @@ TEST(Diagnosis, CandidateKeepsItsBestVerifiedRoundWhenLaterRoundsMissMore) {
 TEST(Diagnosis, ACandidateVerifiesAtMostItsRoundsOfTheOptions) {
   // The drift above makes every round miss its tolerance, so a candidate goes on for as many
   // rounds as it is given: one here.
-  auto truth_point = natural_point(0.2, -0.3, 0.1);
-  truth_point[kMuR] = kTrueMuR;
   const Simulator sim = rolling_truth;
-  const auto ms = targets_at(sim(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  const auto ms = hidden_rolling_targets();
   int verifications = 0;
   const Disturbance drift = [&](const RunRequest& r, Responses& y) {
     if (r.group != "rolling/verify") return;
@@ -783,10 +786,7 @@ TEST(Diagnosis, HiddenCoarseGrainingIsNamedAndItsRadiusRecovered) {
 }
 
 TEST(Diagnosis, CoarseGrainingIsNotNamedForHiddenRollingResistance) {
-  auto truth_point = natural_point(0.2, -0.3, 0.1);
-  truth_point[kMuR] = kTrueMuR;
-  const auto ms =
-      targets_at(rolling_truth(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  const auto ms = hidden_rolling_targets();
   const Driven d = drive(coarse(make_problem(rolling_truth, {kSf, kCn}, ms)), rolling_truth);
   const Report& r = d.step.report;
   EXPECT_EQ(r.state, "done");
@@ -965,10 +965,7 @@ TEST(Diagnosis, ReplicatedVerificationsAverageTheirSeeds) {
   // Noise of opposite sign on the coordination number of the two lab seeds of every
   // verification: averaged over 2 replicates it cancels, the baseline's verified error is the
   // noise-free one, and each verified point takes two runs on seed offsets 0 and 1.
-  auto truth_point = natural_point(0.2, -0.3, 0.1);
-  truth_point[kMuR] = kTrueMuR;
-  const auto ms =
-      targets_at(rolling_truth(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  const auto ms = hidden_rolling_targets();
   const Disturbance noise = [](const RunRequest& r, Responses& y) {
     const bool verification = r.group == "baseline" || r.group.find("/verify") != std::string::npos;
     if (verification) y[kCn] *= r.replicate == 0 ? 1.05 : 0.95;
@@ -1004,10 +1001,7 @@ TEST(Diagnosis, ACutWithinTheSeedsNoiseNamesNothing) {
   // verified error is the same at every s; the spread of the replicates' own errors grows with
   // s. A small s names rolling resistance; a large one leaves the cut within two standard
   // errors of the difference, and nothing is named.
-  auto truth_point = natural_point(0.2, -0.3, 0.1);
-  truth_point[kMuR] = kTrueMuR;
-  const auto ms =
-      targets_at(rolling_truth(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  const auto ms = hidden_rolling_targets();
   for (const double spread : {0.002, 0.5}) {
     SCOPED_TRACE(spread);
     const Disturbance noise = [spread](const RunRequest& r, Responses& y) {
@@ -1043,10 +1037,7 @@ TEST(Diagnosis, ACutWithinTheSeedsNoiseNamesNothing) {
 }
 
 TEST(Diagnosis, AVerificationOnOneSeedHasNoStandardError) {
-  auto truth_point = natural_point(0.2, -0.3, 0.1);
-  truth_point[kMuR] = kTrueMuR;
-  const auto ms =
-      targets_at(rolling_truth(truth_point, {{"particle_law.rolling", "cdt"}}), {kSf, kCn});
+  const auto ms = hidden_rolling_targets();
   const Report r = drive(make_problem(rolling_truth, {kSf, kCn}, ms), rolling_truth).step.report;
   ASSERT_EQ(r.state, "done");
   EXPECT_FALSE(std::isfinite(r.baseline_verified_rms_se));
