@@ -22,14 +22,22 @@ Eigen::MatrixXd response_matrix(const CampaignPlan& plan, const std::vector<JobR
   return y;
 }
 
-std::map<std::string, std::vector<int>> flagged_runs(const std::vector<JobRow>& jobs) {
+std::map<std::string, std::vector<int>> flagged_runs(const std::vector<JobRow>& jobs,
+                                                     std::string_view kind) {
   std::map<std::string, std::vector<int>> out;
   for (const auto& job : jobs) {
-    if (job.kind != job_kind::kDesign || job.state != "done") continue;
+    if (job.kind != kind || job.state != "done") continue;
     for (const auto& [metric, why] : flags_from_json(job.flags_json))
       out[job.test + "." + metric].push_back(job.std_order);
   }
   return out;
+}
+
+std::string flagged_runs_note(const std::vector<int>& runs, const std::string& which) {
+  std::string list;
+  for (int r : runs) list += (list.empty() ? "" : ", ") + std::to_string(r);
+  return "flagged " + which + " " + list +
+         ": a phase this metric is computed from did not reach its target (demcal status --jobs)";
 }
 
 doe::ResponseAnalysis analyse(const CampaignPlan& plan, const Eigen::VectorXd& y,

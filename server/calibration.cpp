@@ -226,10 +226,50 @@ const calib::VerifiedRound* latest_simulated(const Loaded& l) {
   return latest;
 }
 
+/// Per calibrated response, the notes on the flagged values its models are fitted on: the
+/// design's runs, a multi-fidelity design's high level, each calibration stage's runs.
+std::map<std::string, std::vector<std::string>> flagged_fit_notes(const Loaded& l) {
+  std::map<std::string, std::vector<std::string>> out;
+  auto add = [&](std::string_view kind, const std::string& which) {
+    for (const auto& [response, runs] : flagged_runs(l.jobs, kind))
+      out[response].push_back(flagged_runs_note(runs, which));
+  };
+  add(job_kind::kDesign, "runs");
+  if (l.plan.fidelity) add(job_kind::kHighDesign, "high-level runs");
+  std::set<std::string> stages;
+  for (const auto& j : l.jobs)
+    if (job_kind::is_stage(j.kind)) stages.insert(j.kind);
+  for (const auto& kind : stages) add(kind, kind + " runs");
+  return out;
+}
+
+/// Why the value of `response` simulated at calibration round `round` is flagged ("": it is
+/// not).
+std::string flag_at_round(const Loaded& l, int round, const std::string& response) {
+  for (const auto& j : l.jobs) {
+    if (j.kind != job_kind::kVerify || j.std_order != round || j.state != "done") continue;
+    for (const auto& [metric, why] : flags_from_json(j.flags_json))
+      if (j.test + "." + metric == response) return why;
+  }
+  return "";
+}
+
+/// The calibration round a verified round of the state is.
+int round_number(const Loaded& l, const calib::VerifiedRound& r) {
+  return l.round_rows.at(static_cast<std::size_t>(&r - l.state.rounds.data())).round;
+}
+
+/// `text` with `note` after it, "; " between.
+std::string with_note(std::string text, const std::string& note) {
+  return text.empty() ? note : text + "; " + note;
+}
+
 /// Per metric: target, prediction, reach, tolerance, and the value simulated at `shown` (a
-/// verified round: the calibrated set's own once there is one, else the latest).
+/// verified round: the calibrated set's own once there is one, else the latest). Its statement
+/// names the flagged values the calibration uses for it, so none is used silently.
 void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
                  const calib::CalibrationResult* proposal, const calib::VerifiedRound* shown) {
+  const auto flagged = flagged_fit_notes(l);
   for (std::size_t m = 0; m < l.state.targets.size(); ++m) {
     const auto& t = l.state.targets[m];
     auto* o = reply.add_metrics();
@@ -251,11 +291,18 @@ void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
     } else if (!l.state.rounds.empty()) {
       o->set_predicted(l.state.rounds.back().predicted(Eigen::Index(m)));
     }
+    if (const auto f = flagged.find(t.name); f != flagged.end())
+      for (const auto& note : f->second) o->set_statement(with_note(o->statement(), note));
     if (shown && shown->simulated && std::isfinite((*shown->simulated)(Eigen::Index(m)))) {
       const double sim = (*shown->simulated)(Eigen::Index(m));
       o->set_simulated_available(true);
       o->set_simulated(sim);
       o->set_within(tol > 0.0 && std::abs(sim - t.target) <= tol);
+      const int round = round_number(l, *shown);
+      if (const std::string why = flag_at_round(l, round, t.name); !why.empty())
+        o->set_statement(with_note(
+            o->statement(),
+            "the value simulated at round " + std::to_string(round) + " is flagged: " + why));
     }
   }
 }

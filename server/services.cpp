@@ -343,13 +343,8 @@ grpc::Status CampaignServiceImpl::GetEffects(grpc::ServerContext* ctx,
             rpc::effects_message(plan.responses[c], analyse(plan, col, kind, alpha));
         auto* m = reply->add_metrics();
         *m = std::move(effects);
-        if (const auto f = flagged.find(plan.responses[c]); f != flagged.end()) {
-          std::string runs;
-          for (int r : f->second) runs += (runs.empty() ? "" : ", ") + std::to_string(r);
-          m->add_notes("flagged runs " + runs +
-                       ": a phase this metric is computed from did not reach its target "
-                       "(demcal status --jobs)");
-        }
+        if (const auto f = flagged.find(plan.responses[c]); f != flagged.end())
+          m->add_notes(flagged_runs_note(f->second));
       } catch (const InputError& e) {
         auto* m = reply->add_metrics();
         m->set_metric(plan.responses[c]);

@@ -366,6 +366,78 @@ TEST_F(Service, TheCalibratedSetIsShownWithTheValuesSimulatedAtItsOwnRound) {
   EXPECT_EQ(row[5], "8.33");
 }
 
+TEST_F(Service, ACalibrationNamesTheFlaggedValuesItUses) {
+  // Results through the real worker protocol, no physics: the solid fraction rises with mu_s as
+  // above; one design run's value carries a flag (a phase it is computed from did not reach its
+  // target), and so does the verification's. The calibration fits the one and accepts the
+  // other, and its statement of the metric names both, as the effects name the design run.
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  const std::string settle = "phase 'settle' did not reach its rest within 2 s";
+  std::int64_t flagged_job = 0;
+  for (int k = 0; k < 4; ++k)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+      const double a = (job.parameters().at("particle_law.tangential.mu_s") - 0.3) / 0.2;
+      (*c.mutable_metrics())["solid_fraction"] = 0.6 + 0.1 * a;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+      if (k == 1) {
+        (*c.mutable_flags())["solid_fraction"] = settle;
+        flagged_job = job.job_id();
+      }
+    }));
+  int flagged_row = 0;
+  const v1::ResultsReply stored = results(id);
+  for (const auto& j : stored.jobs())
+    if (j.job_id() == flagged_job) flagged_row = j.std_order();
+  ASSERT_GT(flagged_row, 0);
+  const std::string design_note = "flagged runs " + std::to_string(flagged_row) +
+                                  ": a phase this metric is computed from did not reach its target";
+
+  v1::EffectsRequest effects_request;
+  effects_request.set_id(id);
+  v1::EffectsReply effects;
+  ASSERT_TRUE(campaigns_->GetEffects(ctx().get(), effects_request, &effects).ok());
+  bool noted = false;
+  for (const auto& m : effects.metrics())
+    for (const auto& note : m.notes())
+      noted = noted || (m.metric() == "packing.solid_fraction" &&
+                        note.find(design_note) != std::string::npos);
+  EXPECT_TRUE(noted) << effects.DebugString();
+
+  v1::CalibrateRequest verify;
+  verify.set_id(id);
+  verify.set_verify(true);
+  v1::CalibrateReply queued;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), verify, &queued).ok());
+  ASSERT_EQ(queued.verification_jobs_size(), 1) << queued.conclusion();
+  ASSERT_EQ(queued.metrics_size(), 1);
+  EXPECT_NE(queued.metrics(0).statement().find(design_note), std::string::npos)
+      << queued.metrics(0).statement();
+  EXPECT_EQ(queued.metrics(0).statement().find("round 1"), std::string::npos)
+      << queued.metrics(0).statement();
+
+  const std::string hold = "phase 'hold' did not reach 0.5 +- 0.3 Pa";
+  ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec&, v1::CompleteRequest& c) {
+    (*c.mutable_metrics())["solid_fraction"] = 0.61;
+    (*c.mutable_metrics())["coordination_number"] = 4.0;
+    (*c.mutable_flags())["solid_fraction"] = hold;
+  }));
+  v1::CalibrateReply done;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), verify, &done).ok());
+  ASSERT_EQ(done.metrics_size(), 1);
+  const auto& m = done.metrics(0);
+  EXPECT_TRUE(m.within()) << done.conclusion();
+  EXPECT_NE(m.statement().find(design_note), std::string::npos) << m.statement();
+  EXPECT_NE(m.statement().find("the value simulated at round 1 is flagged: " + hold),
+            std::string::npos)
+      << m.statement();
+  // The table prints the statement under its metric.
+  const std::string table =
+      cli_text(dir_, "calibrate_flagged.txt", {"calibrate", std::to_string(id)}, channel_);
+  EXPECT_NE(table.find("is flagged: " + hold), std::string::npos) << table;
+}
+
 TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
