@@ -243,15 +243,15 @@ std::map<std::string, std::vector<std::string>> flagged_fit_notes(const Loaded& 
   return out;
 }
 
-/// Why the value of `response` simulated at calibration round `round` is flagged ("": it is
-/// not).
-std::string flag_at_round(const Loaded& l, int round, const std::string& response) {
-  for (const auto& j : l.jobs) {
-    if (j.kind != job_kind::kVerify || j.std_order != round || j.state != "done") continue;
-    for (const auto& [metric, why] : flags_from_json(j.flags_json))
-      if (j.test + "." + metric == response) return why;
-  }
-  return "";
+/// Per response, why its value simulated at calibration round `round` is flagged (a response
+/// whose value is not flagged is absent).
+std::map<std::string, std::string> flags_at_round(const Loaded& l, int round) {
+  std::map<std::string, std::string> out;
+  for (const auto& j : l.jobs)
+    if (j.kind == job_kind::kVerify && j.std_order == round && j.state == "done")
+      for (const auto& [metric, why] : flags_from_json(j.flags_json))
+        out[j.test + "." + metric] = why;
+  return out;
 }
 
 /// The calibration round a verified round of the state is.
@@ -270,6 +270,8 @@ std::string with_note(std::string text, const std::string& note) {
 void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
                  const calib::CalibrationResult* proposal, const calib::VerifiedRound* shown) {
   const auto flagged = flagged_fit_notes(l);
+  const int round = shown ? round_number(l, *shown) : 0;
+  const auto flagged_at_round = flags_at_round(l, round);
   for (std::size_t m = 0; m < l.state.targets.size(); ++m) {
     const auto& t = l.state.targets[m];
     auto* o = reply.add_metrics();
@@ -298,11 +300,10 @@ void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
       o->set_simulated_available(true);
       o->set_simulated(sim);
       o->set_within(tol > 0.0 && std::abs(sim - t.target) <= tol);
-      const int round = round_number(l, *shown);
-      if (const std::string why = flag_at_round(l, round, t.name); !why.empty())
+      if (const auto f = flagged_at_round.find(t.name); f != flagged_at_round.end())
         o->set_statement(with_note(
             o->statement(),
-            "the value simulated at round " + std::to_string(round) + " is flagged: " + why));
+            "the value simulated at round " + std::to_string(round) + " is flagged: " + f->second));
     }
   }
 }
