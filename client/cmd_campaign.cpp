@@ -1,9 +1,11 @@
 // `demcal list | status ID | watch ID | cancel ID`: campaigns on a coordinator.
 #include <algorithm>
+#include <ctime>
 #include <iomanip>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "client/commands.hpp"
 #include "client/service_client.hpp"
@@ -15,6 +17,16 @@ void print_campaign_row(const v1::Campaign& c) {
   std::cout << std::setw(5) << c.id() << "  " << std::left << std::setw(28) << c.name()
             << std::setw(10) << state_name(c.state()) << std::right
             << progress_line(c.progress(), 20) << "\n";
+}
+
+/// A Unix time as "YYYY-MM-DD HH:MM:SS UTC".
+std::string utc_time(double unix_seconds) {
+  const auto t = static_cast<std::time_t>(unix_seconds);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  std::ostringstream s;
+  s << std::put_time(&tm, "%Y-%m-%d %H:%M:%S UTC");
+  return s.str();
 }
 
 }  // namespace
@@ -81,6 +93,9 @@ void add_campaign_commands(CLI::App& app) {
       if (!j.error().empty()) std::cout << "  (" << j.error() << ")";
       if (j.reused_from() != 0) std::cout << "  reused from job " << j.reused_from();
       if (!j.reused_journal().empty()) std::cout << "  reused from " << j.reused_journal();
+      if (!j.checkpoint_stage().empty())
+        std::cout << "  goes on from checkpoint '" << j.checkpoint_stage() << "' (kept "
+                  << utc_time(j.checkpoint_saved()) << ")";
       std::cout << "\n";
       for (const auto& [k, why] : j.flags()) std::cout << "    ! " << k << ": " << why << "\n";
     }

@@ -57,6 +57,7 @@ void print_metrics(std::ostream& out, const v1::DiagnosisReport& r) {
         << pct(m.has_relative_error(), m.relative_error()) << std::setw(10)
         << num(m.has_curvature_p(), m.curvature_p()) << "\n";
     if (!m.reachable()) out << "    " << m.statement() << "\n";
+    for (const auto& note : m.notes()) out << "    " << note << "\n";
   }
   const auto& b = r.baseline();
   out << "baseline RMS error: predicted " << pct(b.has_predicted_rms(), b.predicted_rms())

@@ -287,7 +287,17 @@ void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std
     out << message_json(c) << "\n";
     return;
   }
-  out << "proposed parameter set (objective " << fmt(c.objective(), 4) << "):\n";
+  // While a round runs its set is shown with the predictions it was queued with; while a stage's
+  // design runs there is no set to show.
+  const bool round_running = c.rounds_size() && c.rounds(c.rounds_size() - 1).state() == "running";
+  const bool predicted = c.fitted() || round_running;
+  if (c.fitted())
+    out << "proposed parameter set (objective " << fmt(c.objective(), 4) << "):\n";
+  else if (round_running)
+    out << "parameter set of calibration round " << c.rounds(c.rounds_size() - 1).round()
+        << ", running (the models are refitted once its jobs are done):\n";
+  else
+    out << "no parameter set: a calibration stage's design is running\n";
   for (int i = 0; i < c.factor_paths_size(); ++i)
     out << "  " << std::left << std::setw(40) << c.factor_paths(i) << std::right << " = "
         << fmt(c.proposed_values(i), 6) << "\n";
@@ -298,13 +308,14 @@ void print_calibration(std::ostream& out, const v1::CalibrateReply& c, const std
       << "  within  reach [min, max]\n";
   for (const auto& m : c.metrics()) {
     out << "  " << std::left << std::setw(36) << m.metric() << std::right << std::setw(12)
-        << fmt(m.target()) << std::setw(12) << fmt(m.predicted()) << std::setw(8)
-        << fmt(100 * m.relative_error(), 3) << std::setw(12)
+        << fmt(m.target()) << std::setw(12) << (predicted ? fmt(m.predicted()) : "-")
+        << std::setw(8) << (predicted ? fmt(100 * m.relative_error(), 3) : "-") << std::setw(12)
         << (m.simulated_available() ? fmt(m.simulated()) : "-") << std::setw(8)
         << (m.simulated_available() ? fmt(100 * relative_error(m.simulated(), m.target()), 3) : "-")
         << std::setw(11) << fmt(m.tolerance(), 3) << "  " << std::setw(6)
-        << (m.simulated_available() ? (m.within() ? "yes" : "no") : "-") << "  ["
-        << fmt(m.envelope_min()) << ", " << fmt(m.envelope_max()) << "]\n";
+        << (m.simulated_available() ? (m.within() ? "yes" : "no") : "-") << "  "
+        << (c.fitted() ? "[" + fmt(m.envelope_min()) + ", " + fmt(m.envelope_max()) + "]" : "-")
+        << "\n";
     if (!m.statement().empty()) out << "      " << m.statement() << "\n";
   }
   out << "  tolerance = sqrt(uncertainty^2 + noise sd^2) (docs/doe.md); surrogate " << c.surrogate()

@@ -40,6 +40,15 @@ std::string flagged_runs_note(const std::vector<int>& runs, const std::string& w
          ": a phase this metric is computed from did not reach its target (demcal status --jobs)";
 }
 
+std::map<std::string, std::vector<std::string>> flagged_notes(
+    const std::vector<JobRow>& jobs, const std::vector<RunsOfKind>& kinds) {
+  std::map<std::string, std::vector<std::string>> out;
+  for (const auto& k : kinds)
+    for (const auto& [response, runs] : flagged_runs(jobs, k.kind))
+      out[response].push_back(flagged_runs_note(runs, k.which));
+  return out;
+}
+
 doe::ResponseAnalysis analyse(const CampaignPlan& plan, const Eigen::VectorXd& y,
                               doe::ModelKind model, double alpha) {
   doe::AnalysisOptions o;

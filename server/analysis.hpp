@@ -30,6 +30,16 @@ std::map<std::string, std::vector<int>> flagged_runs(const std::vector<JobRow>& 
 /// names the runs ("runs", "high-level runs", ...).
 std::string flagged_runs_note(const std::vector<int>& runs, const std::string& which = "runs");
 
+/// A kind of job whose values an analysis uses, and the words that name its runs in a note.
+struct RunsOfKind {
+  std::string kind;
+  std::string which;
+};
+
+/// Per response, one flagged_runs_note per kind of `kinds` whose runs carry a flag for it.
+std::map<std::string, std::vector<std::string>> flagged_notes(const std::vector<JobRow>& jobs,
+                                                              const std::vector<RunsOfKind>& kinds);
+
 doe::ResponseAnalysis analyse(const CampaignPlan& plan, const Eigen::VectorXd& y,
                               doe::ModelKind model, double alpha);
 

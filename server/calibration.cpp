@@ -229,18 +229,13 @@ const calib::VerifiedRound* latest_simulated(const Loaded& l) {
 /// Per calibrated response, the notes on the flagged values its models are fitted on: the
 /// design's runs, a multi-fidelity design's high level, each calibration stage's runs.
 std::map<std::string, std::vector<std::string>> flagged_fit_notes(const Loaded& l) {
-  std::map<std::string, std::vector<std::string>> out;
-  auto add = [&](std::string_view kind, const std::string& which) {
-    for (const auto& [response, runs] : flagged_runs(l.jobs, kind))
-      out[response].push_back(flagged_runs_note(runs, which));
-  };
-  add(job_kind::kDesign, "runs");
-  if (l.plan.fidelity) add(job_kind::kHighDesign, "high-level runs");
+  std::vector<RunsOfKind> kinds{{std::string(job_kind::kDesign), "runs"}};
+  if (l.plan.fidelity) kinds.push_back({std::string(job_kind::kHighDesign), "high-level runs"});
   std::set<std::string> stages;
   for (const auto& j : l.jobs)
     if (job_kind::is_stage(j.kind)) stages.insert(j.kind);
-  for (const auto& kind : stages) add(kind, kind + " runs");
-  return out;
+  for (const auto& kind : stages) kinds.push_back({kind, kind + " runs"});
+  return flagged_notes(l.jobs, kinds);
 }
 
 /// Per response, why its value simulated at calibration round `round` is flagged (a response
@@ -254,6 +249,12 @@ std::map<std::string, std::string> flags_at_round(const Loaded& l, int round) {
   return out;
 }
 
+/// The round whose jobs run, or none (a calibration stage's design runs, or nothing).
+const calib::VerifiedRound* running_round(const Loaded& l) {
+  return l.state.rounds.empty() || l.state.rounds.back().simulated ? nullptr
+                                                                   : &l.state.rounds.back();
+}
+
 /// The calibration round a verified round of the state is.
 int round_number(const Loaded& l, const calib::VerifiedRound& r) {
   return l.round_rows.at(static_cast<std::size_t>(&r - l.state.rounds.data())).round;
@@ -262,6 +263,18 @@ int round_number(const Loaded& l, const calib::VerifiedRound& r) {
 /// `text` with `note` after it, "; " between.
 std::string with_note(std::string text, const std::string& note) {
   return text.empty() ? note : text + "; " + note;
+}
+
+/// What a conclusion adds when values simulated at the calibrated set's round are flagged
+/// (empty when none of its calibrated metrics is).
+std::string flagged_set_note(const Loaded& l, const calib::VerifiedRound& calibrated) {
+  const auto flags = flags_at_round(l, round_number(l, calibrated));
+  std::string names;
+  for (const auto& response : l.responses)
+    if (flags.count(response)) names += (names.empty() ? "" : ", ") + response;
+  if (names.empty()) return {};
+  return "the calibrated set's simulated " + names +
+         " flagged: a phase did not reach its target (the metric's statement says which)";
 }
 
 /// Per metric: target, prediction, reach, tolerance, and the value simulated at `shown` (a
@@ -290,8 +303,6 @@ void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
       o->set_envelope_max(p.envelope.max);
       o->set_reachable(p.reachable);
       o->set_statement(p.statement);
-    } else if (!l.state.rounds.empty()) {
-      o->set_predicted(l.state.rounds.back().predicted(Eigen::Index(m)));
     }
     if (const auto f = flagged.find(t.name); f != flagged.end())
       for (const auto& note : f->second) o->set_statement(with_note(o->statement(), note));
@@ -343,6 +354,17 @@ void set_proposed(v1::CalibrateReply& reply, const Loaded& l, const Eigen::Vecto
     (*reply.mutable_proposed())[l.plan.factors[f].path] = natural(Eigen::Index(f));
     reply.add_factor_paths(l.plan.factors[f].path);
     reply.add_proposed_values(natural(Eigen::Index(f)));
+  }
+}
+
+/// The reply's set and each metric's prediction are a round's: its point and what the models
+/// predicted there when it was queued.
+void show_round(v1::CalibrateReply& reply, const Loaded& l, const calib::VerifiedRound& r) {
+  set_proposed(reply, l, r.natural);
+  for (int m = 0; m < reply.metrics_size(); ++m) {
+    auto* o = reply.mutable_metrics(m);
+    o->set_predicted(r.predicted(m));
+    o->set_relative_error(relative_error(o->predicted(), o->target()));
   }
 }
 
@@ -460,25 +482,22 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
     reply.set_stage(static_cast<int>(l.state.stages.size()));
     reply.set_simulations(l.state.jobs_used);
     reply.set_conclusion(running_conclusion(l));
-    if (!l.state.rounds.empty()) set_proposed(reply, l, l.state.rounds.back().natural);
     add_metrics(reply, l, nullptr, latest_simulated(l));
+    if (const auto* running = running_round(l)) show_round(reply, l, *running);
     if (l.plan.fidelity) add_fidelity(reply, l);
     return reply;
   }
   const calib::SequentialDecision d = calib::next_step(l.state, l.options);
+  reply.set_fitted(true);
   reply.set_stage(d.stage);
   reply.set_objective(d.proposal.objective);
+  const calib::VerifiedRound* calibrated = nullptr;
   if (d.within || d.best_round >= 0) {
     // The calibrated set is a verified one, with what was predicted and simulated there: the
     // round within tolerance, or, once the calibration has ended without one, its best round.
-    const auto& accepted = l.state.rounds[std::size_t(d.within ? d.accepted_round : d.best_round)];
-    add_metrics(reply, l, &d.proposal, &accepted);
-    set_proposed(reply, l, accepted.natural);
-    for (int m = 0; m < reply.metrics_size(); ++m) {
-      auto* o = reply.mutable_metrics(m);
-      o->set_predicted(accepted.predicted(m));
-      o->set_relative_error(relative_error(o->predicted(), o->target()));
-    }
+    calibrated = &l.state.rounds[std::size_t(d.within ? d.accepted_round : d.best_round)];
+    add_metrics(reply, l, &d.proposal, calibrated);
+    show_round(reply, l, *calibrated);
   } else {
     add_metrics(reply, l, &d.proposal, latest_simulated(l));
     set_proposed(reply, l, d.proposal.natural);
@@ -505,6 +524,9 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
       reply.set_conclusion("not within uncertainty yet; calibrate --verify continues: " +
                            d.conclusion);
   }
+  // The calibration accepts a flagged value as simulated; its conclusion says so.
+  if (const std::string note = calibrated ? flagged_set_note(l, *calibrated) : ""; !note.empty())
+    reply.set_conclusion(with_note(reply.conclusion(), note));
   return reply;
 }
 

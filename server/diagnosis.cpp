@@ -186,6 +186,30 @@ v1::DiagnosisReport report_message(const diagnose::Report& r) {
   return out;
 }
 
+/// The runs the diagnosis uses, by kind: the design's, the baseline's verification, and each
+/// candidate's augmented design and verification.
+std::vector<RunsOfKind> diagnosis_runs(const std::vector<JobRow>& jobs) {
+  std::vector<RunsOfKind> kinds{{std::string(job_kind::kDesign), "runs"}};
+  std::set<std::string> groups;
+  for (const auto& j : jobs)
+    if (job_kind::is_diagnosis(j.kind)) groups.insert(job_kind::diagnosis_group(j.kind));
+  constexpr std::string_view kVerify = "/verify";
+  for (const auto& g : groups) {
+    std::string which = g == "baseline" ? "baseline verification runs" : g + " design runs";
+    if (g.ends_with(kVerify)) which = g.substr(0, g.size() - kVerify.size()) + " verification runs";
+    kinds.push_back({job_kind::diagnosis(g), which});
+  }
+  return kinds;
+}
+
+/// Under each metric of the report, the flagged values the diagnosis uses for it.
+void add_flagged_notes(v1::DiagnosisReport& report, const std::vector<JobRow>& jobs) {
+  const auto notes = flagged_notes(jobs, diagnosis_runs(jobs));
+  for (auto& m : *report.mutable_metrics())
+    if (const auto f = notes.find(m.response()); f != notes.end())
+      for (const auto& note : f->second) m.add_notes(note);
+}
+
 }  // namespace
 
 v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::uint64_t seed,
@@ -223,6 +247,7 @@ v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::u
   reply.set_named_cause(step.report.named_cause);
   reply.set_conclusion(step.report.conclusion);
   *reply.mutable_report() = report_message(step.report);
+  add_flagged_notes(*reply.mutable_report(), jobs);
   reply.set_jobs_queued(static_cast<int>(fresh.size()));
   return reply;
 }

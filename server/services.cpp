@@ -307,7 +307,15 @@ grpc::Status CampaignServiceImpl::GetResults(grpc::ServerContext* ctx, const v1:
   if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   if (!store_.campaign(req->id())) return not_found(req->id());
   try {
-    for (const auto& job : store_.jobs(req->id())) *reply->add_jobs() = job_message(job);
+    const auto marks = store_.checkpoint_marks(req->id());
+    for (const auto& job : store_.jobs(req->id())) {
+      auto* j = reply->add_jobs();
+      *j = job_message(job);
+      if (const auto m = marks.find(job.id); m != marks.end()) {
+        j->set_checkpoint_stage(m->second.stage);
+        j->set_checkpoint_saved(m->second.stored);
+      }
+    }
   } catch (const std::exception& e) {
     return internal(e);
   }

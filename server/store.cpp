@@ -780,6 +780,18 @@ std::optional<CheckpointRow> Store::checkpoint(std::int64_t job_id) {
   return CheckpointRow{s.i32(0), s.text(1), s.blob(2)};
 }
 
+std::map<std::int64_t, CheckpointMark> Store::checkpoint_marks(std::int64_t campaign_id) {
+  Guard lock(*this);
+  Statement s(
+      *this,
+      "SELECT c.job_id, c.stage, c.stored FROM checkpoints c JOIN jobs j ON j.id = c.job_id "
+      "WHERE j.campaign_id = ?");
+  s.bind(1, campaign_id);
+  std::map<std::int64_t, CheckpointMark> out;
+  while (s.step()) out.emplace(s.i64(0), CheckpointMark{s.text(1), s.f64(2)});
+  return out;
+}
+
 bool Store::requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason,
                             bool retryable, double now) {
   const bool fail_now = !retryable || counted >= limits_.max_attempts;

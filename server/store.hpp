@@ -122,6 +122,12 @@ struct CheckpointRow {
   std::string stage, state;
 };
 
+/// Where a job's latest checkpoint stands, without its state: the stage and when it was kept.
+struct CheckpointMark {
+  std::string stage;
+  double stored = 0.0;
+};
+
 struct Counts {
   std::int64_t queued = 0, leased = 0, done = 0, failed = 0, cancelled = 0;
   std::int64_t reused = 0;  ///< of done: results taken from an earlier run with the same run key
@@ -243,6 +249,8 @@ class Store {
                               const std::string& stage, const std::string& state, double now);
   /// The job's latest checkpoint, if any.
   std::optional<CheckpointRow> checkpoint(std::int64_t job_id);
+  /// Per job of the campaign with a checkpoint, its stage and when it was kept.
+  std::map<std::int64_t, CheckpointMark> checkpoint_marks(std::int64_t campaign_id);
   /// Expired leases go back to the queue, or fail at the attempt cap. Returns jobs reaped.
   int reap(double now);
   /// The current lease's deadline on the monotonic clock, if the job has one (for tests).

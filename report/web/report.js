@@ -385,14 +385,18 @@
       note(s, data.notes.calibration || 'no calibration');
       return;
     }
+    // While a round runs its prediction is shown; while a stage's design runs there is none.
+    const rounds = cal.rounds || [];
+    const predicted = cal.fitted || (rounds.length > 0 && rounds[rounds.length - 1].state === 'running');
     for (const m of cal.metrics) {
       const tol = m.tolerance > 0 ? m.tolerance : m.uncertainty;
-      const marks = [
+      // While a calibration round runs the models are not refitted: no reach to draw.
+      const marks = cal.fitted ? [
         { what: 'reach of the models', lo: m.envelope_min, hi: m.envelope_max, y: 'envelope' },
-      ];
+      ] : [];
       const pts = [{ what: 'measured', x: m.target, y: 'measured', lo: m.target - (m.uncertainty || 0), hi: m.target + (m.uncertainty || 0) }];
       if (tol > 0) pts.push({ what: 'tolerance', x: m.target, y: 'tolerance', lo: m.target - tol, hi: m.target + tol });
-      pts.push({ what: 'predicted', x: m.predicted, y: 'predicted', lo: m.predicted, hi: m.predicted });
+      if (predicted) pts.push({ what: 'predicted', x: m.predicted, y: 'predicted', lo: m.predicted, hi: m.predicted });
       if (m.simulated_available) pts.push({ what: 'simulated', x: m.simulated, y: 'simulated', lo: m.simulated, hi: m.simulated });
       const order = ['envelope', 'measured', 'tolerance', 'predicted', 'simulated'];
       plot(s, 'envelope:' + m.metric, {
@@ -504,6 +508,11 @@
       });
     }
     if ((r.conflicts || []).length) s.appendChild(el('ul', {}, r.conflicts.map((c) => el('li', {}, c.statement))));
+    const flagged = (r.metrics || []).flatMap((m) => (m.notes || []).map((n) => m.response + ': ' + n));
+    if (flagged.length) {
+      s.appendChild(el('p', {}, 'Flagged values the diagnosis uses:'));
+      s.appendChild(el('ul', { class: 'flagged' }, flagged.map((f) => el('li', {}, f))));
+    }
   }
 
   // The curves of each lab test (docs/lab-tests.md names the series, docs/report.md the figures):

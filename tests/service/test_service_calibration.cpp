@@ -17,6 +17,7 @@
 #include <sstream>
 #include <thread>
 
+#include "client/format.hpp"
 #include "client/service_client.hpp"
 #include "client/spec_yaml.hpp"
 #include "core/common/error.hpp"
@@ -366,6 +367,67 @@ TEST_F(Service, TheCalibratedSetIsShownWithTheValuesSimulatedAtItsOwnRound) {
   EXPECT_EQ(row[5], "8.33");
 }
 
+TEST_F(Service, WhileARoundRunsTheCalibrationShowsItsSetAndNoReach) {
+  // Results through the real worker protocol, no physics, as above. Once round 1 is queued and
+  // before its job is done, the calibration is not refitted: it shows round 1's set with what was
+  // predicted there and its deviation from the measurement, and neither an objective nor a reach.
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  for (int k = 0; k < 4; ++k)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+      const double a = (job.parameters().at("particle_law.tangential.mu_s") - 0.3) / 0.2;
+      (*c.mutable_metrics())["solid_fraction"] = 0.6 + 0.1 * a;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+    }));
+  v1::CalibrateRequest request;
+  request.set_id(id);
+  request.set_verify(true);
+  v1::CalibrateReply queued;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), request, &queued).ok());
+  ASSERT_EQ(queued.verification_jobs_size(), 1) << queued.conclusion();
+  EXPECT_TRUE(queued.fitted());
+  ASSERT_EQ(queued.metrics_size(), 1);
+  EXPECT_LT(queued.metrics(0).envelope_min(), queued.metrics(0).envelope_max());
+
+  request.set_verify(false);
+  v1::CalibrateReply running;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), request, &running).ok());
+  EXPECT_EQ(running.verification_state(), "running");
+  EXPECT_FALSE(running.fitted());
+  ASSERT_EQ(running.rounds_size(), 1);
+  const auto& round = running.rounds(0);
+  EXPECT_EQ(round.state(), "running");
+  ASSERT_EQ(running.proposed_values_size(), round.proposed_values_size());
+  for (int f = 0; f < round.proposed_values_size(); ++f)
+    EXPECT_EQ(running.proposed_values(f), round.proposed_values(f)) << f;
+  ASSERT_EQ(running.metrics_size(), 1);
+  const auto& m = running.metrics(0);
+  ASSERT_EQ(round.predicted_size(), 1);
+  EXPECT_EQ(m.predicted(), round.predicted(0));
+  ASSERT_NE(m.target(), 0.0);
+  EXPECT_DOUBLE_EQ(m.relative_error(), (m.predicted() - m.target()) / m.target());
+  EXPECT_FALSE(m.simulated_available());
+
+  // The table says which round runs, prints its prediction's deviation and no reach.
+  const std::string table =
+      cli_text(dir_, "calibrate_running.txt", {"calibrate", std::to_string(id)}, channel_);
+  EXPECT_NE(table.find("parameter set of calibration round 1, running"), std::string::npos)
+      << table;
+  EXPECT_EQ(table.find("objective"), std::string::npos) << table;
+  std::istringstream lines(table);
+  std::string line;
+  std::vector<std::string> row;
+  while (std::getline(lines, line))
+    if (line.rfind("  packing.solid_fraction ", 0) == 0) {
+      std::istringstream words(line);
+      for (std::string w; words >> w;) row.push_back(w);
+    }
+  ASSERT_EQ(row.size(), 9u) << table;
+  EXPECT_EQ(row[3], cli::fmt(100 * m.relative_error(), 3)) << table;
+  EXPECT_EQ(row[8], "-") << table;
+}
+
 TEST_F(Service, ACalibrationNamesTheFlaggedValuesItUses) {
   // Results through the real worker protocol, no physics: the solid fraction rises with mu_s as
   // above; one design run's value carries a flag (a phase it is computed from did not reach its
@@ -432,10 +494,90 @@ TEST_F(Service, ACalibrationNamesTheFlaggedValuesItUses) {
   EXPECT_NE(m.statement().find("the value simulated at round 1 is flagged: " + hold),
             std::string::npos)
       << m.statement();
+  // It accepts the flagged value as simulated, and its conclusion says so.
+  EXPECT_EQ(done.conclusion().rfind("within uncertainty after 1 round(s)", 0), 0u)
+      << done.conclusion();
+  EXPECT_NE(done.conclusion().find("the calibrated set's simulated packing.solid_fraction flagged"),
+            std::string::npos)
+      << done.conclusion();
   // The table prints the statement under its metric.
   const std::string table =
       cli_text(dir_, "calibrate_flagged.txt", {"calibrate", std::to_string(id)}, channel_);
   EXPECT_NE(table.find("is flagged: " + hold), std::string::npos) << table;
+}
+
+TEST_F(Service, TheDiagnosisNamesTheFlaggedValuesItUses) {
+  // Results through the real worker protocol, no physics: one design run's solid fraction, the
+  // baseline verification's and one coarse_graining design run's carry a flag. The diagnosis fits
+  // and verifies with them, and its report names each under the metric, as does the table.
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit("name: flagged" + coarse_grained_packing() + R"(
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
+  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
+design: {type: full_factorial}
+measurements:
+  - {metric: solid_fraction, value: 0.6}
+diagnose: {candidates: [coarse_graining], rounds: 1}
+)",
+                     &id)
+                  .ok());
+  const std::string settle = "phase 'settle' did not reach its rest within 2 s";
+  std::set<std::int64_t> flagged_jobs;
+  const auto fill = [&](bool flag) {
+    return [&, flag](const v1::JobSpec& job, v1::CompleteRequest& c) {
+      (*c.mutable_metrics())["solid_fraction"] =
+          0.5 + 0.1 * job.parameters().at("particle_law.tangential.mu_s");
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+      if (!flag) return;
+      (*c.mutable_flags())["solid_fraction"] = settle;
+      flagged_jobs.insert(job.job_id());
+    };
+  };
+  for (int k = 0; k < 4; ++k) ASSERT_NO_FATAL_FAILURE(complete_fake_job(fill(k == 1)));
+  v1::DiagnoseRequest diagnose;
+  diagnose.set_id(id);
+  v1::DiagnoseReply first;
+  ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), diagnose, &first).ok());
+  ASSERT_EQ(first.jobs_queued(), 1 + 5);  // the baseline and the candidate's runs
+  // The baseline (the one run at the material's own size) and the candidate's first run are
+  // flagged.
+  bool candidate_flagged = false;
+  for (int k = 0; k < first.jobs_queued(); ++k)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+      const bool baseline = !job.parameters().count("sizes.scale");
+      fill(baseline || !candidate_flagged)(job, c);
+      candidate_flagged = candidate_flagged || !baseline;
+    }));
+
+  std::map<std::string, std::string> expected;  // kind -> the note's words for its runs
+  const v1::ResultsReply stored = results(id);
+  for (const auto& j : stored.jobs())
+    if (flagged_jobs.count(j.job_id()))
+      expected[j.kind()] = std::to_string(j.std_order()) + ": a phase this metric is computed from";
+  ASSERT_EQ(expected.size(), 3u);
+  const std::vector<std::string> notes{
+      "flagged runs " + expected.at("design"),
+      "flagged baseline verification runs " + expected.at("diagnose:baseline"),
+      "flagged coarse_graining design runs " + expected.at("diagnose:coarse_graining")};
+
+  v1::DiagnoseReply second;
+  ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), diagnose, &second).ok());
+  ASSERT_TRUE(second.has_report()) << second.conclusion();
+  const v1::DiagnosisMetric* fraction = nullptr;
+  for (const auto& m : second.report().metrics())
+    if (m.response() == "packing.solid_fraction") fraction = &m;
+  ASSERT_NE(fraction, nullptr);
+  ASSERT_EQ(fraction->notes_size(), 3) << fraction->DebugString();
+  for (int n = 0; n < 3; ++n)
+    EXPECT_EQ(fraction->notes(n).rfind(notes[std::size_t(n)], 0), 0u) << fraction->notes(n);
+  for (const auto& m : second.report().metrics())
+    EXPECT_TRUE(m.response() == "packing.solid_fraction" || m.notes_size() == 0) << m.response();
+
+  const std::string table = cli_text(dir_, "diagnose_flagged.txt",
+                                     {"diagnose", std::to_string(id), "--no-wait"}, channel_);
+  for (const auto& note : notes) EXPECT_NE(table.find(note), std::string::npos) << table;
 }
 
 TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {

@@ -87,6 +87,25 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
   give_back.set_give_back(true);
   v1::FailReply fr;
   ASSERT_TRUE(workers_stub_->Fail(ctx().get(), give_back, &fr).ok());
+  // Queued again, the job shows the checkpoint it goes on from, in the results and in the job
+  // list of `demcal status`.
+  const double before =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  const v1::ResultsReply queued = results(id);
+  for (const auto& j : queued.jobs())
+    if (j.job_id() == job.job_id()) {
+      EXPECT_EQ(j.state(), "queued");
+      EXPECT_EQ(j.checkpoint_stage(), kept.stage);
+      EXPECT_GT(j.checkpoint_saved(), before - 600.0);
+      EXPECT_LE(j.checkpoint_saved(), before);
+    } else {
+      EXPECT_TRUE(j.checkpoint_stage().empty());
+    }
+  const std::string listed =
+      cli_text(dir_, "status_checkpoint.txt", {"status", std::to_string(id), "--jobs"}, channel_);
+  EXPECT_NE(listed.find("job " + std::to_string(job.job_id()) + " "), std::string::npos) << listed;
+  EXPECT_NE(listed.find("goes on from checkpoint '" + kept.stage + "' (kept 20"), std::string::npos)
+      << listed;
   // A real worker leases the job again with its checkpoint and goes on from it.
   Process& second = start_worker("second", kToken, {"--max-jobs", "1"});
   std::optional<v1::JobResult> stored;
@@ -115,6 +134,7 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
   EXPECT_EQ(stored->cost().phases(turned).name(), kept.stage);
   EXPECT_EQ(stored->cost().phases(turned).wall_seconds(), whole.cost.phases[turned].wall_seconds);
   EXPECT_EQ(stored->cost().steps(), whole.cost.steps);
+  EXPECT_TRUE(stored->checkpoint_stage().empty());
   // A stored result drops its job's checkpoint.
   int checkpoints = -1;
   each_row(path("c.db"), "SELECT COUNT(*) FROM checkpoints",
