@@ -482,7 +482,9 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
     reply.set_stage(static_cast<int>(l.state.stages.size()));
     reply.set_simulations(l.state.jobs_used);
     reply.set_conclusion(running_conclusion(l));
-    add_metrics(reply, l, nullptr, latest_simulated(l));
+    // The table shows the running round alone: its values are not simulated yet (the rounds
+    // carry what earlier ones gave).
+    add_metrics(reply, l, nullptr, nullptr);
     if (const auto* running = running_round(l)) show_round(reply, l, *running);
     if (l.plan.fidelity) add_fidelity(reply, l);
     return reply;

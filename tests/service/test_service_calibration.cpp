@@ -370,10 +370,11 @@ TEST_F(Service, TheCalibratedSetIsShownWithTheValuesSimulatedAtItsOwnRound) {
 TEST_F(Service, WhileARoundRunsTheCalibrationShowsItsSetAndNoReach) {
   // Results through the real worker protocol, no physics, as above. Once round 1 is queued and
   // before its job is done, the calibration is not refitted: it shows round 1's set with what was
-  // predicted there and its deviation from the measurement, and neither an objective nor a reach.
+  // predicted there and its deviation from the measurement, and neither an objective nor a reach;
+  // the same for round 2, with no value simulated at it shown.
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
-  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  ASSERT_TRUE(submit(tiny_spec(30, 0, "", "calibration: {rounds: 2, stages: 1}\n"), &id).ok());
   for (int k = 0; k < 4; ++k)
     ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
       const double a = (job.parameters().at("particle_law.tangential.mu_s") - 0.3) / 0.2;
@@ -426,6 +427,27 @@ TEST_F(Service, WhileARoundRunsTheCalibrationShowsItsSetAndNoReach) {
   ASSERT_EQ(row.size(), 9u) << table;
   EXPECT_EQ(row[3], cli::fmt(100 * m.relative_error(), 3)) << table;
   EXPECT_EQ(row[8], "-") << table;
+
+  // Round 1 misses. While round 2 runs the metrics are round 2's alone: nothing simulated there
+  // yet (round 1's value is in the rounds).
+  ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec&, v1::CompleteRequest& c) {
+    (*c.mutable_metrics())["solid_fraction"] = 0.75;
+    (*c.mutable_metrics())["coordination_number"] = 4.0;
+  }));
+  request.set_verify(true);
+  v1::CalibrateReply second;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), request, &second).ok());
+  ASSERT_EQ(second.verification_jobs_size(), 1) << second.conclusion();
+  request.set_verify(false);
+  v1::CalibrateReply later;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), request, &later).ok());
+  EXPECT_FALSE(later.fitted());
+  ASSERT_EQ(later.rounds_size(), 2);
+  EXPECT_EQ(later.rounds(0).state(), "done");
+  ASSERT_EQ(later.rounds(1).predicted_size(), 1);
+  ASSERT_EQ(later.metrics_size(), 1);
+  EXPECT_EQ(later.metrics(0).predicted(), later.rounds(1).predicted(0));
+  EXPECT_FALSE(later.metrics(0).simulated_available());
 }
 
 TEST_F(Service, ACalibrationNamesTheFlaggedValuesItUses) {
