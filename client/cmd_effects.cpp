@@ -8,7 +8,6 @@
 // run` spec of one job, finished, failed or not yet run (docs/report.md).
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -112,8 +111,20 @@ std::map<std::string, v1::JobResult> verification_runs(v1::CampaignService::Stub
   return out;
 }
 
+/// What a job's result is in its spec's first comment lines: its flags when it finished (its
+/// stored metrics are the spec's `expected`), its error when it failed, its state otherwise.
+std::string job_outcome_comment(const v1::JobResult& job) {
+  if (job.state() == "failed") return "#   failed: " + job.error() + "\n";
+  if (job.state() != "done") return "#   not finished: " + job.state() + "\n";
+  std::string out;
+  const std::map<std::string, std::string> flags(job.flags().begin(), job.flags().end());
+  for (const auto& [name, why] : flags) out += "#   flagged " + name + ": " + why + "\n";
+  return out;
+}
+
 /// The `demcal lab run` spec that simulates a job of test instance `instance` (again): its
-/// settings, seed and parameters on the instance's material, one thread.
+/// settings, seed and parameters on the instance's material, one thread; a finished job's stored
+/// metrics as what the run is expected to give.
 lab::LabRunSpec rerun_spec(const v1::CampaignSpec& spec, const v1::LabTest& instance,
                            const v1::JobResult& job) {
   lab::LabRunSpec run;
@@ -123,6 +134,7 @@ lab::LabRunSpec rerun_spec(const v1::CampaignSpec& spec, const v1::LabTest& inst
   run.options.seed = job.seed();
   run.material =
       rpc::job_material(spec, &instance, {job.parameters().begin(), job.parameters().end()});
+  if (job.state() == "done") run.expected.insert(job.metrics().begin(), job.metrics().end());
   return run;
 }
 
@@ -155,7 +167,7 @@ void write_lab_specs(v1::CampaignService::Stub& stub, const rpc::ChannelOptions&
     const auto file = std::filesystem::path(dir) / (name + ".yaml");
     std::ofstream(file) << "# demcal campaign " << id << ", test " << name << ": "
                         << calibrated_run_origin(found) << "\n"
-                        << lab::lab_run_yaml(run);
+                        << (found ? job_outcome_comment(*found) : "") << lab::lab_run_yaml(run);
     std::cerr << "wrote " << file.string() << "\n";
   }
 }
@@ -190,25 +202,9 @@ v1::JobResult campaign_job(v1::CampaignService::Stub& stub, const rpc::ChannelOp
                                 " --jobs` lists its jobs and their states)");
 }
 
-/// What a job's result is in its spec's first comment lines: its stored metrics (17 significant
-/// digits) and flags when it finished, its error when it failed, its state otherwise.
-std::string job_outcome_comment(const v1::JobResult& job) {
-  if (job.state() == "failed") return "#   failed: " + job.error() + "\n";
-  if (job.state() != "done") return "#   not finished: " + job.state() + "\n";
-  std::string out;
-  const std::map<std::string, double> metrics(job.metrics().begin(), job.metrics().end());
-  for (const auto& [name, value] : metrics) {
-    char line[160];
-    std::snprintf(line, sizeof line, "#   %s: %.17g\n", name.c_str(), value);
-    out += line;
-  }
-  const std::map<std::string, std::string> flags(job.flags().begin(), job.flags().end());
-  for (const auto& [name, why] : flags) out += "#   flagged " + name + ": " + why + "\n";
-  return out;
-}
-
-/// The `demcal lab run` spec that simulates job `job` (again): a finished job's stored metrics and
-/// flags, a failed job's error or an unfinished job's state in its first comment lines.
+/// The `demcal lab run` spec that simulates job `job` (again): a finished job's stored metrics as
+/// its `expected` and its flags, a failed job's error or an unfinished job's state in its first
+/// comment lines.
 std::string job_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
                        std::int64_t id, std::int64_t job) {
   const v1::Campaign campaign = fetch_campaign(stub, channel, id);
@@ -222,7 +218,7 @@ std::string job_export(v1::CampaignService::Stub& stub, const rpc::ChannelOption
                                   " was planned by an older build whose payload cannot be read");
   return "# demcal campaign " + std::to_string(id) + " '" + campaign.name() + "', job " +
          std::to_string(job) + " (" + found.test() + "): simulates it" +
-         (found.state() == "done" ? " again; its stored metrics" : "") + ":\n" +
+         (found.state() == "done" ? " again, its stored metrics expected" : "") + "\n" +
          job_outcome_comment(found) +
          lab::lab_run_yaml(rerun_spec(campaign.spec(), *instance, found));
 }

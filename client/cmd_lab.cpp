@@ -27,7 +27,31 @@ struct LabOptions {
   std::string out_dir;
   std::string stage_cache;
   int threads = 0;
+  double tolerance = 0.0;  ///< of an expected metric, relative; 0: the same double
 };
+
+/// The spec's expected metrics against the run, as `j["expected"]` and `j["reproduced"]`; the
+/// ones not reproduced, in words (empty when every one is).
+std::string check_expected(const lab::LabRunSpec& spec, const lab::LabOutput& out, double tolerance,
+                           nlohmann::json& j) {
+  if (spec.expected.empty()) return {};
+  std::string missed;
+  bool reproduced = true;
+  for (const auto& m : lab::compare_expected(spec, out.metrics, tolerance)) {
+    j["expected"][m.metric] = {{"stored", m.stored},
+                               {"simulated", m.simulated},
+                               {"relative_difference", m.difference},
+                               {"reproduced", m.reproduced}};
+    reproduced = reproduced && m.reproduced;
+    if (m.reproduced) continue;
+    char line[256];
+    std::snprintf(line, sizeof line, "\n  %s: simulated %.17g against the stored %.17g",
+                  m.metric.c_str(), m.simulated, m.stored);
+    missed += line;
+  }
+  j["reproduced"] = reproduced;
+  return missed;
+}
 
 void run_lab(const LabOptions& opt) {
   auto spec = lab::read_lab_run(io::YamlNode::load_file(opt.spec));
@@ -56,9 +80,18 @@ void run_lab(const LabOptions& opt) {
       j["series"].push_back(path);
     }
     j["snapshots"] = out.snapshots;
-    std::ofstream(opt.out_dir + "/metrics.json") << j.dump(2) << "\n";
   }
+  const std::string missed = check_expected(spec, out, opt.tolerance, j);
+  if (!opt.out_dir.empty()) std::ofstream(opt.out_dir + "/metrics.json") << j.dump(2) << "\n";
   std::cout << j.dump(2) << "\n";
+  if (missed.empty()) return;
+  std::ostringstream why;
+  why << opt.spec << ": the run does not reproduce its expected metrics ";
+  if (opt.tolerance > 0.0)
+    why << "within a relative " << opt.tolerance;
+  else
+    why << "to the bit";
+  throw std::runtime_error(why.str() + ":" + missed);
 }
 
 struct StudyOptions {
@@ -305,6 +338,10 @@ void add_lab_command(CLI::App& app) {
   run->add_option("--out", opt->out_dir,
                   "directory for metrics.json, series CSV and VTK snapshots");
   run->add_option("--threads", opt->threads, "override the spec's thread count");
+  run->add_option("--tolerance", opt->tolerance,
+                  "relative difference allowed between the spec's `expected` metrics and the run's "
+                  "(default 0: the same bits); a miss exits with status 1")
+      ->check(CLI::Range(0.0, 1.0));
   run->add_option("--stage-cache", opt->stage_cache,
                   "directory where runs keep the stages other runs start from (e.g. the bed a "
                   "confined compression conditioned, for a tensile test)");

@@ -1,5 +1,6 @@
 #include "core/lab/lab_run_yaml.hpp"
 
+#include <cmath>
 #include <sstream>
 
 #include "core/io/material_yaml.hpp"
@@ -16,11 +17,20 @@ std::string lab_run_yaml(const LabRunSpec& spec) {
   }
   y << "}\nseed: " << spec.options.seed << "\nthreads: " << spec.options.threads << "\n"
     << io::material_yaml(spec.material);
+  if (!spec.expected.empty()) {
+    y << "expected: {";
+    first = true;
+    for (const auto& [name, value] : spec.expected) {
+      y << (first ? "" : ", ") << name << ": " << io::yaml_number(value);
+      first = false;
+    }
+    y << "}\n";
+  }
   return y.str();
 }
 
 LabRunSpec read_lab_run(const io::YamlNode& root) {
-  root.expect_only({"test", "settings", "seed", "threads", "material"});
+  root.expect_only({"test", "settings", "seed", "threads", "material", "expected"});
   LabRunSpec spec;
   spec.test = root["test"].as_string();
   const auto& info = find_lab_info(spec.test);
@@ -35,7 +45,30 @@ LabRunSpec read_lab_run(const io::YamlNode& root) {
   spec.material = io::read_material(root["material"]);
   spec.options.seed = static_cast<std::uint64_t>(root.number("seed", 1));
   spec.options.threads = static_cast<int>(root.number("threads", 1));
+  if (auto e = root.child("expected"))
+    for (const auto& key : e->keys()) {
+      if (!reports_metric(info, key))
+        (*e)[key].fail("'" + key + "' is not a metric of the " + spec.test + " test");
+      spec.expected[key] = (*e)[key].as_number();
+    }
   return spec;
+}
+
+std::vector<ExpectedMetric> compare_expected(const LabRunSpec& spec,
+                                             const std::map<std::string, double>& metrics,
+                                             double tolerance) {
+  std::vector<ExpectedMetric> out;
+  for (const auto& [name, stored] : spec.expected) {
+    ExpectedMetric m{name, stored, std::nan(""), std::nan(""), false};
+    if (const auto it = metrics.find(name); it != metrics.end()) {
+      m.simulated = it->second;
+      const double miss = std::abs(m.simulated - stored);
+      m.difference = stored != 0.0 ? miss / std::abs(stored) : miss;
+      m.reproduced = m.simulated == stored || m.difference <= tolerance;
+    }
+    out.push_back(m);
+  }
+  return out;
 }
 
 }  // namespace demcal::lab

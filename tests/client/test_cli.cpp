@@ -485,7 +485,8 @@ calibration: {rounds: 1, stages: 1}
 /// 30 spheres, poured and grown, one verification round) is run and calibrated; the exported
 /// material block read back by the lab-run spec reader holds the calibrated values and the fixed
 /// one, and the lab run spec written for each test instance (the grown one with its own
-/// preparation) simulates the verified number again, to the bit.
+/// preparation) simulates the verified number again, to the bit, which it holds as expected; a
+/// spec expecting another value fails `demcal lab run`, naming the metric.
 TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
   const fs::path dir = scratch_dir("yaml");
   std::ofstream(dir / "tiny.yaml") << kTinyPackingCampaign;
@@ -528,10 +529,35 @@ TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
         (dir / ("rerun-" + instance)).string() + " 2>/dev/null");
     ASSERT_EQ(rerun.exit_code, 0) << rerun.out;
     const std::size_t at = instance == "packing" ? 0 : 1;  // the measurements' order
-    EXPECT_EQ(nlohmann::json::parse(rerun.out)["metrics"]["solid_fraction"].get<double>(),
-              round["simulated"][at].get<double>())
-        << instance;
+    const double verified = round["simulated"][at].get<double>();
+    EXPECT_EQ(lab.expected.at("solid_fraction"), verified) << instance;
+    const auto rerun_json = nlohmann::json::parse(rerun.out);
+    EXPECT_EQ(rerun_json["metrics"]["solid_fraction"].get<double>(), verified) << instance;
+    EXPECT_TRUE(rerun_json["reproduced"].get<bool>()) << rerun.out;
   }
+
+  // A spec whose expected value the run does not give: `demcal lab run` exits with status 1 and
+  // names the metric, unless the difference is within --tolerance.
+  auto off = demcal::lab::read_lab_run(
+      demcal::io::YamlNode::load_file((dir / "specs" / "packing.yaml").string()));
+  const double verified = off.expected.at("solid_fraction");
+  off.expected["solid_fraction"] = verified * 1.01;
+  const fs::path off_file = dir / "off.yaml";
+  std::ofstream(off_file) << demcal::lab::lab_run_yaml(off);
+  const auto missed = demcal::test::run_command(
+      std::string(DEMCAL_BINARY_DIR) + "/client/demcal lab run " + off_file.string() + " 2>&1");
+  EXPECT_EQ(missed.exit_code, 1) << missed.out;
+  char named[200];
+  std::snprintf(named, sizeof named, "solid_fraction: simulated %.17g against the stored %.17g",
+                verified, verified * 1.01);
+  EXPECT_NE(missed.out.find("does not reproduce its expected metrics to the bit:"),
+            std::string::npos)
+      << missed.out;
+  EXPECT_NE(missed.out.find(named), std::string::npos) << missed.out;
+  const auto within =
+      demcal::test::run_command(std::string(DEMCAL_BINARY_DIR) + "/client/demcal lab run " +
+                                off_file.string() + " --tolerance 0.02 2>&1");
+  EXPECT_EQ(within.exit_code, 0) << within.out;
 
   // With no finished run of an instance at the calibrated set (inside the box, so no design run
   // is there: the grown verification job marked failed in the store), its spec is the run the
@@ -564,13 +590,15 @@ TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
   EXPECT_EQ(demcal::lab::material_identity(lab.material), demcal::lab::material_identity(expected));
   EXPECT_EQ(lab.options.seed, 1u);
   EXPECT_EQ(lab.settings.at("particles"), 30.0);
+  EXPECT_TRUE(lab.expected.empty());  // no stored run to expect
   fs::remove_all(dir);
 }
 
 /// `demcal export --format yaml --job N`: the `demcal lab run` spec of one job of a campaign
 /// still without a calibration (the tiny packing campaign, run with --no-verify). Run, the spec of
-/// a grown job gives the stored solid fraction to the bit, and its first comment names the job and
-/// holds the stored value; the poured job, marked failed in the store afterwards, has its spec
+/// a grown job gives the stored solid fraction to the bit, its first comment names the job, and its
+/// `expected` holds the stored metrics, which `demcal lab run` reports reproduced; the poured job,
+/// marked failed in the store afterwards, has its spec
 /// written all the same, its error in the comment, and that spec gives the solid fraction its run
 /// stored. A job the campaign does not have, the option outside the yaml format and beside
 /// --lab-specs are refused, naming --job.
@@ -610,21 +638,25 @@ TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAJobAgain) {
     const std::string first = text.substr(0, text.find('\n'));
     EXPECT_NE(first.find("job " + std::to_string(id) + " (" + instance + ")"), std::string::npos)
         << first;
-    char stored[80];
-    std::snprintf(stored, sizeof stored, "\n#   solid_fraction: %.17g\n",
-                  job["metrics"]["solid_fraction"].get<double>());
-    const std::string outcome = instance == "packing" ? "\n#   failed: " + failure + "\n" : stored;
-    EXPECT_LT(text.find(outcome), text.find("\ntest: packing")) << text;
+    const double stored = job["metrics"]["solid_fraction"].get<double>();
     const auto lab = demcal::lab::read_lab_run(demcal::io::YamlNode::load_file(file.string()));
     EXPECT_EQ(lab.material.preparation.method == demcal::lab::PreparationMethod::kGrowth,
               instance == "grown");
+    if (instance == "packing") {
+      EXPECT_LT(text.find("\n#   failed: " + failure + "\n"), text.find("\ntest: packing")) << text;
+      EXPECT_TRUE(lab.expected.empty());
+    } else {
+      EXPECT_NE(first.find("simulates it again, its stored metrics expected"), std::string::npos)
+          << first;
+      EXPECT_EQ(lab.expected.at("solid_fraction"), stored);
+    }
     const auto rerun = demcal::test::run_command(
         std::string(DEMCAL_BINARY_DIR) + "/client/demcal lab run " + file.string() + " --out " +
         (dir / ("rerun-" + instance)).string() + " 2>/dev/null");
     ASSERT_EQ(rerun.exit_code, 0) << rerun.out;
-    EXPECT_EQ(nlohmann::json::parse(rerun.out)["metrics"]["solid_fraction"].get<double>(),
-              job["metrics"]["solid_fraction"].get<double>())
-        << instance;
+    const auto rerun_json = nlohmann::json::parse(rerun.out);
+    EXPECT_EQ(rerun_json["metrics"]["solid_fraction"].get<double>(), stored) << instance;
+    EXPECT_EQ(rerun_json.value("reproduced", false), instance == "grown") << rerun.out;
   }
 
   const Result unknown = demcal("export " + spec + work + " --format yaml --job 99");

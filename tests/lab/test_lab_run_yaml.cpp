@@ -1,12 +1,16 @@
 // The YAML of a material and of a lab run written by material_yaml() / lab_run_yaml() reads back
 // with the lab-run reader to the same model and run, for every part of a material the writer
 // covers: both laws, a log-normal distribution, size scale, scaling, a clump shape, a
-// preparation and the real median radius. The lab-run specs committed beside seed 000's tables
+// preparation and the real median radius; a run's expected metrics, checked against the test's
+// and compared with a run's. The lab-run specs committed beside seed 000's tables
 // (docs/data/seed000) read as runs of the test each is named after.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
+#include "core/common/error.hpp"
 #include "core/io/yaml_node.hpp"
 #include "core/lab/lab_run_yaml.hpp"
 
@@ -52,6 +56,7 @@ TEST(LabRunYaml, ALabRunReadsBackToTheSameRun) {
   run.material = every_part();
   run.options.seed = 1000002;
   run.options.threads = 2;
+  run.expected = {{"solid_fraction", 0.1 + 0.2}, {"coordination_number", 4.0 / 3.0}};
   const std::string yaml = lab_run_yaml(run);
   const LabRunSpec back = read_lab_run(io::YamlNode::load_string(yaml, "run.yaml"));
   EXPECT_EQ(back.test, run.test);
@@ -59,6 +64,52 @@ TEST(LabRunYaml, ALabRunReadsBackToTheSameRun) {
   EXPECT_EQ(back.options.seed, run.options.seed);
   EXPECT_EQ(back.options.threads, run.options.threads);
   EXPECT_EQ(material_identity(back.material), material_identity(run.material)) << yaml;
+  EXPECT_EQ(back.expected, run.expected) << yaml;  // the same doubles
+}
+
+TEST(LabRunYaml, ExpectedMetricsAreTheTestsAndFinite) {
+  LabRunSpec run;
+  run.test = "packing";
+  run.material = every_part();
+  const std::string yaml = lab_run_yaml(run);
+  auto error_of = [&](const std::string& expected) {
+    try {
+      read_lab_run(io::YamlNode::load_string(yaml + expected, "run.yaml"));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const int line = static_cast<int>(std::count(yaml.begin(), yaml.end(), '\n')) + 1;
+  const std::string unknown = error_of("expected: {tensile_strength: 1.0}\n");
+  EXPECT_NE(unknown.find("'tensile_strength' is not a metric of the packing test"),
+            std::string::npos)
+      << unknown;
+  EXPECT_NE(unknown.find("run.yaml:" + std::to_string(line)), std::string::npos) << unknown;
+  const std::string infinite = error_of("expected: {solid_fraction: .inf}\n");
+  EXPECT_NE(infinite.find("expected a finite number"), std::string::npos) << infinite;
+}
+
+TEST(LabRunYaml, ARunReproducesItsExpectedMetricsToTheBitOrWithinTheTolerance) {
+  LabRunSpec run;
+  run.expected = {{"solid_fraction", 0.6}, {"coordination_number", 4.0}};
+  const std::map<std::string, double> same{{"solid_fraction", 0.6}, {"coordination_number", 4.0}};
+  for (const auto& m : compare_expected(run, same, 0.0)) {
+    EXPECT_TRUE(m.reproduced) << m.metric;
+    EXPECT_EQ(m.difference, 0.0);
+  }
+  const std::map<std::string, double> near{{"solid_fraction", 0.6 * (1 + 1e-12)},
+                                           {"coordination_number", 4.0}};
+  const auto exact = compare_expected(run, near, 0.0);
+  ASSERT_EQ(exact.size(), 2u);
+  EXPECT_TRUE(exact[0].reproduced);  // coordination_number, in name order
+  EXPECT_FALSE(exact[1].reproduced);
+  EXPECT_NEAR(exact[1].difference, 1e-12, 1e-15);
+  EXPECT_TRUE(compare_expected(run, near, 1e-9)[1].reproduced);
+  // A metric the run did not give is not reproduced.
+  const auto missing = compare_expected(run, {{"coordination_number", 4.0}}, 1.0);
+  EXPECT_FALSE(missing[1].reproduced);
+  EXPECT_TRUE(std::isnan(missing[1].simulated));
 }
 
 TEST(LabRunYaml, TheCommittedSeed000LabSpecsReadAsRunsOfTheirTest) {
