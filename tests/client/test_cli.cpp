@@ -486,7 +486,8 @@ calibration: {rounds: 1, stages: 1}
 /// material block read back by the lab-run spec reader holds the calibrated values and the fixed
 /// one, and the lab run spec written for each test instance (the grown one with its own
 /// preparation) simulates the verified number again, to the bit, which it holds as expected; a
-/// spec expecting another value fails `demcal lab run`, naming the metric.
+/// spec expecting another value fails `demcal lab run`, naming the metric, and `scripts/resimulate`
+/// of the directory.
 TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
   const fs::path dir = scratch_dir("yaml");
   std::ofstream(dir / "tiny.yaml") << kTinyPackingCampaign;
@@ -558,6 +559,24 @@ TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
       demcal::test::run_command(std::string(DEMCAL_BINARY_DIR) + "/client/demcal lab run " +
                                 off_file.string() + " --tolerance 0.02 2>&1");
   EXPECT_EQ(within.exit_code, 0) << within.out;
+
+  // scripts/resimulate runs every spec of a directory: the exported ones reproduce their numbers;
+  // with the off one beside them it exits 1 and names it and its metric.
+  const std::string resimulate = "DEMCAL=" + std::string(DEMCAL_BINARY_DIR) + "/client/demcal " +
+                                 source("scripts/resimulate") + " ";
+  const auto exported_dir =
+      demcal::test::run_command(resimulate + (dir / "specs").string() + " 2>&1");
+  EXPECT_EQ(exported_dir.exit_code, 0) << exported_dir.out;
+  for (const std::string line :
+       {"grown.yaml: reproduced", "packing.yaml: reproduced", "2 spec(s), 0 not reproduced"})
+    EXPECT_NE(exported_dir.out.find(line), std::string::npos) << exported_dir.out;
+  fs::copy_file(off_file, dir / "specs" / "off.yaml");
+  const auto with_off = demcal::test::run_command(resimulate + (dir / "specs").string() + " 2>&1");
+  EXPECT_EQ(with_off.exit_code, 1) << with_off.out;
+  for (const std::string& line : {std::string("off.yaml: NOT REPRODUCED"), std::string(named),
+                                  std::string("3 spec(s), 1 not reproduced")})
+    EXPECT_NE(with_off.out.find(line), std::string::npos) << with_off.out;
+  fs::remove(dir / "specs" / "off.yaml");
 
   // With no finished run of an instance at the calibrated set (inside the box, so no design run
   // is there: the grown verification job marked failed in the store), its spec is the run the
