@@ -214,6 +214,17 @@ class Service : public ::testing::Test {
     ASSERT_TRUE(st.ok()) << st.error_message();
   }
 
+  /// Completes the four design jobs of tiny_spec's packing campaign with fake metrics: the solid
+  /// fraction rising with mu_s over the box 0.1-0.5, 0.6 + 0.1 (mu_s - 0.3) / 0.2.
+  void complete_linear_design() {
+    for (int k = 0; k < 4; ++k)
+      ASSERT_NO_FATAL_FAILURE(complete_fake_job([](const v1::JobSpec& job, v1::CompleteRequest& c) {
+        const double a = (job.parameters().at("particle_law.tangential.mu_s") - 0.3) / 0.2;
+        (*c.mutable_metrics())["solid_fraction"] = 0.6 + 0.1 * a;
+        (*c.mutable_metrics())["coordination_number"] = 4.0;
+      }));
+  }
+
   /// Completes the `design_jobs` design jobs of a packing campaign with fake metrics (the solid
   /// fraction rising with mu_s), then calls Diagnose once: the runs it queues first.
   void finish_design_and_diagnose(std::int64_t id, int design_jobs, v1::DiagnoseReply& reply) {

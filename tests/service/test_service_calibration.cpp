@@ -32,6 +32,18 @@
 namespace demcal::test {
 namespace {
 
+/// The words of the line of `metric` in a table `demcal calibrate` printed (empty: no such line).
+std::vector<std::string> table_row(const std::string& table, const std::string& metric) {
+  std::istringstream lines(table);
+  std::vector<std::string> row;
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("  " + metric + " ", 0) == 0) {
+      std::istringstream words(line);
+      for (std::string w; words >> w;) row.push_back(w);
+    }
+  return row;
+}
+
 TEST_F(Service, DiagnoseOrVerifyOnACancelledCampaignIsRefusedAndQueuesNothing) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
@@ -313,12 +325,7 @@ TEST_F(Service, TheCalibratedSetIsShownWithTheValuesSimulatedAtItsOwnRound) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
   ASSERT_TRUE(submit(tiny_spec(30, 0, "", "calibration: {rounds: 2, stages: 1}\n"), &id).ok());
-  for (int k = 0; k < 4; ++k)
-    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
-      const double a = (job.parameters().at("particle_law.tangential.mu_s") - 0.3) / 0.2;
-      (*c.mutable_metrics())["solid_fraction"] = 0.6 + 0.1 * a;
-      (*c.mutable_metrics())["coordination_number"] = 4.0;
-    }));
+  ASSERT_NO_FATAL_FAILURE(complete_linear_design());
   v1::CalibrateRequest verify;
   verify.set_id(id);
   verify.set_verify(true);
@@ -353,14 +360,7 @@ TEST_F(Service, TheCalibratedSetIsShownWithTheValuesSimulatedAtItsOwnRound) {
   // against 0.6 is +8.33 %.
   const std::string table =
       cli_text(dir_, "calibrate_table.txt", {"calibrate", std::to_string(id)}, channel_);
-  std::istringstream lines(table);
-  std::string line;
-  std::vector<std::string> row;
-  while (std::getline(lines, line))
-    if (line.rfind("  packing.solid_fraction ", 0) == 0) {
-      std::istringstream words(line);
-      for (std::string w; words >> w;) row.push_back(w);
-    }
+  const std::vector<std::string> row = table_row(table, "packing.solid_fraction");
   ASSERT_GE(row.size(), 6u) << table;
   EXPECT_EQ(row[1], "0.6");
   EXPECT_EQ(row[4], "0.65");
@@ -375,12 +375,7 @@ TEST_F(Service, WhileARoundRunsTheCalibrationShowsItsSetAndNoReach) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
   ASSERT_TRUE(submit(tiny_spec(30, 0, "", "calibration: {rounds: 2, stages: 1}\n"), &id).ok());
-  for (int k = 0; k < 4; ++k)
-    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
-      const double a = (job.parameters().at("particle_law.tangential.mu_s") - 0.3) / 0.2;
-      (*c.mutable_metrics())["solid_fraction"] = 0.6 + 0.1 * a;
-      (*c.mutable_metrics())["coordination_number"] = 4.0;
-    }));
+  ASSERT_NO_FATAL_FAILURE(complete_linear_design());
   v1::CalibrateRequest request;
   request.set_id(id);
   request.set_verify(true);
@@ -416,14 +411,7 @@ TEST_F(Service, WhileARoundRunsTheCalibrationShowsItsSetAndNoReach) {
   EXPECT_NE(table.find("parameter set of calibration round 1, running"), std::string::npos)
       << table;
   EXPECT_EQ(table.find("objective"), std::string::npos) << table;
-  std::istringstream lines(table);
-  std::string line;
-  std::vector<std::string> row;
-  while (std::getline(lines, line))
-    if (line.rfind("  packing.solid_fraction ", 0) == 0) {
-      std::istringstream words(line);
-      for (std::string w; words >> w;) row.push_back(w);
-    }
+  const std::vector<std::string> row = table_row(table, "packing.solid_fraction");
   ASSERT_EQ(row.size(), 9u) << table;
   EXPECT_EQ(row[3], cli::fmt(100 * m.relative_error(), 3)) << table;
   EXPECT_EQ(row[8], "-") << table;
