@@ -94,7 +94,7 @@ void add_campaign_commands(CLI::App& app) {
       if (j.reused_from() != 0) std::cout << "  reused from job " << j.reused_from();
       if (!j.reused_journal().empty()) std::cout << "  reused from " << j.reused_journal();
       if (!j.checkpoint_stage().empty())
-        std::cout << "  goes on from checkpoint '" << j.checkpoint_stage() << "' (kept "
+        std::cout << "  checkpoint '" << j.checkpoint_stage() << "' (kept "
                   << utc_time(j.checkpoint_saved()) << ")";
       std::cout << "\n";
       for (const auto& [k, why] : j.flags()) std::cout << "    ! " << k << ": " << why << "\n";
