@@ -22,6 +22,13 @@ namespace {
 /// Verification seeds start here, apart from every design and stage row's seed.
 constexpr std::uint64_t kVerifySeedOffset = 1'000'000;
 
+/// The lab seed of replicate `replicate` (0-based) of calibration round `round`: replicate 0's
+/// is the one a calibration without replicates uses; each further one a million on, apart from
+/// every other round's and replicate's.
+std::uint64_t verify_seed(int round, int replicate) {
+  return kVerifySeedOffset * std::uint64_t(replicate + 1) + std::uint64_t(round);
+}
+
 /// Everything the calibration of one campaign knows, read from the store.
 struct Loaded {
   CampaignPlan plan;
@@ -52,10 +59,13 @@ int column_of(const CampaignPlan& plan, const std::string& response) {
   throw InputError("spec.measurements", "no response " + response);
 }
 
-/// The simulated values of a round once every job of it has ended (NaN for a failed metric).
+/// The simulated values of a round once every job of it has ended: per metric the mean over the
+/// round's replicates (NaN when a replicate's run of it failed).
 std::optional<Eigen::VectorXd> round_values(const Loaded& l, const std::vector<int>& columns,
                                             int round) {
-  Eigen::VectorXd v = Eigen::VectorXd::Constant(Eigen::Index(columns.size()), std::nan(""));
+  const auto n = Eigen::Index(columns.size());
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXi count = Eigen::VectorXi::Zero(n);
   int seen = 0;
   for (const auto& j : l.jobs) {
     if (j.kind != job_kind::kVerify || j.std_order != round) continue;
@@ -63,11 +73,16 @@ std::optional<Eigen::VectorXd> round_values(const Loaded& l, const std::vector<i
     if (is_open(j)) return std::nullopt;
     if (j.state != "done" || !j.metrics_json) continue;
     for (const auto& [metric, value] : metrics_from_json(*j.metrics_json))
-      for (std::size_t m = 0; m < columns.size(); ++m)
-        if (l.plan.responses[std::size_t(columns[m])] == j.test + "." + metric)
-          v(Eigen::Index(m)) = value;
+      for (Eigen::Index m = 0; m < n; ++m)
+        if (l.plan.responses[std::size_t(columns[std::size_t(m)])] == j.test + "." + metric) {
+          sum(m) += value;
+          ++count(m);
+        }
   }
   if (seen == 0) return std::nullopt;
+  Eigen::VectorXd v(n);
+  for (Eigen::Index m = 0; m < n; ++m)
+    v(m) = count(m) == l.options.replicates ? sum(m) / count(m) : std::nan("");
   return v;
 }
 
@@ -138,8 +153,10 @@ void add_targets(Loaded& l) {
                                   : l.fidelity[m].mean_correction_sd(l.state.stages.front().coded,
                                                                      l.low.col(Eigen::Index(m)),
                                                                      l.high.col(Eigen::Index(m)));
-    l.state.targets.push_back(
-        {t.response, t.value, t.weight, t.uncertainty, a.noise.sd, correction});
+    // A verified value is the mean of the round's replicates: its noise is a run's over
+    // sqrt(replicates).
+    const double noise = a.noise.sd / std::sqrt(double(l.options.replicates));
+    l.state.targets.push_back({t.response, t.value, t.weight, t.uncertainty, noise, correction});
     l.noise_df.push_back(a.noise.degrees_of_freedom);
     ++m;
   }
@@ -169,7 +186,7 @@ Loaded load(Store& store, const CampaignRow& row, const CalibrateCall& call,
   auto& s = l.state;
   s.factors.clear();
   for (const auto& f : l.plan.factors) s.factors.push_back(f.factor);
-  s.jobs_per_point = std::max(1, static_cast<int>(l.plan.instances.size()));
+  s.jobs_per_point = std::max(1, static_cast<int>(l.plan.instances.size())) * l.options.replicates;
   s.stages.push_back(stage_runs(l, columns, s.factors, job_kind::kDesign));
   if (l.plan.fidelity) correct_design(l);
   add_targets(l);
@@ -379,9 +396,13 @@ std::vector<std::int64_t> queue_rounds(Store& store, const CampaignRow& row, con
     std::map<std::string, double> parameters;
     for (std::size_t f = 0; f < l.plan.factors.size(); ++f)
       parameters[l.plan.factors[f].path] = d.batch[b](Eigen::Index(f));
-    const auto jobs = jobs_of(
-        l.plan, runs_at(l.plan, parameters, true, round, std::string(job_kind::kVerify),
-                        l.plan.pinned_seeds ? 0 : kVerifySeedOffset + std::uint64_t(round)));
+    std::vector<NewJob> jobs;
+    for (int r = 0; r < l.options.replicates; ++r) {
+      const auto replicate =
+          jobs_of(l.plan, runs_at(l.plan, parameters, true, round, std::string(job_kind::kVerify),
+                                  l.plan.pinned_seeds ? 0 : verify_seed(round, r)));
+      jobs.insert(jobs.end(), replicate.begin(), replicate.end());
+    }
     const auto queued = store.add_calibration_round(
         row.id,
         {round, d.stage, proposal_to_json(d.batch[b], d.batch_predicted[b], l.responses, batch),

@@ -68,6 +68,10 @@ CampaignPlan read_plan_input(const v1::CampaignSpec& spec) {
   for (const auto& f : spec.factors()) plan.factors.push_back(read_factor(f));
   plan.pinned_seeds = spec.design().simulation_seeds() == v1::Design::PINNED;
   plan.calibration = calibration_options(spec.calibration(), "spec.calibration");
+  if (plan.pinned_seeds && plan.calibration.replicates > 1)
+    throw InputError("spec.calibration.replicates",
+                     "the design's simulation seeds are pinned, so every replicate would be the "
+                     "same run: leave it at 1 or let the seeds vary");
   plan.batch_per_worker = spec.calibration().batch() == 0;
   plan.diagnosis = diagnose_options(spec.diagnose(), "spec.diagnose");
   return plan;
@@ -94,6 +98,7 @@ calib::SequentialOptions calibration_options(const v1::CalibrationOptions& spec,
                      "unknown surrogate '" + spec.surrogate() + "' (polynomial or gp)");
   if (spec.batch() < 0) throw InputError(where + ".batch", "must be >= 0");
   if (spec.batch() > 0) o.batch = spec.batch();
+  if (spec.replicates() != 0) o.replicates = spec.replicates();
   if (!spec.model().empty()) o.model = polynomial_model(spec.model(), where + ".model");
   o.validate(where);
   return o;

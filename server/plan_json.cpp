@@ -59,6 +59,7 @@ Json calibration_json(const CampaignPlan& p) {
           {"stages", o.stages},
           {"narrow", o.narrow},
           {"max_jobs", o.max_jobs},
+          {"replicates", o.replicates},
           {"model", doe::to_string(o.model)}};
 }
 
@@ -72,6 +73,7 @@ void calibration_from(const Json& j, CampaignPlan& p) {
   o.stages = j.at("stages");
   o.narrow = j.at("narrow");
   o.max_jobs = j.at("max_jobs");
+  o.replicates = j.value("replicates", 1);  // plans stored before replicates: one seed
   o.model = polynomial_model(j.at("model"), "plan.calibration.model");
 }
 

@@ -200,6 +200,8 @@ void SequentialOptions::validate(const std::string& where) const {
   if (!(std::isfinite(narrow) && narrow > 0.0 && narrow < 1.0))
     throw InputError(where + ".narrow", "must lie in (0, 1)");
   if (max_jobs < 0) throw InputError(where + ".max_jobs", "must be >= 0");
+  if (replicates < 1 || replicates > 16)
+    throw InputError(where + ".replicates", "must lie in [1, 16]");
 }
 
 double tolerance(const SequentialTarget& target) {

@@ -34,6 +34,9 @@ struct SequentialOptions {
   int stages = 2;       ///< 1 = no second-stage design
   double narrow = 0.3;  ///< a new stage's box spans this fraction of each factor's coded range
   int max_jobs = 0;     ///< simulations the calibration may add; 0 = no limit
+  /// Lab seeds each verified point is simulated on; its value is their mean, whose run-to-run
+  /// noise is the single run's over sqrt(replicates).
+  int replicates = 1;
   doe::ModelKind model = doe::ModelKind::kTwoFactor;
   CalibrationOptions calibration;
   /// InputError naming "<where>.rounds" etc. for a value out of range.
@@ -79,7 +82,7 @@ struct SequentialState {
   std::vector<StageRuns> stages;  ///< stage 1 = the campaign's design
   std::vector<VerifiedRound> rounds;
   int jobs_used = 0;       ///< simulations added by the calibration so far
-  int jobs_per_point = 1;  ///< simulations one parameter set costs (one per lab test)
+  int jobs_per_point = 1;  ///< simulations one parameter set costs (one per lab test and replicate)
 };
 
 /// How a simulated point compares with the targets: each metric's |simulated - target| in

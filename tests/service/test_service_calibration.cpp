@@ -438,6 +438,70 @@ TEST_F(Service, WhileARoundRunsTheCalibrationShowsItsSetAndNoReach) {
   EXPECT_FALSE(later.metrics(0).simulated_available());
 }
 
+TEST_F(Service, ARoundOnSeveralSeedsIsVerifiedByTheirMean) {
+  // Results through the real worker protocol, no physics. With `replicates: 2` a round's point is
+  // simulated on two lab seeds of its own, and its value is their mean, judged against a tolerance
+  // whose run-to-run noise is a run's over sqrt(2): the noise of the same design in a campaign
+  // without replicates, over sqrt(2). Each replicate alone misses the measurement (0.6 +- 0.02)
+  // by 0.03; their mean meets it.
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t single = 0, replicated = 0;
+  ASSERT_TRUE(submit(tiny_spec(30, 0, "", "calibration: {rounds: 1, stages: 1}\n"), &single).ok());
+  for (int k = 0; k < 4; ++k)
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([](const v1::JobSpec& job, v1::CompleteRequest& c) {
+      const auto& p = job.parameters();
+      const double a = (p.at("particle_law.tangential.mu_s") - 0.3) / 0.2;
+      const double b = (p.at("particle_law.normal.restitution") - 0.4) / 0.2;
+      (*c.mutable_metrics())["solid_fraction"] = 0.6 + 0.1 * a + 0.004 * a * b;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+    }));
+  // The same design with replicated rounds: its runs are the first campaign's, taken at the next
+  // lease instead of handed out.
+  ASSERT_TRUE(submit(tiny_spec(30, 0, "", "calibration: {rounds: 1, stages: 1, replicates: 2}\n"),
+                     &replicated)
+                  .ok());
+  v1::LeaseReply none;
+  ASSERT_NO_FATAL_FAILURE(lease_as("fake", none));
+  EXPECT_FALSE(none.has_job());
+  const v1::ResultsReply taken = results(replicated);
+  for (const auto& j : taken.jobs()) EXPECT_NE(j.reused_from(), 0) << j.job_id();
+  v1::CalibrateRequest request;
+  request.set_id(single);
+  v1::CalibrateReply one_seed;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), request, &one_seed).ok());
+  ASSERT_EQ(one_seed.metrics_size(), 1);
+  ASSERT_GT(one_seed.metrics(0).noise_sd(), 0.0);
+
+  request.set_id(replicated);
+  request.set_verify(true);
+  v1::CalibrateReply queued;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), request, &queued).ok());
+  ASSERT_EQ(queued.verification_jobs_size(), 2) << queued.conclusion();
+  ASSERT_EQ(queued.metrics_size(), 1);
+  EXPECT_NEAR(queued.metrics(0).noise_sd(), one_seed.metrics(0).noise_sd() / std::sqrt(2.0),
+              1e-12 * one_seed.metrics(0).noise_sd());
+  std::set<std::uint64_t> seeds;
+  for (const double value : {0.57, 0.63})
+    ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec& job, v1::CompleteRequest& c) {
+      EXPECT_EQ(job.parameters().at("particle_law.tangential.mu_s"),
+                queued.proposed().at("particle_law.tangential.mu_s"));
+      seeds.insert(job.seed());
+      (*c.mutable_metrics())["solid_fraction"] = value;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+    }));
+  // The test's seed 1 on from round 1's replicate seeds 1,000,001 and 2,000,001.
+  EXPECT_EQ(seeds, (std::set<std::uint64_t>{1'000'002, 2'000'002}));
+  v1::CalibrateReply done;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), request, &done).ok());
+  ASSERT_EQ(done.rounds_size(), 1);
+  ASSERT_EQ(done.rounds(0).simulated_size(), 1);
+  EXPECT_NEAR(done.rounds(0).simulated(0), 0.6, 1e-12);
+  ASSERT_EQ(done.metrics_size(), 1);
+  EXPECT_TRUE(done.metrics(0).within()) << done.conclusion();
+  EXPECT_EQ(done.conclusion().rfind("within uncertainty after 1 round(s) (2 simulations)", 0), 0u)
+      << done.conclusion();
+}
+
 TEST_F(Service, ACalibrationNamesTheFlaggedValuesItUses) {
   // Results through the real worker protocol, no physics: the solid fraction rises with mu_s as
   // above; one design run's value carries a flag (a phase it is computed from did not reach its

@@ -71,6 +71,13 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
       {tiny_spec(30, 0, "", "calibration: {model: quadratic}\n"), "spec.calibration.model"},
       {tiny_spec(30, 0, "", "calibration: {surrogate: kriging}\n"), "spec.calibration.surrogate"},
       {tiny_spec(30, 0, "", "calibration: {batch: -1}\n"), "spec.calibration.batch"},
+      {tiny_spec(30, 0, "", "calibration: {replicates: 17}\n"), "spec.calibration.replicates"},
+      {[] {
+         auto s = tiny_spec(30, 0, "", "calibration: {replicates: 2}\n");
+         s.replace(s.find("centre_points: 0}"), 17, "centre_points: 0, simulation_seeds: pinned}");
+         return s;
+       }(),
+       "spec.calibration.replicates: the design's simulation seeds are pinned"},
       {tiny_spec(30, 0, "", "diagnose: {aspect_ratio_max: 1.0e9}\n"),
        "spec.diagnose.aspect_ratio_max"},
       {tiny_spec(30, 0, "", "diagnose: {rolling_max: -0.3}\n"), "spec.diagnose.rolling_max"},
