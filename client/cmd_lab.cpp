@@ -13,6 +13,7 @@
 #include "client/markdown.hpp"
 #include "client/study_journal.hpp"
 #include "core/io/csv.hpp"
+#include "core/io/material_yaml.hpp"
 #include "core/lab/lab_run_yaml.hpp"
 #include "core/lab/protocol.hpp"
 #include "core/lab/size_extrapolation.hpp"
@@ -44,10 +45,8 @@ std::string check_expected(const lab::LabRunSpec& spec, const lab::LabOutput& ou
                                {"reproduced", m.reproduced}};
     reproduced = reproduced && m.reproduced;
     if (m.reproduced) continue;
-    char line[256];
-    std::snprintf(line, sizeof line, "\n  %s: simulated %.17g against the stored %.17g",
-                  m.metric.c_str(), m.simulated, m.stored);
-    missed += line;
+    missed += "\n  " + m.metric + ": simulated " + io::yaml_number(m.simulated) +
+              " against the stored " + io::yaml_number(m.stored);
   }
   j["reproduced"] = reproduced;
   return missed;
