@@ -162,6 +162,25 @@ void add_targets(Loaded& l) {
   }
 }
 
+/// Per response, why its value simulated at calibration round `round` is flagged (a response
+/// whose value is not flagged is absent).
+std::map<std::string, std::string> flags_at_round(const Loaded& l, int round) {
+  std::map<std::string, std::string> out;
+  for (const auto& j : l.jobs)
+    if (j.kind == job_kind::kVerify && j.std_order == round && j.state == "done")
+      for (const auto& [metric, why] : flags_from_json(j.flags_json))
+        out[j.test + "." + metric] = why;
+  return out;
+}
+
+/// Per calibrated response, whether its value simulated at calibration round `round` is flagged.
+std::vector<bool> flagged_at(const Loaded& l, int round) {
+  const auto flags = flags_at_round(l, round);
+  std::vector<bool> out;
+  for (const auto& response : l.responses) out.push_back(flags.count(response) > 0);
+  return out;
+}
+
 Loaded load(Store& store, const CampaignRow& row, const CalibrateCall& call,
             std::function<void()> interrupt = {}) {
   Loaded l;
@@ -198,7 +217,7 @@ Loaded load(Store& store, const CampaignRow& row, const CalibrateCall& call,
   for (const auto& r : l.round_rows) {
     const StoredProposal p = proposal_from_json(r.proposal_json);
     s.rounds.push_back({r.stage, p.natural, p.predicted, round_values(l, columns, r.round),
-                        p.batch.value_or(r.round)});
+                        p.batch.value_or(r.round), flagged_at(l, r.round)});
   }
   std::set<std::string> workers;
   for (const auto& j : l.jobs) {
@@ -228,7 +247,7 @@ v1::CalibrationRound round_message(const Loaded& l, std::size_t i) {
   if (r.simulated) {
     for (Eigen::Index t = 0; t < r.simulated->size(); ++t) m.add_simulated((*r.simulated)(t));
     const calib::PointScore score = calib::score_point(l.state.targets, *r.simulated);
-    m.set_within(score.within);
+    m.set_within(score.within && calib::flagged_names(l.state, r).empty());
     m.set_worst_deviation(score.worst);
     m.set_worst_metric(l.responses[std::size_t(score.worst_metric)]);
   }
@@ -255,17 +274,6 @@ std::map<std::string, std::vector<std::string>> flagged_fit_notes(const Loaded& 
   return flagged_notes(l.jobs, kinds);
 }
 
-/// Per response, why its value simulated at calibration round `round` is flagged (a response
-/// whose value is not flagged is absent).
-std::map<std::string, std::string> flags_at_round(const Loaded& l, int round) {
-  std::map<std::string, std::string> out;
-  for (const auto& j : l.jobs)
-    if (j.kind == job_kind::kVerify && j.std_order == round && j.state == "done")
-      for (const auto& [metric, why] : flags_from_json(j.flags_json))
-        out[j.test + "." + metric] = why;
-  return out;
-}
-
 /// The round whose jobs run, or none (a calibration stage's design runs, or nothing).
 const calib::VerifiedRound* running_round(const Loaded& l) {
   return l.state.rounds.empty() || l.state.rounds.back().simulated ? nullptr
@@ -285,10 +293,7 @@ std::string with_note(std::string text, const std::string& note) {
 /// What a conclusion adds when values simulated at the calibrated set's round are flagged
 /// (empty when none of its calibrated metrics is).
 std::string flagged_set_note(const Loaded& l, const calib::VerifiedRound& calibrated) {
-  const auto flags = flags_at_round(l, round_number(l, calibrated));
-  std::string names;
-  for (const auto& response : l.responses)
-    if (flags.count(response)) names += (names.empty() ? "" : ", ") + response;
+  const std::string names = calib::flagged_names(l.state, calibrated);
   if (names.empty()) return {};
   return "the calibrated set's simulated " + names +
          " flagged: a phase did not reach its target (the metric's statement says which)";
@@ -327,8 +332,10 @@ void add_metrics(v1::CalibrateReply& reply, const Loaded& l,
       const double sim = (*shown->simulated)(Eigen::Index(m));
       o->set_simulated_available(true);
       o->set_simulated(sim);
-      o->set_within(tol > 0.0 && std::abs(sim - t.target) <= tol);
-      if (const auto f = flagged_at_round.find(t.name); f != flagged_at_round.end())
+      const auto f = flagged_at_round.find(t.name);
+      // A flagged value is not a measurement of the protocol: never within.
+      o->set_within(tol > 0.0 && std::abs(sim - t.target) <= tol && f == flagged_at_round.end());
+      if (f != flagged_at_round.end())
         o->set_statement(with_note(
             o->statement(),
             "the value simulated at round " + std::to_string(round) + " is flagged: " + f->second));
@@ -547,7 +554,8 @@ v1::CalibrateReply calibrate_campaign(Store& store, const CampaignRow& row,
       reply.set_conclusion("not within uncertainty yet; calibrate --verify continues: " +
                            d.conclusion);
   }
-  // The calibration accepts a flagged value as simulated; its conclusion says so.
+  // A calibrated set that is the best round, not one within, may hold flagged values: its
+  // conclusion says so.
   if (const std::string note = calibrated ? flagged_set_note(l, *calibrated) : ""; !note.empty())
     reply.set_conclusion(with_note(reply.conclusion(), note));
   return reply;

@@ -107,13 +107,30 @@ Eigen::VectorXd predicted_at(const CalibrationProblem& problem, const Eigen::Vec
   return y;
 }
 
-/// The index of the first round within tolerance, -1 when none is.
+/// The index of the first round within tolerance with no flagged value, -1 when none is.
 int within_round(const SequentialState& state) {
   for (std::size_t i = 0; i < state.rounds.size(); ++i) {
     const auto& r = state.rounds[i];
-    if (r.simulated && score_point(state.targets, *r.simulated).within) return static_cast<int>(i);
+    if (r.simulated && score_point(state.targets, *r.simulated).within &&
+        flagged_names(state, r).empty())
+      return static_cast<int>(i);
   }
   return -1;
+}
+
+/// What a conclusion adds for the rounds within tolerance only by flagged values (empty when
+/// there are none): they are not accepted, and the conclusion says why.
+std::string flagged_within_note(const SequentialState& state) {
+  std::string note;
+  for (std::size_t i = 0; i < state.rounds.size(); ++i) {
+    const auto& r = state.rounds[i];
+    if (!r.simulated || !score_point(state.targets, *r.simulated).within) continue;
+    const std::string names = flagged_names(state, r);
+    if (names.empty()) continue;
+    note += "; round " + std::to_string(i + 1) + " is within tolerance, but its simulated " +
+            names + " flagged (a phase did not reach its target): not accepted";
+  }
+  return note;
 }
 
 bool affordable(const SequentialState& state, const SequentialOptions& o, int points) {
@@ -186,6 +203,45 @@ SequentialDecision gp_step(const SequentialState& state, const SequentialOptions
   }
   PointScore best_score;
   const VerifiedRound* best = best_round(state, &best_score);
+  d.best_round = round_index(state, best);
+  d.conclusion = not_within(state, best, best_score);
+  return d;
+}
+
+/// The polynomial surrogate's step: verify its proposal, a narrowed stage, or the end.
+SequentialDecision polynomial_step(const SequentialState& state, const SequentialOptions& options) {
+  SequentialDecision d;
+  d.stage = static_cast<int>(state.stages.size());
+  d.proposal =
+      calibrate(stage_problem(state, state.stages.size() - 1, options.model), options.calibration);
+  PointScore best_score;
+  const VerifiedRound* best = best_round(state, &best_score);
+  if ((d.accepted_round = within_round(state)) >= 0) {
+    d.within = true;
+    d.conclusion = "within uncertainty after " + spent(state);
+    return d;
+  }
+  if (batches_in_stage(state, d.stage) < options.rounds && affordable(state, options, 1)) {
+    d.step = NextStep::kVerify;
+    Eigen::VectorXd predicted(Eigen::Index(d.proposal.metrics.size()));
+    for (std::size_t m = 0; m < d.proposal.metrics.size(); ++m)
+      predicted(Eigen::Index(m)) = d.proposal.metrics[m].predicted;
+    d.batch = {d.proposal.natural};
+    d.batch_predicted = {predicted};
+    d.conclusion = "verifying round " + std::to_string(state.rounds.size() + 1) + " (stage " +
+                   std::to_string(d.stage) + ")";
+    return d;
+  }
+  const auto design_points = static_cast<int>(state.stages.front().coded.rows());
+  if (d.stage < options.stages && affordable(state, options, design_points + 1)) {
+    d.step = NextStep::kNewStage;
+    const Eigen::VectorXd centre = best ? best->natural : d.proposal.natural;
+    d.next_box =
+        narrowed_box(state.factors, centre, std::pow(options.narrow, static_cast<double>(d.stage)));
+    d.conclusion = "stage " + std::to_string(d.stage + 1) +
+                   ": a design in a box narrowed around the best point so far";
+    return d;
+  }
   d.best_round = round_index(state, best);
   d.conclusion = not_within(state, best, best_score);
   return d;
@@ -337,44 +393,20 @@ CalibrationProblem stage_problem(const SequentialState& state, std::size_t stage
   return problem;
 }
 
+std::string flagged_names(const SequentialState& state, const VerifiedRound& round) {
+  std::string names;
+  for (std::size_t m = 0; m < round.flagged.size() && m < state.targets.size(); ++m)
+    if (round.flagged[m]) names += (names.empty() ? "" : ", ") + state.targets[m].name;
+  return names;
+}
+
 SequentialDecision next_step(const SequentialState& state, const SequentialOptions& options) {
   options.validate("calibration");
   if (state.stages.empty()) throw InputError("stages", "no stage design to calibrate from");
-  if (options.surrogate == Surrogate::kGaussianProcess) return gp_step(state, options);
-  SequentialDecision d;
-  d.stage = static_cast<int>(state.stages.size());
-  d.proposal =
-      calibrate(stage_problem(state, state.stages.size() - 1, options.model), options.calibration);
-  PointScore best_score;
-  const VerifiedRound* best = best_round(state, &best_score);
-  if ((d.accepted_round = within_round(state)) >= 0) {
-    d.within = true;
-    d.conclusion = "within uncertainty after " + spent(state);
-    return d;
-  }
-  if (batches_in_stage(state, d.stage) < options.rounds && affordable(state, options, 1)) {
-    d.step = NextStep::kVerify;
-    Eigen::VectorXd predicted(Eigen::Index(d.proposal.metrics.size()));
-    for (std::size_t m = 0; m < d.proposal.metrics.size(); ++m)
-      predicted(Eigen::Index(m)) = d.proposal.metrics[m].predicted;
-    d.batch = {d.proposal.natural};
-    d.batch_predicted = {predicted};
-    d.conclusion = "verifying round " + std::to_string(state.rounds.size() + 1) + " (stage " +
-                   std::to_string(d.stage) + ")";
-    return d;
-  }
-  const auto design_points = static_cast<int>(state.stages.front().coded.rows());
-  if (d.stage < options.stages && affordable(state, options, design_points + 1)) {
-    d.step = NextStep::kNewStage;
-    const Eigen::VectorXd centre = best ? best->natural : d.proposal.natural;
-    d.next_box =
-        narrowed_box(state.factors, centre, std::pow(options.narrow, static_cast<double>(d.stage)));
-    d.conclusion = "stage " + std::to_string(d.stage + 1) +
-                   ": a design in a box narrowed around the best point so far";
-    return d;
-  }
-  d.best_round = round_index(state, best);
-  d.conclusion = not_within(state, best, best_score);
+  SequentialDecision d = options.surrogate == Surrogate::kGaussianProcess
+                             ? gp_step(state, options)
+                             : polynomial_step(state, options);
+  if (!d.within) d.conclusion += flagged_within_note(state);
   return d;
 }
 

@@ -74,6 +74,9 @@ struct VerifiedRound {
   Eigen::VectorXd predicted;
   std::optional<Eigen::VectorXd> simulated;
   int batch = 1;  ///< the round's batch (1-based); a batch verifies several points at once
+  /// Per target, whether its simulated value is flagged: a phase it is computed from did not
+  /// reach its target (empty: none is). A round with a flagged value is never accepted.
+  std::vector<bool> flagged;
 };
 
 struct SequentialState {
@@ -117,6 +120,10 @@ struct SequentialDecision {
   /// much, or what runs next.
   std::string conclusion;
 };
+
+/// The names of the targets whose value `round` simulated is flagged, ", " between (empty when
+/// none is).
+std::string flagged_names(const SequentialState& state, const VerifiedRound& round);
 
 /// The next step; throws InputError when a stage has too few runs to fit.
 SequentialDecision next_step(const SequentialState& state, const SequentialOptions& options);

@@ -172,6 +172,65 @@ TEST(Sequential, UnreachableTargetStopsAtTheJobBudgetAndNamesTheMetric) {
     EXPECT_LE(worst(o.state.rounds[std::size_t(o.last.best_round)]), worst(r));
 }
 
+/// A campaign's design on the synthetic simulator with targets at `hidden`, and one verified
+/// round there whose simulated values are the noise-free truth: within tolerance.
+SequentialState state_with_a_round_at(const Eigen::VectorXd& hidden) {
+  Simulator sim{Rng(7)};
+  doe::Design design = doe::full_factorial(3);
+  doe::add_centre_points(design, 3);
+  SequentialState s;
+  s.factors = kBox;
+  s.stages.push_back(simulate_stage(kBox, design, sim));
+  const Eigen::VectorXd y = truth(hidden);
+  for (int m = 0; m < 2; ++m)
+    s.targets.push_back({"m" + std::to_string(m), y(m), 1.0, 0.01 * std::abs(y(m)), kNoise(m)});
+  s.rounds.push_back({1, hidden, y, y, 1});
+  s.jobs_used = 1;
+  return s;
+}
+
+TEST(Sequential, ARoundWithinOnlyByAFlaggedValueIsNotAccepted) {
+  const Eigen::Vector3d hidden(0.38, 0.31, 3e7);
+  SequentialState s = state_with_a_round_at(hidden);
+  ASSERT_TRUE(score_point(s.targets, *s.rounds[0].simulated).within);
+  SequentialOptions options;
+  options.stages = 1;
+  options.rounds = 1;
+  // Unflagged, the round is the calibrated set.
+  SequentialDecision d = next_step(s, options);
+  EXPECT_TRUE(d.within) << d.conclusion;
+  EXPECT_EQ(d.accepted_round, 0);
+  // The same values with m0's flagged (a phase it is computed from missed its target): the
+  // round is not accepted, and with the rounds spent the calibration ends not within, saying why.
+  s.rounds[0].flagged = {true, false};
+  d = next_step(s, options);
+  EXPECT_FALSE(d.within) << d.conclusion;
+  EXPECT_EQ(d.step, NextStep::kDone);
+  EXPECT_EQ(d.accepted_round, -1);
+  EXPECT_EQ(d.conclusion.rfind("not within uncertainty after 1 round(s)", 0), 0u) << d.conclusion;
+  EXPECT_NE(d.conclusion.find("round 1 is within tolerance, but its simulated m0 flagged (a phase "
+                              "did not reach its target): not accepted"),
+            std::string::npos)
+      << d.conclusion;
+  // With rounds left it verifies again, under either surrogate, and says why.
+  for (const Surrogate surrogate : {Surrogate::kPolynomial, Surrogate::kGaussianProcess}) {
+    options.surrogate = surrogate;
+    options.rounds = 3;
+    d = next_step(s, options);
+    EXPECT_FALSE(d.within) << d.conclusion;
+    EXPECT_EQ(d.step, NextStep::kVerify) << d.conclusion;
+    EXPECT_NE(d.conclusion.find("round 1 is within tolerance, but its simulated m0 flagged"),
+              std::string::npos)
+        << d.conclusion;
+    // A second round within and unflagged is accepted, and the first stays refused.
+    s.rounds.push_back({1, hidden, truth(hidden), truth(hidden), 2});
+    const SequentialDecision second = next_step(s, options);
+    EXPECT_TRUE(second.within) << second.conclusion;
+    EXPECT_EQ(second.accepted_round, 1);
+    s.rounds.pop_back();
+  }
+}
+
 TEST(Sequential, OptionsOutOfRangeNameTheField) {
   SequentialOptions o;
   o.rounds = 0;

@@ -505,11 +505,12 @@ TEST_F(Service, ARoundOnSeveralSeedsIsVerifiedByTheirMean) {
 TEST_F(Service, ACalibrationNamesTheFlaggedValuesItUses) {
   // Results through the real worker protocol, no physics: the solid fraction rises with mu_s as
   // above; one design run's value carries a flag (a phase it is computed from did not reach its
-  // target), and so does the verification's. The calibration fits the one and accepts the
-  // other, and its statement of the metric names both, as the effects name the design run.
+  // target), and so do the verifications'. The calibration fits the one and names it, as the
+  // effects do; a verified value within tolerance but flagged is not accepted: the calibration
+  // verifies again, and ends not within, naming the flagged rounds.
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
-  ASSERT_TRUE(submit(tiny_spec(30), &id).ok());
+  ASSERT_TRUE(submit(tiny_spec(30, 0, "", "calibration: {rounds: 2, stages: 1}\n"), &id).ok());
   const std::string settle = "phase 'settle' did not reach its rest within 2 s";
   std::int64_t flagged_job = 0;
   for (int k = 0; k < 4; ++k)
@@ -554,26 +555,55 @@ TEST_F(Service, ACalibrationNamesTheFlaggedValuesItUses) {
       << queued.metrics(0).statement();
 
   const std::string hold = "phase 'hold' did not reach 0.5 +- 0.3 Pa";
-  ASSERT_NO_FATAL_FAILURE(complete_fake_job([&](const v1::JobSpec&, v1::CompleteRequest& c) {
-    (*c.mutable_metrics())["solid_fraction"] = 0.61;
-    (*c.mutable_metrics())["coordination_number"] = 4.0;
-    (*c.mutable_flags())["solid_fraction"] = hold;
-  }));
+  const auto complete_flagged_round = [&](double solid_fraction) {
+    complete_fake_job([&](const v1::JobSpec&, v1::CompleteRequest& c) {
+      (*c.mutable_metrics())["solid_fraction"] = solid_fraction;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+      (*c.mutable_flags())["solid_fraction"] = hold;
+    });
+  };
+  ASSERT_NO_FATAL_FAILURE(complete_flagged_round(0.61));
+  const std::string refused =
+      "round 1 is within tolerance, but its simulated packing.solid_fraction flagged (a phase did "
+      "not reach its target): not accepted";
+  v1::CalibrateReply again;
+  ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), verify, &again).ok());
+  EXPECT_EQ(again.verification_jobs_size(), 1) << again.conclusion();
+  EXPECT_EQ(again.conclusion().rfind("verifying round 2", 0), 0u) << again.conclusion();
+  EXPECT_NE(again.conclusion().find(refused), std::string::npos) << again.conclusion();
+  ASSERT_EQ(again.metrics_size(), 1);
+  EXPECT_FALSE(again.metrics(0).within());
+  EXPECT_NE(again.metrics(0).statement().find("the value simulated at round 1 is flagged: " + hold),
+            std::string::npos)
+      << again.metrics(0).statement();
+  ASSERT_EQ(again.rounds_size(), 1);  // the rounds as loaded, before round 2 was queued
+  EXPECT_FALSE(again.rounds(0).within());
+
+  ASSERT_NO_FATAL_FAILURE(complete_flagged_round(0.605));
   v1::CalibrateReply done;
   ASSERT_TRUE(campaigns_->Calibrate(ctx().get(), verify, &done).ok());
+  EXPECT_EQ(done.verification_jobs_size(), 0);
   ASSERT_EQ(done.metrics_size(), 1);
   const auto& m = done.metrics(0);
-  EXPECT_TRUE(m.within()) << done.conclusion();
+  EXPECT_FALSE(m.within()) << done.conclusion();
   EXPECT_NE(m.statement().find(design_note), std::string::npos) << m.statement();
-  EXPECT_NE(m.statement().find("the value simulated at round 1 is flagged: " + hold),
+  EXPECT_NE(m.statement().find("the value simulated at round 2 is flagged: " + hold),
             std::string::npos)
       << m.statement();
-  // It accepts the flagged value as simulated, and its conclusion says so.
-  EXPECT_EQ(done.conclusion().rfind("within uncertainty after 1 round(s)", 0), 0u)
+  // It ends not within, at its best round (round 2, the closer), and says why each round was
+  // refused and that the set it reports is flagged.
+  EXPECT_EQ(done.conclusion().rfind("not within uncertainty after 2 round(s)", 0), 0u)
+      << done.conclusion();
+  EXPECT_NE(done.conclusion().find(refused), std::string::npos) << done.conclusion();
+  EXPECT_NE(done.conclusion().find("round 2 is within tolerance, but its simulated "
+                                   "packing.solid_fraction flagged"),
+            std::string::npos)
       << done.conclusion();
   EXPECT_NE(done.conclusion().find("the calibrated set's simulated packing.solid_fraction flagged"),
             std::string::npos)
       << done.conclusion();
+  ASSERT_EQ(done.rounds_size(), 2);
+  EXPECT_DOUBLE_EQ(done.proposed_values(0), done.rounds(1).proposed_values(0));
   // The table prints the statement under its metric.
   const std::string table =
       cli_text(dir_, "calibrate_flagged.txt", {"calibrate", std::to_string(id)}, channel_);
