@@ -1,6 +1,5 @@
 // `demcal lab run SPEC.yaml --out DIR` runs one virtual lab test without the service;
 // `demcal lab list` shows every test with its metrics and settings.
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -12,6 +11,7 @@
 #include "client/json_out.hpp"
 #include "client/markdown.hpp"
 #include "client/study_journal.hpp"
+#include "core/common/exact_number.hpp"
 #include "core/io/csv.hpp"
 #include "core/io/material_yaml.hpp"
 #include "core/lab/lab_run_yaml.hpp"
@@ -45,8 +45,8 @@ std::string check_expected(const lab::LabRunSpec& spec, const lab::LabOutput& ou
                                {"reproduced", m.reproduced}};
     reproduced = reproduced && m.reproduced;
     if (m.reproduced) continue;
-    missed += "\n  " + m.metric + ": simulated " + io::yaml_number(m.simulated) +
-              " against the stored " + io::yaml_number(m.stored);
+    missed += "\n  " + m.metric + ": simulated " + exact_number(m.simulated) +
+              " against the stored " + exact_number(m.stored);
   }
   j["reproduced"] = reproduced;
   return missed;
@@ -190,27 +190,21 @@ nlohmann::json study_json(const lab::StudyResult& r, const std::string& test,
   return j;
 }
 
-std::string csv_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 /// The extrapolated row of summary.csv: the value, the particles it implies, seeds 0 (no run),
 /// and per metric the estimate and the half-width of its confidence interval in the mean and sd
 /// columns; empty cells for a metric not extrapolated (not catalogued, or no fit).
 void append_extrapolated_row(const std::string& path, const std::vector<std::string>& names,
                              const lab::StudyExtrapolation& e) {
   std::ofstream out(path, std::ios::app);
-  out << csv_number(e.value) << "," << csv_number(e.particles) << ",0";
+  out << exact_number(e.value) << "," << exact_number(e.particles) << ",0";
   for (const auto& n : names) {
     const auto it = e.metrics.find(n);
     if (it == e.metrics.end() || !it->second.fit) {
       out << ",,";
       continue;
     }
-    out << "," << csv_number(it->second.fit->estimate) << ","
-        << csv_number(it->second.fit->half_width);
+    out << "," << exact_number(it->second.fit->estimate) << ","
+        << exact_number(it->second.fit->half_width);
   }
   out << "\n";
   if (!out) throw InputError(path, "cannot write file");

@@ -73,8 +73,7 @@ void check_sizes(const v1::SizeDistribution& sizes, const lab::MaterialModel& mo
                      where + ".monodisperse.radius");
       break;
     case v1::SizeDistribution::kDiscrete: {
-      lab::MaterialModel mono;
-      mono.sizes = particles::Monodisperse{};
+      const lab::MaterialModel mono;  // monodisperse by default
       const lab::ParameterInfo radius = range_of(mono, "sizes.radius");
       const auto& d = sizes.discrete();
       for (int k = 0; k < d.radii_size(); ++k)

@@ -1,9 +1,9 @@
 #include "core/io/csv.hpp"
 
-#include <cstdio>
 #include <sstream>
 
 #include "core/common/error.hpp"
+#include "core/common/exact_number.hpp"
 #include "core/io/read_file.hpp"
 
 namespace demcal::io {
@@ -17,11 +17,7 @@ CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& co
 
 void CsvWriter::row(const std::vector<double>& values) {
   if (values.size() != columns_) throw std::logic_error("CSV row of wrong width for " + path_);
-  char buf[32];
-  for (std::size_t k = 0; k < values.size(); ++k) {
-    std::snprintf(buf, sizeof buf, "%.17g", values[k]);
-    out_ << (k ? "," : "") << buf;
-  }
+  for (std::size_t k = 0; k < values.size(); ++k) out_ << (k ? "," : "") << exact_number(values[k]);
   out_ << "\n";
 }
 

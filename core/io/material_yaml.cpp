@@ -1,8 +1,8 @@
 #include "core/io/material_yaml.hpp"
 
-#include <cstdio>
 #include <sstream>
 
+#include "core/common/exact_number.hpp"
 #include "core/io/contact_law_yaml.hpp"
 #include "core/io/scene_yaml.hpp"
 #include "core/model/preparation.hpp"
@@ -30,7 +30,7 @@ auto read_kind_block(const io::YamlNode& s, const std::string& kind_key, const s
 std::string flow_block(const std::string& key, const std::string& kind,
                        const std::map<std::string, double>& params) {
   std::string out = "{" + key + ": " + kind;
-  for (const auto& [name, value] : params) out += ", " + name + ": " + yaml_number(value);
+  for (const auto& [name, value] : params) out += ", " + name + ": " + exact_number(value);
   return out + "}";
 }
 
@@ -47,27 +47,21 @@ void write_law(std::ostream& y, const std::string& name, const contact::ContactL
 
 std::string sizes_yaml(const particles::SizeDistribution& sizes) {
   if (const auto* m = std::get_if<particles::Monodisperse>(&sizes))
-    return "{monodisperse: {radius: " + yaml_number(m->radius) + "}}";
+    return "{monodisperse: {radius: " + exact_number(m->radius) + "}}";
   if (const auto* l = std::get_if<particles::LogNormal>(&sizes))
-    return "{lognormal: {median_radius: " + yaml_number(l->median_radius) +
-           ", sigma_g: " + yaml_number(l->sigma_g) + ", truncate_k: " + yaml_number(l->truncate_k) +
-           "}}";
+    return "{lognormal: {median_radius: " + exact_number(l->median_radius) +
+           ", sigma_g: " + exact_number(l->sigma_g) +
+           ", truncate_k: " + exact_number(l->truncate_k) + "}}";
   const auto& d = std::get<particles::DiscreteClasses>(sizes);
   std::string radii, fractions;
   for (std::size_t k = 0; k < d.radii.size(); ++k) {
-    radii += (k ? ", " : "") + yaml_number(d.radii[k]);
-    fractions += (k ? ", " : "") + yaml_number(d.mass_fractions[k]);
+    radii += (k ? ", " : "") + exact_number(d.radii[k]);
+    fractions += (k ? ", " : "") + exact_number(d.mass_fractions[k]);
   }
   return "{discrete: {radii: [" + radii + "], mass_fractions: [" + fractions + "]}}";
 }
 
 }  // namespace
-
-std::string yaml_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 std::string material_yaml(const lab::MaterialModel& m) {
   std::ostringstream y;
@@ -75,10 +69,10 @@ std::string material_yaml(const lab::MaterialModel& m) {
   write_law(y, "particle_law", m.particle_law);
   write_law(y, "wall_law", m.wall_law);
   y << "  sizes: " << sizes_yaml(m.sizes) << "\n"
-    << "  size_scale: " << yaml_number(m.size_scale) << "\n"
-    << "  density: " << yaml_number(m.density) << "\n"
+    << "  size_scale: " << exact_number(m.size_scale) << "\n"
+    << "  density: " << exact_number(m.density) << "\n"
     << "  scaling: {law: " << contact::scaling_law_name(m.scaling)
-    << ", factor: " << yaml_number(m.scale_factor) << "}\n";
+    << ", factor: " << exact_number(m.scale_factor) << "}\n";
   if (m.shape.kind != particles::ShapeKind::kSphere)
     y << "  shape: "
       << flow_block("kind", particles::shape_kind_name(m.shape.kind),
@@ -90,7 +84,7 @@ std::string material_yaml(const lab::MaterialModel& m) {
                     lab::preparation_values(m.preparation))
       << "\n";
   if (m.real_median_radius != 0.0)
-    y << "  real_median_radius: " << yaml_number(m.real_median_radius) << "\n";
+    y << "  real_median_radius: " << exact_number(m.real_median_radius) << "\n";
   return y.str();
 }
 

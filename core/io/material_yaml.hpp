@@ -29,7 +29,4 @@ lab::PreparationSpec read_preparation(const YamlNode& node);
 /// 17 significant digits, so every value reads back to the same double.
 std::string material_yaml(const lab::MaterialModel& model);
 
-/// A number as YAML text that reads back to the same double (17 significant digits).
-std::string yaml_number(double value);
-
 }  // namespace demcal::io

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/common/exact_number.hpp"
 #include "core/io/material_yaml.hpp"
 
 namespace demcal::lab {
@@ -12,7 +13,7 @@ std::string lab_run_yaml(const LabRunSpec& spec) {
   y << "test: " << spec.test << "\nsettings: {";
   bool first = true;
   for (const auto& [name, value] : spec.settings) {
-    y << (first ? "" : ", ") << name << ": " << io::yaml_number(value);
+    y << (first ? "" : ", ") << name << ": " << exact_number(value);
     first = false;
   }
   y << "}\nseed: " << spec.options.seed << "\nthreads: " << spec.options.threads << "\n"
@@ -21,7 +22,7 @@ std::string lab_run_yaml(const LabRunSpec& spec) {
     y << "expected: {";
     first = true;
     for (const auto& [name, value] : spec.expected) {
-      y << (first ? "" : ", ") << name << ": " << io::yaml_number(value);
+      y << (first ? "" : ", ") << name << ": " << exact_number(value);
       first = false;
     }
     y << "}\n";

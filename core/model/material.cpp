@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "core/common/error.hpp"
+#include "core/common/exact_number.hpp"
 
 namespace demcal::lab {
 namespace {
@@ -152,12 +152,6 @@ void MaterialModel::validate() const {
 
 namespace {
 
-std::string number_text(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 void identify_law(std::string& out, const contact::ContactLawSpec& law, const std::string& name) {
   const std::pair<const char*, const contact::SlotSpec*> slots[] = {{"normal", &law.normal},
                                                                     {"cohesion", &law.cohesion},
@@ -166,20 +160,20 @@ void identify_law(std::string& out, const contact::ContactLawSpec& law, const st
   for (const auto& [slot, spec] : slots) {
     out += name + "." + slot + "=" + spec->model + "\n";
     for (const auto& [param, value] : spec->params)
-      out += name + "." + slot + "." + param + "=" + number_text(value) + "\n";
+      out += name + "." + slot + "." + param + "=" + exact_number(value) + "\n";
   }
 }
 
 std::string size_identity(const particles::SizeDistribution& sizes) {
   if (const auto* m = std::get_if<particles::Monodisperse>(&sizes))
-    return "monodisperse " + number_text(m->radius);
+    return "monodisperse " + exact_number(m->radius);
   if (const auto* l = std::get_if<particles::LogNormal>(&sizes))
-    return "lognormal " + number_text(l->median_radius) + " " + number_text(l->sigma_g) + " " +
-           number_text(l->truncate_k);
+    return "lognormal " + exact_number(l->median_radius) + " " + exact_number(l->sigma_g) + " " +
+           exact_number(l->truncate_k);
   const auto& d = std::get<particles::DiscreteClasses>(sizes);
   std::string out = "discrete";
   for (std::size_t k = 0; k < d.radii.size(); ++k)
-    out += " " + number_text(d.radii[k]) + ":" + number_text(d.mass_fractions[k]);
+    out += " " + exact_number(d.radii[k]) + ":" + exact_number(d.mass_fractions[k]);
   return out;
 }
 
@@ -190,17 +184,17 @@ std::string material_identity(const MaterialModel& model) {
   identify_law(out, model.particle_law, "particle_law");
   identify_law(out, model.wall_law, "wall_law");
   out += "sizes=" + size_identity(model.sizes) + "\n";
-  out += "sizes.scale=" + number_text(model.size_scale) + "\n";
-  out += "density=" + number_text(model.density) + "\n";
+  out += "sizes.scale=" + exact_number(model.size_scale) + "\n";
+  out += "density=" + exact_number(model.density) + "\n";
   out += "scaling=" + std::to_string(static_cast<int>(model.scaling)) + " " +
-         number_text(model.scale_factor) + "\n";
+         exact_number(model.scale_factor) + "\n";
   out += "shape=" + std::to_string(static_cast<int>(model.shape.kind)) + "\n";
   for (const auto& [name, value] : particles::shape_values(model.shape))
-    out += "shape." + name + "=" + number_text(value) + "\n";
+    out += "shape." + name + "=" + exact_number(value) + "\n";
   out += "preparation=" + preparation_method_name(model.preparation.method) + "\n";
   for (const auto& info : PreparationSpec::table())
     out += "preparation." + std::string(info.name) + "=" +
-           number_text(model.preparation.*(info.field)) + "\n";
+           exact_number(model.preparation.*(info.field)) + "\n";
   return out;
 }
 
