@@ -13,7 +13,6 @@
 #include "client/study_journal.hpp"
 #include "core/common/exact_number.hpp"
 #include "core/io/csv.hpp"
-#include "core/io/material_yaml.hpp"
 #include "core/lab/lab_run_yaml.hpp"
 #include "core/lab/protocol.hpp"
 #include "core/lab/size_extrapolation.hpp"

@@ -247,7 +247,7 @@ v1::CalibrationRound round_message(const Loaded& l, std::size_t i) {
   if (r.simulated) {
     for (Eigen::Index t = 0; t < r.simulated->size(); ++t) m.add_simulated((*r.simulated)(t));
     const calib::PointScore score = calib::score_point(l.state.targets, *r.simulated);
-    m.set_within(score.within && calib::flagged_names(l.state, r).empty());
+    m.set_within(calib::accepted(l.state, r));
     m.set_worst_deviation(score.worst);
     m.set_worst_metric(l.responses[std::size_t(score.worst_metric)]);
   }

@@ -107,14 +107,15 @@ Eigen::VectorXd predicted_at(const CalibrationProblem& problem, const Eigen::Vec
   return y;
 }
 
-/// The index of the first round within tolerance with no flagged value, -1 when none is.
+/// Whether a round's simulated values, flagged or not, are all within tolerance.
+bool within_by_values(const SequentialState& state, const VerifiedRound& round) {
+  return round.simulated && score_point(state.targets, *round.simulated).within;
+}
+
+/// The index of the first accepted round, -1 when none is.
 int within_round(const SequentialState& state) {
-  for (std::size_t i = 0; i < state.rounds.size(); ++i) {
-    const auto& r = state.rounds[i];
-    if (r.simulated && score_point(state.targets, *r.simulated).within &&
-        flagged_names(state, r).empty())
-      return static_cast<int>(i);
-  }
+  for (std::size_t i = 0; i < state.rounds.size(); ++i)
+    if (accepted(state, state.rounds[i])) return static_cast<int>(i);
   return -1;
 }
 
@@ -124,7 +125,7 @@ std::string flagged_within_note(const SequentialState& state) {
   std::string note;
   for (std::size_t i = 0; i < state.rounds.size(); ++i) {
     const auto& r = state.rounds[i];
-    if (!r.simulated || !score_point(state.targets, *r.simulated).within) continue;
+    if (!within_by_values(state, r)) continue;
     const std::string names = flagged_names(state, r);
     if (names.empty()) continue;
     note += "; round " + std::to_string(i + 1) + " is within tolerance, but its simulated " +
@@ -398,6 +399,10 @@ std::string flagged_names(const SequentialState& state, const VerifiedRound& rou
   for (std::size_t m = 0; m < round.flagged.size() && m < state.targets.size(); ++m)
     if (round.flagged[m]) names += (names.empty() ? "" : ", ") + state.targets[m].name;
   return names;
+}
+
+bool accepted(const SequentialState& state, const VerifiedRound& round) {
+  return within_by_values(state, round) && flagged_names(state, round).empty();
 }
 
 SequentialDecision next_step(const SequentialState& state, const SequentialOptions& options) {

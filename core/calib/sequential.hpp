@@ -125,6 +125,10 @@ struct SequentialDecision {
 /// none is).
 std::string flagged_names(const SequentialState& state, const VerifiedRound& round);
 
+/// Whether a verified round can be the calibrated set: simulated, every calibrated metric within
+/// its tolerance, none of them flagged.
+bool accepted(const SequentialState& state, const VerifiedRound& round);
+
 /// The next step; throws InputError when a stage has too few runs to fit.
 SequentialDecision next_step(const SequentialState& state, const SequentialOptions& options);
 
