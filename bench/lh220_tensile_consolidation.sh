@@ -12,7 +12,8 @@
 # A run already in OUT (its metrics.json) is kept. Prints per stress, over the runs not flagged,
 # the tensile strength and the weight of the particles stuck to the piston (mean +- sample sd),
 # the solid fraction of the conditioned bed (the settled bed's, times its height over the
-# conditioned height) and the settle's steps. Not part of ctest.
+# conditioned height), the settle's steps, and the runs that ended, were flagged or failed (no
+# metrics.json; their exit status is in OUT/times.txt). Not part of ctest.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-$root/build}
@@ -52,12 +53,16 @@ def mean_sd(xs):
     if not xs: return "-"
     return "%.3f" % xs[0] if len(xs) == 1 else "%.3f +- %.3f" % (st.mean(xs), st.stdev(xs))
 print("%-10s %-20s %-20s %-20s %-18s %s" % ("stress Pa", "tensile kPa", "stuck weight kPa",
-                                             "solid fraction", "settle steps (M)", "runs / flagged"))
+                                             "solid fraction", "settle steps (M)",
+                                             "ended / flagged / failed"))
 for s in stresses:
-    strength, stuck, phi, settle, runs, flagged = [], [], [], [], 0, 0
-    for d in sorted(glob.glob(os.path.join(out, "c%s-s*" % s))):
+    strength, stuck, phi, settle, runs, flagged, failed = [], [], [], [], 0, 0, 0
+    for spec in sorted(glob.glob(os.path.join(out, "c%s-s*.yaml" % s))):
+        d = spec[:-len(".yaml")]
         m = os.path.join(d, "metrics.json")
-        if not os.path.isdir(d) or not os.path.exists(m): continue
+        if not os.path.exists(m):
+            failed += 1
+            continue
         runs += 1
         r = json.load(open(m))
         if r["flags"]:
@@ -69,7 +74,7 @@ for s in stresses:
         phi.append(float(bed["solid_fraction"]) * float(bed["h0_m"])
                    / float(fracture["conditioned_height_m"]))
         settle += [p["steps"] / 1e6 for p in r["cost"]["phases"] if p["name"] == "settle"]
-    print("%-10s %-20s %-20s %-20s %-18s %d / %d" % (s, mean_sd(strength), mean_sd(stuck), mean_sd(phi),
-                                                     ", ".join("%.2f" % x for x in settle), runs,
-                                                     flagged))
+    print("%-10s %-20s %-20s %-20s %-18s %d / %d / %d" % (
+        s, mean_sd(strength), mean_sd(stuck), mean_sd(phi), ", ".join("%.2f" % x for x in settle),
+        runs, flagged, failed))
 PY
