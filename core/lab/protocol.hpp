@@ -22,8 +22,10 @@ inline constexpr int kProtocolVersion = 2;
 ///     until the flow is steady at sigma_pre (at least pre_shear_travel).
 ///   tensile 3: the unload with the adhesive piston bounds the controller's step by the piston's
 ///     contact stiffness.
+///   tensile 4: the die keeps the compression's law through the unload and becomes frictionless
+///     and non-cohesive for the pull; a peak in the pull's last tenth flags the strength.
 inline constexpr std::array<std::pair<std::string_view, int>, 2> kOwnProtocolVersions = {
-    {{"shear_cell", 4}, {"tensile", 3}}};
+    {{"shear_cell", 4}, {"tensile", 4}}};
 
 /// The protocol version of lab test `test`.
 constexpr int protocol_version(std::string_view test) {

@@ -5,11 +5,12 @@
 // conditioned so (seed 000 §2.7.3: "loading the pre-compressed powder as well as the piston at
 // its last position from the confined compression test"); then piston and bottom become
 // adhesive (the wall law stiffened by wall_stiffness_factor, A_H times eq. 34, k2 times eq. 35)
-// and the die wall frictionless and non-cohesive; the piston (StressServo) unloads to
-// unload_stress and is pulled up at constant speed. The tensile stress on the piston is
-// sigma_t = -F_z / A (F_z: the particles' force on it); the fracture is the peak of sigma_t over
-// the pull, and the tensile strength is that peak less the weight of the powder still stuck to
-// the piston at the end of the pull, over A (seed 000 §2.7.3, Fig. 10-11).
+// and the piston (StressServo) unloads to unload_stress against the die as it was; then the die
+// wall becomes frictionless and non-cohesive and the piston is pulled up at constant speed. The
+// tensile stress on the piston is sigma_t = -F_z / A (F_z: the particles' force on it); the
+// fracture is the peak of sigma_t over the pull, which must come before the pull's last tenth,
+// and the tensile strength is that peak less the weight of the powder still stuck to the piston
+// at the end of the pull, over A (seed 000 §2.7.3, Fig. 10-11).
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -80,8 +81,8 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
         adhesive.normal.params.count("k2_ratio") ? adhesive.normal.params["k2_ratio"] : 5.0;
     adhesive.normal.params["k2_ratio"] = std::min(1e4, k2 * f_k2);
   }
-  // The die: frictionless and without cohesion, it only stabilises the sample. Its slots keep
-  // their models with the forces set to zero, so the conditioned bed keeps its wall contacts.
+  // The die for the pull: frictionless and without cohesion, it only stabilises the sample. Its
+  // slots keep their models with the forces set to zero, so the bed keeps its wall contacts.
   contact::ContactLawSpec die = material.wall_law;
   if (die.cohesion.model == "van_der_waals") die.cohesion.params["hamaker"] = 0.0;
   if (die.rolling.model != "none") die.rolling.params["mu_r"] = 0.0;
@@ -130,7 +131,6 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
     conditioned_z = std::get<walls::Disk>(w.walls[c.bed.piston].shape).centre.z;
   w.change_wall_law(kWallPiston, 0, adhesive_law);
   w.change_wall_law(kWallBottom, 0, adhesive_law);
-  w.change_wall_law(kWallDie, 0, die_law);
   const ServoSettings& servo = c.bed.servo;
   if (next <= unload_stage) {
     ServoSettings ps = servo;
@@ -148,6 +148,11 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
     stages.reached(unload_stage, w);
   }
   const PistonBed& bed = c.bed;
+  // The die keeps the compression's law up to here, as the experiment's glass tube does: the bed
+  // was consolidated against it, and a bed conditioned at a low stress, whose lower part the
+  // die's friction screened from the consolidation, collapses under the unload's stress once
+  // the die no longer holds it.
+  w.change_wall_law(kWallDie, 0, die_law);
 
   // Pull-off at constant speed.
   const auto& p = w.particles;
@@ -161,6 +166,7 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   piston.velocity = {0, 0, v};
   Series series{{"time_s", "displacement_m", "strain", "tensile_stress_kPa"}, {}};
   double peak = -1e300, peak_strain = 0.0;
+  long peak_step = 0;
   const long steps = std::lround(travel / (v * w.dt));
   const long record_every = std::max<long>(1, steps / 2000);
   // Smooth the force over a window of ~1 % of the pull so that a single rattling contact does not
@@ -179,6 +185,7 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
       if (sigma > peak) {
         peak = sigma;
         peak_strain = (z - h_start) / h_start;
+        peak_step = k;
       }
       acc = 0.0;
       n_acc = 0;
@@ -193,7 +200,14 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
     return true;
   });
   piston.velocity = {};
-  out.add_phase(pull_clock.stop(w, "pull", "pull distance travelled", true), {});
+  // A stress still rising at the end of the pull has not peaked: the bed stretches, it has not
+  // broken, and its peak is somewhere past the pull distance.
+  constexpr double kPeakBefore = 0.9;
+  out.add_phase(pull_clock.stop(w, "pull",
+                                "pull distance travelled, the tensile stress's peak before its "
+                                "last tenth",
+                                static_cast<double>(peak_step) < kPeakBefore * steps),
+                {"tensile_strength"});
   // Powder stuck to the piston: the particles that followed it over the last quarter of the pull.
   double stuck_mass = 0.0;
   const double dz_piston = 0.25 * travel;

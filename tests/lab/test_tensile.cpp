@@ -1,8 +1,10 @@
 // tensile (seed 000 §2.7.3): about zero without cohesion; rises with the Hamaker constant and
-// with kc/k1; starts from the bed a confined compression of the same settings conditioned, taken
-// from the stage cache to the bit.
+// with kc/k1; a bed conditioned at a low stress keeps its height through the unload; a peak at
+// the end of the pull is flagged; starts from the bed a confined compression of the same settings
+// conditioned, taken from the stage cache to the bit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -45,6 +47,49 @@ TEST(Tensile, RisesWithCohesionStiffness) {
   const double a = strength(testing::soft_luding(1e7, 5.0, 0.0, 1e-18));
   const double b = strength(testing::soft_luding(1e7, 5.0, 1.0, 1e-18));
   EXPECT_GT(b, 1.5 * a);
+}
+
+/// Cohesive spheres with sliding and rolling friction (CDT) against each other and the die: a bed
+/// whose die friction screens much of a consolidation of 1.5 kPa from its lower part.
+MaterialModel screened_bed() {
+  MaterialModel m = testing::soft_luding(1e7, 5.0, 0.5, 4e-18, 0.6);
+  m.particle_law.tangential.params["mu_s"] = 0.6;
+  m.particle_law.rolling = {"cdt", {{"mu_r", 0.1}}};
+  m.wall_law.rolling = m.particle_law.rolling;
+  return m;
+}
+
+TEST(Tensile, ABedConditionedAtALowStressKeepsItsHeightThroughTheUnload) {
+  Settings low = small();
+  low["particles"] = 200;
+  low["consolidation_stress"] = 1500;
+  low["min_stress"] = 50;
+  const LabOutput out = run_lab_test("tensile", screened_bed(), low, {});
+  EXPECT_TRUE(out.flags.empty());
+  // The unload to 50 Pa runs against the die the bed was consolidated in. Made frictionless
+  // before it, the die let this bed compact by 2.5 % under the unload's stress.
+  const auto& fracture = out.series.at("fracture");
+  const auto column = [&](const std::string& name) {
+    const auto at = std::find(fracture.columns.begin(), fracture.columns.end(), name);
+    return fracture.rows.at(0).at(static_cast<std::size_t>(at - fracture.columns.begin()));
+  };
+  const double conditioned = column("conditioned_height_m");
+  EXPECT_NEAR(column("unloaded_height_m"), conditioned, 1e-3 * conditioned);
+  EXPECT_GT(out.metrics.at("tensile_strength"), 0.03);
+}
+
+TEST(Tensile, APeakInThePullsLastTenthFlagsTheStrength) {
+  Settings low = small();
+  low["particles"] = 150;
+  low["consolidation_stress"] = 1500;
+  low["min_stress"] = 50;
+  // This bed still stretches at the end of a pull of one diameter: its stress has not peaked.
+  const LabOutput short_pull = run_lab_test("tensile", screened_bed(), low, {});
+  ASSERT_EQ(short_pull.flags.count("tensile_strength"), 1u);
+  EXPECT_NE(short_pull.flags.at("tensile_strength").find("peak"), std::string::npos);
+  // Pulled twice as far, it breaks: the peak lies inside the pull, nothing is flagged.
+  low["pull_distance"] = 2;
+  EXPECT_TRUE(run_lab_test("tensile", screened_bed(), low, {}).flags.empty());
 }
 
 /// A fresh stage cache in a directory of its own.
