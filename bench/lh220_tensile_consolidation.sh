@@ -9,7 +9,11 @@
 # 40 at this set's 20 um); without it, eq. 34 at every S.
 #   bench/lh220_tensile_consolidation.sh [BUILD_DIR] [OUT] [STRESSES] [PARTICLES] [SEEDS] [WALL_FACTOR]
 #   e.g. bench/lh220_tensile_consolidation.sh build out/consolidation "15000 4500 1500 500" 300 2 40
-# A run already in OUT (its metrics.json) is kept. Prints per stress, over the runs not flagged,
+# PULL_DISTANCE=D (mean diameters) pulls further than the spec's default: a bed conditioned at a
+# low stress stretches before it breaks. The conditioned beds are kept in the stage cache
+# STAGE_CACHE (default OUT/stages), so runs of another pull distance or wall factor with the same
+# stress, particles and seed start from them. A run already in OUT (its metrics.json) is kept.
+# Prints per stress, over the runs not flagged,
 # the tensile strength and the weight of the particles stuck to the piston (mean +- sample sd),
 # the solid fraction of the conditioned bed (the settled bed's, times its height over the
 # conditioned height), the settle's steps, and the runs that ended, were flagged or failed (no
@@ -23,9 +27,10 @@ PARTICLES=${4:-300}
 SEEDS=${5:-2}
 WALL_FACTOR=${6:-}
 DEMCAL=${DEMCAL:-$BUILD/client/demcal}
+STAGE_CACHE=${STAGE_CACHE:-$OUT/stages}
 SPEC="$root/docs/data/seed000/lh220/tensile.yaml"
 [ -x "$DEMCAL" ] || { echo "no $DEMCAL; build the demcal target first" >&2; exit 1; }
-mkdir -p "$OUT"
+mkdir -p "$OUT" "$STAGE_CACHE"
 base_seed=$(sed -n 's/^seed: //p' "$SPEC")
 
 for s in $STRESSES; do
@@ -35,10 +40,11 @@ for s in $STRESSES; do
     settings="particles: $PARTICLES, consolidation_stress: $s, min_stress: $(python3 -c "print(repr($s / 30))")"
     [ -n "$WALL_FACTOR" ] &&
       settings+=", wall_hamaker_factor: $(python3 -c "print(repr($WALL_FACTOR * $s / 15000))")"
+    [ -n "${PULL_DISTANCE:-}" ] && settings+=", pull_distance: $PULL_DISTANCE"
     sed -e "s/^settings: .*/settings: {$settings}/" \
         -e "s/^seed: .*/seed: $((base_seed + k))/" -e '/^expected:/d' -e '/^#/d' "$SPEC" > "$run.yaml"
     start=$(date +%s)
-    "$DEMCAL" lab run "$run.yaml" --out "$run" > "$run.log" 2>&1
+    "$DEMCAL" lab run "$run.yaml" --out "$run" --stage-cache "$STAGE_CACHE" > "$run.log" 2>&1
     echo "c$s seed $((base_seed + k)): rc $?, $(( $(date +%s) - start )) s" >> "$OUT/times.txt"
   done
 done
