@@ -59,12 +59,17 @@ MaterialModel screened_bed() {
   return m;
 }
 
-TEST(Tensile, ABedConditionedAtALowStressKeepsItsHeightThroughTheUnload) {
+/// small() with the bed conditioned at 1.5 kPa, cycled to 50 Pa.
+Settings low_consolidation(int particles) {
   Settings low = small();
-  low["particles"] = 200;
+  low["particles"] = particles;
   low["consolidation_stress"] = 1500;
   low["min_stress"] = 50;
-  const LabOutput out = run_lab_test("tensile", screened_bed(), low, {});
+  return low;
+}
+
+TEST(Tensile, ABedConditionedAtALowStressKeepsItsHeightThroughTheUnload) {
+  const LabOutput out = run_lab_test("tensile", screened_bed(), low_consolidation(200), {});
   EXPECT_TRUE(out.flags.empty());
   // The unload to 50 Pa runs against the die the bed was consolidated in. Made frictionless
   // before it, the die let this bed compact by 2.5 % under the unload's stress.
@@ -79,10 +84,7 @@ TEST(Tensile, ABedConditionedAtALowStressKeepsItsHeightThroughTheUnload) {
 }
 
 TEST(Tensile, APeakInThePullsLastTenthFlagsTheStrength) {
-  Settings low = small();
-  low["particles"] = 150;
-  low["consolidation_stress"] = 1500;
-  low["min_stress"] = 50;
+  Settings low = low_consolidation(150);
   // This bed still stretches at the end of a pull of one diameter: its stress has not peaked.
   const LabOutput short_pull = run_lab_test("tensile", screened_bed(), low, {});
   ASSERT_EQ(short_pull.flags.count("tensile_strength"), 1u);
