@@ -16,8 +16,9 @@
 # Prints per stress, over the runs not flagged,
 # the tensile strength and the weight of the particles stuck to the piston (mean +- sample sd),
 # the solid fraction of the conditioned bed (the settled bed's, times its height over the
-# conditioned height), the settle's steps, and the runs that ended, were flagged or failed (no
-# metrics.json; their exit status is in OUT/times.txt). Not part of ctest.
+# conditioned height; of the runs that conditioned their own bed), the settle's steps, and the
+# runs that ended, were flagged or failed (no metrics.json; their exit status is in
+# OUT/times.txt). Not part of ctest.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-$root/build}
@@ -75,10 +76,13 @@ for s in stresses:
             flagged += 1
             continue
         strength.append(r["metrics"]["tensile_strength"])
-        bed, fracture = row(os.path.join(d, "settled_bed.csv")), row(os.path.join(d, "fracture.csv"))
+        fracture = row(os.path.join(d, "fracture.csv"))
         stuck.append(float(fracture["stuck_weight_stress_kPa"]))
-        phi.append(float(bed["solid_fraction"]) * float(bed["h0_m"])
-                   / float(fracture["conditioned_height_m"]))
+        settled = os.path.join(d, "settled_bed.csv")  # absent when the bed came from the cache
+        if os.path.exists(settled):
+            bed = row(settled)
+            phi.append(float(bed["solid_fraction"]) * float(bed["h0_m"])
+                       / float(fracture["conditioned_height_m"]))
         settle += [p["steps"] / 1e6 for p in r["cost"]["phases"] if p["name"] == "settle"]
     print("%-10s %-20s %-20s %-20s %-18s %d / %d / %d" % (
         s, mean_sd(strength), mean_sd(stuck), mean_sd(phi), ", ".join("%.2f" % x for x in settle),
