@@ -11,8 +11,9 @@
 #   e.g. bench/lh220_tensile_consolidation.sh build out/consolidation "15000 4500 1500 500" 300 2 40
 # PULL_DISTANCE=D (mean diameters) pulls further than the spec's default: a bed conditioned at a
 # low stress stretches before it breaks. The conditioned beds are kept in the stage cache
-# STAGE_CACHE (default OUT/stages), so runs of another pull distance or wall factor with the same
-# stress, particles and seed start from them. A run already in OUT (its metrics.json) is kept.
+# STAGE_CACHE (default OUT/stages): runs in another OUT (another pull distance or wall factor)
+# given the same STAGE_CACHE start from the beds of the same stress, particles and seed. A run
+# already in OUT (its metrics.json) is kept.
 # Prints per stress, over the runs not flagged,
 # the tensile strength and the weight of the particles stuck to the piston (mean +- sample sd),
 # the solid fraction of the conditioned bed (the settled bed's, times its height over the
