@@ -2,7 +2,8 @@
 // CAMPAIGN is a campaign id on a coordinator, or a spec YAML run on the embedded default (its
 // design is run first if the work directory has no campaign of that name). The diagnosis
 // advances as its simulations finish; this command drives it to the end and prints the report
-// as tables, or as JSON with --format json.
+// as tables, or as JSON with --format json. With --no-wait it reports the state as it stands and
+// queues the next runs, and on the embedded default runs none.
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -136,7 +137,7 @@ void run(const DiagnoseOptions& o) {
       [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
         report(drive(stub, channel, id, o), o.format);
       },
-      o.journal);
+      o.journal, o.wait);
 }
 
 }  // namespace

@@ -63,15 +63,16 @@ std::filesystem::path work_directory(const std::string& spec, const std::string&
 
 void with_campaign(const std::string& campaign, const std::string& workdir,
                    const LocalWorkers& local, bool verbose, const rpc::ChannelOptions& channel,
-                   const CampaignAction& act, const std::string& journal) {
+                   const CampaignAction& act, const std::string& journal, bool run_jobs) {
   if (std::filesystem::is_regular_file(campaign)) {
     const SpecFile file = read_campaign_spec(campaign);
     // Read before anything starts: a journal with a bad line refuses the command.
     std::optional<CampaignJournal> runs;
     if (!journal.empty()) runs.emplace(journal);
-    EmbeddedService service(work_directory(campaign, workdir), local, verbose);
+    const LocalWorkers workers = run_jobs ? local : LocalWorkers{.workers = 0};
+    EmbeddedService service(work_directory(campaign, workdir), workers, verbose);
     const std::int64_t id = service.submit_or_resume(file, std::cerr, runs ? &*runs : nullptr);
-    watch_campaign(service.stub(), service.channel(), id, std::cerr);
+    if (run_jobs) watch_campaign(service.stub(), service.channel(), id, std::cerr);
     act(service.stub(), service.channel(), id);
     return;
   }

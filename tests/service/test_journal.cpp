@@ -104,6 +104,31 @@ class Journal : public Service {
     return nlohmann::json::parse(std::ifstream(path(work + ".json")));
   }
 
+  /// A packing campaign with two measurements and the curvature candidate, in diag.yaml.
+  std::string diagnosis_spec() {
+    const std::string spec = path("diag.yaml");
+    std::ofstream(spec) << packing_spec("diag", 0.75) << R"(measurements:
+  - {metric: solid_fraction, value: 0.6, uncertainty: 0.02}
+  - {metric: coordination_number, value: 5.5}
+diagnose: {candidates: [curvature]}
+)";
+    return spec;
+  }
+
+  /// `demcal diagnose SPEC --workdir WORK --format json` on one worker of one thread, with the
+  /// journal when one is given, with --no-wait when not `wait`; its standard output in
+  /// WORK.json, its standard error in WORK.err. The exit status.
+  int diagnose(const std::string& spec, const std::string& work, const std::string& journal,
+               bool wait = true) {
+    std::vector<std::string> argv{DEMCAL_CLI_BIN, "diagnose", spec,        "--workdir", path(work),
+                                  "--workers",    "1",        "--threads", "1",         "--format",
+                                  "json"};
+    if (!journal.empty()) argv.insert(argv.end(), {"--journal", journal});
+    if (!wait) argv.push_back("--no-wait");
+    Process p(argv, path(work + ".json"), path(work + ".err"));
+    return p.wait_exit(120);
+  }
+
   /// The jobs of the campaign in WORK/campaign.db, in job order.
   std::vector<StoredJob> stored_jobs(const std::string& work) {
     std::vector<StoredJob> out;
@@ -282,20 +307,9 @@ TEST_F(Journal, AnInterruptedCampaignGoesOnElsewhereFromItsJournalToTheSameEffec
 }
 
 TEST_F(Journal, ADiagnosisKeepsItsRunsInTheJournalAndGoesOnFromItElsewhere) {
-  const std::string spec = path("diag.yaml");
-  std::ofstream(spec) << packing_spec("diag", 0.75) << R"(measurements:
-  - {metric: solid_fraction, value: 0.6, uncertainty: 0.02}
-  - {metric: coordination_number, value: 5.5}
-diagnose: {candidates: [curvature]}
-)";
+  const std::string spec = diagnosis_spec();
   const std::string journal = path("diag.jsonl");
-  auto diagnose = [&](const std::string& work, const std::string& where) {
-    Process p({DEMCAL_CLI_BIN, "diagnose", spec, "--workdir", path(work), "--workers", "1",
-               "--threads", "1", "--format", "json", "--journal", where},
-              path(work + ".json"), path(work + ".err"));
-    return p.wait_exit(120);
-  };
-  ASSERT_EQ(diagnose("first", journal), 0) << file_lines(path("first.err")).back();
+  ASSERT_EQ(diagnose(spec, "first", journal), 0) << file_lines(path("first.err")).back();
   // The design's four runs, the baseline, the candidate's axial and centre runs and its
   // verifications: every run the diagnosis simulated is a run of the journal (a verification at
   // a point already run takes that run's result).
@@ -308,7 +322,7 @@ diagnose: {candidates: [curvature]}
   EXPECT_EQ(simulated_and_reused("first").first, static_cast<int>(distinct.size()));
 
   // Elsewhere, from the journal: nothing is simulated again and the report is the same.
-  ASSERT_EQ(diagnose("second", journal), 0);
+  ASSERT_EQ(diagnose(spec, "second", journal), 0);
   const auto [simulated, reused] = simulated_and_reused("second");
   EXPECT_EQ(simulated, 0);
   EXPECT_EQ(reused, static_cast<int>(first.size()));
@@ -322,6 +336,27 @@ diagnose: {candidates: [curvature]}
   std::ifstream in(path("id.err"));
   const std::string err((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(err.find("--journal"), std::string::npos) << err;
+}
+
+TEST_F(Journal, ADiagnosisLookedAtWithoutWaitingSimulatesNothing) {
+  const std::string spec = diagnosis_spec();
+  // A new campaign: its design is queued, no local worker starts, nothing is simulated.
+  ASSERT_EQ(diagnose(spec, "look", "", false), 0) << file_lines(path("look.err")).back();
+  EXPECT_EQ(output("look").at("state"), "waiting");
+  EXPECT_EQ(stored_jobs("look").size(), 4u);
+  EXPECT_EQ(results_stored("look"), 0);
+  // Driven to its end in the same work directory, then looked at in a copy of its store (as a
+  // diagnosis still running is looked at, its store being held by its coordinator): the same
+  // report, no run simulated again.
+  fs::remove(path("look.json"));  // a process's output is appended to its file
+  ASSERT_EQ(diagnose(spec, "look", ""), 0) << file_lines(path("look.err")).back();
+  ASSERT_EQ(output("look").at("state"), "done");
+  const int results = results_stored("look");
+  fs::create_directories(path("copy"));
+  fs::copy_file(path("look/campaign.db"), path("copy/campaign.db"));
+  ASSERT_EQ(diagnose(spec, "copy", "", false), 0) << file_lines(path("copy.err")).back();
+  EXPECT_EQ(output("copy"), output("look"));
+  EXPECT_EQ(results_stored("copy"), results);
 }
 
 TEST_F(Journal, AJournalOfAnotherSpecGivesExactlyTheRunsWhoseKeysMatch) {
