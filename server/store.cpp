@@ -710,14 +710,14 @@ LeaseAnswer Store::check_lease(std::int64_t job_id, int attempt, const std::stri
   return s.text(0) == worker ? LeaseAnswer::kOk : LeaseAnswer::kNotHolder;
 }
 
-bool Store::already_stored(std::int64_t job_id, int attempt, const std::string& worker,
-                           const std::string& metrics_json, double wall_seconds) {
+std::optional<Store::StoredResult> Store::stored_result(std::int64_t job_id, int attempt,
+                                                        const std::string& worker) {
   Statement s(*this,
-              "SELECT 1 FROM results r JOIN jobs j ON j.id = r.job_id WHERE r.job_id = ? AND "
-              "r.attempt = ? AND r.worker = ? AND r.metrics_json = ? AND r.wall_seconds = ? AND "
-              "j.state = 'done'");
-  s.bind(1, job_id).bind(2, attempt).bind(3, worker).bind(4, metrics_json).bind(5, wall_seconds);
-  return s.step();
+              "SELECT r.metrics_json, r.wall_seconds FROM results r JOIN jobs j ON j.id = r.job_id "
+              "WHERE r.job_id = ? AND r.attempt = ? AND r.worker = ? AND j.state = 'done'");
+  s.bind(1, job_id).bind(2, attempt).bind(3, worker);
+  if (!s.step()) return std::nullopt;
+  return StoredResult{s.text(0), s.f64(1)};
 }
 
 LeaseAnswer Store::heartbeat(std::int64_t job_id, int attempt, const std::string& worker,
@@ -725,6 +725,8 @@ LeaseAnswer Store::heartbeat(std::int64_t job_id, int attempt, const std::string
   Guard lock(*this);
   const LeaseAnswer answer = check_lease(job_id, attempt, worker, now);
   if (answer == LeaseAnswer::kOk) deadlines_[job_id] = now + limits_.lease_seconds;
+  if (answer == LeaseAnswer::kStale && stored_result(job_id, attempt, worker))
+    return LeaseAnswer::kOk;
   return answer;
 }
 
@@ -734,7 +736,10 @@ LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string&
                             const std::string& series_json) {
   Guard lock(*this);
   Transaction tx(*this);
-  if (already_stored(job_id, attempt, worker, metrics_json, wall_seconds)) return LeaseAnswer::kOk;
+  // A retry of the result already stored for this lease (its answer was lost) is a success.
+  if (const auto r = stored_result(job_id, attempt, worker);
+      r && r->metrics_json == metrics_json && r->wall_seconds == wall_seconds)
+    return LeaseAnswer::kOk;
   if (const auto answer = check_lease(job_id, attempt, worker, now); answer != LeaseAnswer::kOk)
     return answer;
   const double stored = server::wall_seconds();

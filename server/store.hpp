@@ -229,7 +229,9 @@ class Store {
   /// protocol is simulated under this one and must be known by this one's key. A done job keeps
   /// the key its result was simulated under. An empty key marks a job that is never reused.
   void refresh_run_keys(const std::function<RunKey(const std::string& payload)>& key_of);
-  /// Extends the current, unexpired lease held by `worker`.
+  /// Extends the current, unexpired lease held by `worker`. A beat of a lease whose result that
+  /// worker has stored (a beat sent while its Complete was being answered) is kOk and extends
+  /// nothing: the lease ended by its own result, not lost.
   LeaseAnswer heartbeat(std::int64_t job_id, int attempt, const std::string& worker, double now);
   /// Stores the result of the current, unexpired lease held by `worker` exactly once; a retry
   /// with the result already stored for that lease (same metrics and wall time) is kOk too.
@@ -264,9 +266,13 @@ class Store {
   class Guard;
   /// The job's current lease named by (attempt, worker), leased and unexpired at `now`.
   LeaseAnswer check_lease(std::int64_t job_id, int attempt, const std::string& worker, double now);
-  /// A retried Complete: the job is done with this very result of this lease.
-  bool already_stored(std::int64_t job_id, int attempt, const std::string& worker,
-                      const std::string& metrics_json, double wall_seconds);
+  /// The result `worker`'s lease `attempt` stored, when the job is done with it.
+  struct StoredResult {
+    std::string metrics_json;
+    double wall_seconds = 0.0;
+  };
+  std::optional<StoredResult> stored_result(std::int64_t job_id, int attempt,
+                                            const std::string& worker);
   void restore_leases(double opened);
   /// Seconds on the clock of limits().clock.
   double clock_now() const { return limits_.clock ? limits_.clock() : steady_seconds(); }

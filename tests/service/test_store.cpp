@@ -268,6 +268,25 @@ TEST(Store, ARetriedCompleteOfTheStoredResultSucceedsAndStoresItOnce) {
   EXPECT_EQ(*s.job(a->id)->metrics_json, R"({"x":1})");
 }
 
+TEST(Store, ABeatTakenAfterItsLeasesResultIsNoLostLease) {
+  // A worker beats until its Complete has been answered, so the coordinator may take a beat of
+  // a lease whose result it has just stored: the lease ended by its result, it was not lost.
+  Store s(":memory:", {10.0, 3});
+  s.create_campaign("c", "{}", "{}", jobs(2), 0.0);
+  const auto a = s.lease("w1", 0.0);
+  ASSERT_TRUE(a);
+  EXPECT_EQ(s.complete(a->id, 1, "w1", R"({"x":1})", 0.5, 1.0), kOk);
+  EXPECT_EQ(s.heartbeat(a->id, 1, "w1", 2.0), kOk);
+  EXPECT_EQ(s.job(a->id)->state, "done");
+  // Another worker's or another attempt's beat is refused, as is one of a lease that expired.
+  EXPECT_EQ(s.heartbeat(a->id, 1, "w2", 2.0), kStale);
+  EXPECT_EQ(s.heartbeat(a->id, 2, "w1", 2.0), kStale);
+  const auto b = s.lease("w1", 3.0);
+  ASSERT_TRUE(b);
+  EXPECT_EQ(s.reap(14.0), 1);
+  EXPECT_EQ(s.heartbeat(b->id, 1, "w1", 14.5), kStale);
+}
+
 TEST(Store, OnlyTheLeaseHolderMayHeartbeatCompleteOrFailIt) {
   Store s(":memory:", {10.0, 3});
   s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
