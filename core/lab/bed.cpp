@@ -168,10 +168,11 @@ sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
           ? spec.insert_height
           : std::max(bound * bound * bound * solid / (0.25 * M_PI * radius * radius), 4.0 * r_max);
 
-  w.walls.push_back(walls::make_wall("bottom", walls::Plane{{0, 0, 0}, {0, 0, 1}}, kWallBottom));
+  w.walls.push_back(
+      walls::make_wall("bottom", walls::Plane{{0, 0, kDieFloorZ}, {0, 0, 1}}, kWallBottom));
   w.walls.push_back(
       walls::make_wall("die", walls::Cylinder{{0, 0, 0}, {0, 0, 1}, radius}, kWallDie));
-  req.region = particles::CylinderRegion{{0, 0, 0}, radius, 0.0, height};
+  req.region = particles::CylinderRegion{{0, 0, 0}, radius, kDieFloorZ, kDieFloorZ + height};
   if (grown)
     insert_shrunk(w, req, rng, spec.time_step_safety, growth_start_factor(prep));
   else

@@ -79,8 +79,12 @@ PhaseCost timed_fill(sim::World& world, const particles::InsertRequest& request,
 double expected_solid_volume(const particles::SizeDistribution& sizes, double count,
                              std::uint64_t seed);
 
-/// A world with the material's simulated laws, a floor (kWallBottom) and a die (kWallDie, an
-/// inner cylinder about the z axis), and the particles inserted at random without overlap.
+/// The height of the die world's floor (m): where make_die_world puts the bottom wall.
+inline constexpr double kDieFloorZ = 0.0;
+
+/// A world with the material's simulated laws, a floor (kWallBottom, at kDieFloorZ) and a die
+/// (kWallDie, an inner cylinder about the z axis), and the particles inserted at random without
+/// overlap.
 sim::World make_die_world(const MaterialModel& material, const BedSpec& spec,
                           const RunOptions& options);
 

@@ -9,6 +9,7 @@
 //   T = int_0^R tau 2 pi r^2 dr = (2/3) pi R^3 tau   =>   tau = 3 T / (2 pi R^3).
 #include <cmath>
 
+#include "core/lab/bed.hpp"
 #include "core/lab/lab_run.hpp"
 #include "core/lab/piston.hpp"
 #include "core/lab/stages.hpp"
@@ -70,7 +71,6 @@ LabOutput WallFrictionTest::run(const MaterialModel& material, const Settings& v
   const double turn_time = s.rotation_diameters * d_mean / rim_speed;
   auto& piston = w.walls[bed.piston];
   const std::size_t bottom = 0;
-  const double floor_z = std::get<walls::Plane>(w.walls[bottom].shape).point.z;
 
   for (std::size_t k = next - 1; k < stresses.size(); ++k) {
     const double sigma_real = stresses[k];
@@ -79,8 +79,9 @@ LabOutput WallFrictionTest::run(const MaterialModel& material, const Settings& v
     ps.tolerance = std::max(servo.tolerance * target, 2e-3 * request.stress_level);
     // A turn can jam the bed between the piston and the die: the stress then stays above the
     // target however far the bottom sinks, and the loose powder would fall with it. The bottom
-    // stops at the floor; the measured stress, not the target, enters the regression.
-    ps.retreat_limit = floor_z;
+    // stops at the die's floor, where it stood when the bed was built (not where it stands at a
+    // checkpoint it went on from); the measured stress, not the target, enters the regression.
+    ps.retreat_limit = kDieFloorZ;
     piston.omega = {};
     const std::string at = stress_text(sigma_real * s.stress_factor);
     add_servo_phase(out,
