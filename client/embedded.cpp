@@ -3,17 +3,22 @@
 #include <google/protobuf/util/message_differencer.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <stdlib.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <optional>
 #include <random>
 
 #include "core/common/error.hpp"
 #include "rpc/material_convert.hpp"
+#include "server/store.hpp"
+#include "server/store_lock.hpp"
 
 namespace demcal::cli {
 namespace {
@@ -54,6 +59,35 @@ void watch_stop_signals() {
   (void)started;
 }
 
+/// A copy of a store another coordinator holds, in a private temporary directory removed with
+/// it: what a look at a running campaign reads instead of the store itself.
+class StoreCopy {
+ public:
+  explicit StoreCopy(const std::filesystem::path& db) {
+    std::string tmpl = (std::filesystem::temp_directory_path() / "demcal-look-XXXXXX").string();
+    if (!::mkdtemp(tmpl.data()))
+      throw std::runtime_error("cannot make a directory for a copy of " + db.string() + ": " +
+                               std::strerror(errno));
+    dir_ = tmpl;
+    try {
+      server::Store::copy_file(db.string(), (dir_ / db.filename()).string());
+    } catch (...) {
+      std::filesystem::remove_all(dir_);
+      throw;
+    }
+  }
+  ~StoreCopy() {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir_, ignored);
+  }
+  StoreCopy(const StoreCopy&) = delete;
+  StoreCopy& operator=(const StoreCopy&) = delete;
+  const std::filesystem::path& dir() const { return dir_; }
+
+ private:
+  std::filesystem::path dir_;
+};
+
 }  // namespace
 
 std::filesystem::path work_directory(const std::string& spec, const std::string& workdir) {
@@ -66,11 +100,25 @@ void with_campaign(const std::string& campaign, const std::string& workdir,
                    const CampaignAction& act, const std::string& journal, bool run_jobs) {
   if (std::filesystem::is_regular_file(campaign)) {
     const SpecFile file = read_campaign_spec(campaign);
+    std::filesystem::path dir = work_directory(campaign, workdir);
+    // A look at a campaign whose store a running coordinator holds (e.g. a diagnosis going on in
+    // another process) reads a copy taken now; the running one and its journal are not touched.
+    std::optional<StoreCopy> copy;
+    if (!run_jobs)
+      if (const auto pid = server::StoreLock::holder((dir / "campaign.db").string())) {
+        copy.emplace(dir / "campaign.db");
+        std::cerr << "the store " << (dir / "campaign.db").string()
+                  << " is held by a running coordinator"
+                  << (pid->empty() ? std::string() : " (pid " + *pid + ")")
+                  << ": reporting from a copy of it taken now (its jobs in flight show as "
+                     "queued there; what the copy queues is thrown away with it)\n";
+        dir = copy->dir();
+      }
     // Read before anything starts: a journal with a bad line refuses the command.
     std::optional<CampaignJournal> runs;
-    if (!journal.empty()) runs.emplace(journal);
+    if (!journal.empty() && !copy) runs.emplace(journal);
     const LocalWorkers workers = run_jobs ? local : LocalWorkers{.workers = 0};
-    EmbeddedService service(work_directory(campaign, workdir), workers, verbose);
+    EmbeddedService service(dir, workers, verbose);
     const std::int64_t id = service.submit_or_resume(file, std::cerr, runs ? &*runs : nullptr);
     if (run_jobs) watch_campaign(service.stub(), service.channel(), id, std::cerr);
     act(service.stub(), service.channel(), id);

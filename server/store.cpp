@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
+#include <memory>
 #include <stdexcept>
 #include <string_view>
 #include <tuple>
@@ -252,6 +254,39 @@ std::optional<double> Store::lease_deadline(std::int64_t job_id) {
   const auto it = deadlines_.find(job_id);
   if (it == deadlines_.end()) return std::nullopt;
   return it->second;
+}
+
+void Store::copy_file(const std::string& from, const std::string& to) {
+  // Both connections close however the copy ends.
+  const auto close_db = [](sqlite3* db) { sqlite3_close(db); };
+  const auto open_db = [&](const std::string& path, int flags) {
+    sqlite3* db = nullptr;
+    const int rc = sqlite3_open_v2(path.c_str(), &db, flags, nullptr);
+    std::unique_ptr<sqlite3, decltype(close_db)> held(db, close_db);
+    if (rc != SQLITE_OK)
+      throw std::runtime_error("cannot open " + path + ": " +
+                               (db ? sqlite3_errmsg(db) : "out of memory"));
+    sqlite3_busy_timeout(db, 10000);
+    return held;
+  };
+  if (!std::filesystem::is_regular_file(from)) throw std::runtime_error("no store file " + from);
+  const auto source = open_db(from, SQLITE_OPEN_READONLY);
+  if (std::filesystem::exists(to)) throw std::runtime_error("refusing to overwrite " + to);
+  create_private_file(to);
+  const auto target = open_db(to, SQLITE_OPEN_READWRITE);
+  sqlite3_backup* backup = sqlite3_backup_init(target.get(), "main", source.get(), "main");
+  if (!backup)
+    throw std::runtime_error("cannot copy " + from + " to " + to + ": " +
+                             sqlite3_errmsg(target.get()));
+  // All pages in one step: one read transaction on the source, so one state of it.
+  int rc = sqlite3_backup_step(backup, -1);
+  for (int tries = 0; (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) && tries < 100; ++tries) {
+    sqlite3_sleep(100);
+    rc = sqlite3_backup_step(backup, -1);
+  }
+  sqlite3_backup_finish(backup);
+  if (rc != SQLITE_DONE)
+    throw std::runtime_error("cannot copy " + from + " to " + to + ": " + sqlite3_errstr(rc));
 }
 
 Store::~Store() {

@@ -181,6 +181,10 @@ class Store {
   static constexpr std::size_t kInsertBatch = 256;
 
   static int latest_schema_version();
+  /// Writes a copy of the store file `from` to the new file `to` (owner-only), taken in one read
+  /// transaction by SQLite's online backup: a consistent state of the store, also while another
+  /// store has `from` open and writes it. `from` is only read (its lock is not taken).
+  static void copy_file(const std::string& from, const std::string& to);
   int schema_version();
   std::string journal_mode();
   const StoreLimits& limits() const { return limits_; }

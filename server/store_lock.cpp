@@ -53,6 +53,17 @@ StoreLock::StoreLock(const std::string& db_path) {
   (void)write_own_pid(fd_);
 }
 
+std::optional<std::string> StoreLock::holder(const std::string& db_path) {
+  if (db_path.empty() || db_path == ":memory:") return std::nullopt;
+  const int fd = ::open((db_path + ".lock").c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return std::nullopt;
+  // A shared lock is refused while a store holds the exclusive one; taken, it is let go at once.
+  std::optional<std::string> pid;
+  if (::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK) pid = holder_pid(fd);
+  ::close(fd);
+  return pid;
+}
+
 StoreLock::~StoreLock() {
   if (fd_ >= 0) ::close(fd_);  // closing the descriptor releases the lock
 }

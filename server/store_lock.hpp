@@ -4,6 +4,7 @@
 // on one file would both lease its jobs: each keeps its lease deadlines in memory, so each
 // would give the other's running jobs out again. The kernel releases the lock when the process
 // ends, however it ends (a SIGKILLed coordinator leaves no stale lock).
+#include <optional>
 #include <string>
 
 namespace demcal::server {
@@ -13,6 +14,9 @@ class StoreLock {
   /// Takes the lock of `db_path` (nothing for ":memory:"). Throws std::runtime_error naming
   /// the file and the holder's pid when another store holds it.
   explicit StoreLock(const std::string& db_path);
+  /// Whether another process holds the lock of `db_path` now: its pid ("" when its lock file
+  /// names none), or nothing when the store is free (or has no lock file yet).
+  static std::optional<std::string> holder(const std::string& db_path);
   ~StoreLock();
   StoreLock(const StoreLock&) = delete;
   StoreLock& operator=(const StoreLock&) = delete;

@@ -7,7 +7,10 @@
 // and line.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -19,6 +22,7 @@
 #include <vector>
 
 #include "core/lab/protocol.hpp"
+#include "server/store_lock.hpp"
 #include "tests/service/service_fixture.hpp"
 
 namespace demcal::test {
@@ -338,25 +342,49 @@ TEST_F(Journal, ADiagnosisKeepsItsRunsInTheJournalAndGoesOnFromItElsewhere) {
   EXPECT_NE(err.find("--journal"), std::string::npos) << err;
 }
 
-TEST_F(Journal, ADiagnosisLookedAtWithoutWaitingSimulatesNothing) {
+TEST_F(Journal, ADiagnosisLookedAtWithoutWaitingSimulatesNothingAlsoWhileItsStoreIsHeld) {
   const std::string spec = diagnosis_spec();
   // A new campaign: its design is queued, no local worker starts, nothing is simulated.
   ASSERT_EQ(diagnose(spec, "look", "", false), 0) << file_lines(path("look.err")).back();
   EXPECT_EQ(output("look").at("state"), "waiting");
   EXPECT_EQ(stored_jobs("look").size(), 4u);
   EXPECT_EQ(results_stored("look"), 0);
-  // Driven to its end in the same work directory, then looked at in a copy of its store (as a
-  // diagnosis still running is looked at, its store being held by its coordinator): the same
-  // report, no run simulated again.
+  // Driven to its end in the same work directory.
   fs::remove(path("look.json"));  // a process's output is appended to its file
   ASSERT_EQ(diagnose(spec, "look", ""), 0) << file_lines(path("look.err")).back();
-  ASSERT_EQ(output("look").at("state"), "done");
-  const int results = results_stored("look");
-  fs::create_directories(path("copy"));
-  fs::copy_file(path("look/campaign.db"), path("copy/campaign.db"));
-  ASSERT_EQ(diagnose(spec, "copy", "", false), 0) << file_lines(path("copy.err")).back();
-  EXPECT_EQ(output("copy"), output("look"));
-  EXPECT_EQ(results_stored("copy"), results);
+  const nlohmann::json done = output("look");
+  ASSERT_EQ(done.at("state"), "done");
+  const auto jobs = stored_jobs("look");
+  // Its store held, as a diagnosis still running holds it: a look reads a copy taken in the
+  // temporary directory and removed after, and gives the same report; the store is not touched.
+  // Without --no-wait the store is refused, naming its holder.
+  const auto err_has = [&](const std::string& text) {
+    const auto lines = file_lines(path("look.err"));
+    return std::any_of(lines.begin(), lines.end(),
+                       [&](const std::string& l) { return l.find(text) != std::string::npos; });
+  };
+  const std::string pid = "(pid " + std::to_string(::getpid()) + ")";
+  fs::create_directories(path("tmp"));
+  ASSERT_EQ(setenv("TMPDIR", path("tmp").c_str(), 1), 0);
+  {
+    const server::StoreLock held(path("look/campaign.db"));
+    fs::remove(path("look.json"));
+    fs::remove(path("look.err"));
+    ASSERT_EQ(diagnose(spec, "look", "", false), 0) << file_lines(path("look.err")).back();
+    EXPECT_EQ(output("look"), done);
+    EXPECT_TRUE(err_has("held by a running coordinator " + pid));
+    fs::remove(path("look.err"));
+    EXPECT_NE(diagnose(spec, "look", ""), 0);
+    EXPECT_TRUE(err_has("another coordinator " + pid));
+  }
+  ASSERT_EQ(unsetenv("TMPDIR"), 0);
+  EXPECT_TRUE(fs::is_empty(path("tmp")));
+  const auto after = stored_jobs("look");
+  ASSERT_EQ(after.size(), jobs.size());
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    EXPECT_EQ(after[k].run_key, jobs[k].run_key);
+    EXPECT_EQ(after[k].metrics, jobs[k].metrics);
+  }
 }
 
 TEST_F(Journal, AJournalOfAnotherSpecGivesExactlyTheRunsWhoseKeysMatch) {
