@@ -104,11 +104,11 @@ void with_campaign(const std::string& campaign, const std::string& workdir,
     // A look at a campaign whose store a running coordinator holds (e.g. a diagnosis going on in
     // another process) reads a copy taken now; the running one and its journal are not touched.
     std::optional<StoreCopy> copy;
+    const std::filesystem::path store = EmbeddedService::store_path(dir);
     if (!run_jobs)
-      if (const auto pid = server::StoreLock::holder((dir / "campaign.db").string())) {
-        copy.emplace(dir / "campaign.db");
-        std::cerr << "the store " << (dir / "campaign.db").string()
-                  << " is held by a running coordinator"
+      if (const auto pid = server::StoreLock::holder(store.string())) {
+        copy.emplace(store);
+        std::cerr << "the store " << store.string() << " is held by a running coordinator"
                   << (pid->empty() ? std::string() : " (pid " + *pid + ")")
                   << ": reporting from a copy of it taken now (its jobs in flight show as "
                      "queued there; what the copy queues is thrown away with it)\n";
@@ -163,7 +163,7 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
   spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
   server::CoordinatorOptions co;
   co.listen = "127.0.0.1:0";
-  co.db = db_ = (workdir / "campaign.db").string();
+  co.db = db_ = store_path(workdir).string();
   co.token = random_token();
   // Its workers die with it: no lease of an earlier run is still worked on, and none was the
   // job's fault (the run was stopped), so the jobs go back to the queue uncounted, to go on

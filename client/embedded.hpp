@@ -38,6 +38,11 @@ class EmbeddedService {
   EmbeddedService(const EmbeddedService&) = delete;
   EmbeddedService& operator=(const EmbeddedService&) = delete;
 
+  /// The campaign's SQLite file in work directory `workdir`.
+  static std::filesystem::path store_path(const std::filesystem::path& workdir) {
+    return workdir / "campaign.db";
+  }
+
   const rpc::ChannelOptions& channel() const { return channel_; }
   v1::CampaignService::Stub& stub() { return *stub_; }
   std::string db() const { return db_; }

@@ -154,19 +154,25 @@ void create_private_file(const std::string& path) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd >= 0) ::close(fd);
 }
+
+/// A connection to the SQLite file `path` opened with `flags`, waiting up to 10 s for a lock
+/// another connection holds. Throws std::runtime_error naming the file when it cannot open it.
+sqlite3* open_connection(const std::string& path, int flags) {
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(path.c_str(), &db, flags, nullptr) != SQLITE_OK) {
+    const std::string msg = db ? sqlite3_errmsg(db) : "out of memory";
+    sqlite3_close(db);
+    throw std::runtime_error("cannot open " + path + ": " + msg);
+  }
+  sqlite3_busy_timeout(db, 10000);
+  return db;
+}
 }  // namespace
 
 Store::Store(const std::string& path, StoreLimits limits, std::optional<double> opened)
     : lock_(path), limits_(limits) {
   create_private_file(path);
-  if (sqlite3_open_v2(path.c_str(), &db_,
-                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
-                      nullptr) != SQLITE_OK) {
-    const std::string msg = db_ ? sqlite3_errmsg(db_) : "out of memory";
-    sqlite3_close(db_);
-    throw std::runtime_error("cannot open " + path + ": " + msg);
-  }
-  sqlite3_busy_timeout(db_, 10000);
+  db_ = open_connection(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX);
   try {
     // Checked before the first write (switching to WAL rewrites the header, migrations and the
     // clean-up write tables): a damaged file is left exactly as it was found, for recovery.
@@ -258,32 +264,19 @@ std::optional<double> Store::lease_deadline(std::int64_t job_id) {
 
 void Store::copy_file(const std::string& from, const std::string& to) {
   // Both connections close however the copy ends.
-  const auto close_db = [](sqlite3* db) { sqlite3_close(db); };
-  const auto open_db = [&](const std::string& path, int flags) {
-    sqlite3* db = nullptr;
-    const int rc = sqlite3_open_v2(path.c_str(), &db, flags, nullptr);
-    std::unique_ptr<sqlite3, decltype(close_db)> held(db, close_db);
-    if (rc != SQLITE_OK)
-      throw std::runtime_error("cannot open " + path + ": " +
-                               (db ? sqlite3_errmsg(db) : "out of memory"));
-    sqlite3_busy_timeout(db, 10000);
-    return held;
-  };
+  using Connection = std::unique_ptr<sqlite3, decltype(&sqlite3_close)>;
   if (!std::filesystem::is_regular_file(from)) throw std::runtime_error("no store file " + from);
-  const auto source = open_db(from, SQLITE_OPEN_READONLY);
+  const Connection source(open_connection(from, SQLITE_OPEN_READONLY), &sqlite3_close);
   if (std::filesystem::exists(to)) throw std::runtime_error("refusing to overwrite " + to);
   create_private_file(to);
-  const auto target = open_db(to, SQLITE_OPEN_READWRITE);
+  const Connection target(open_connection(to, SQLITE_OPEN_READWRITE), &sqlite3_close);
   sqlite3_backup* backup = sqlite3_backup_init(target.get(), "main", source.get(), "main");
   if (!backup)
     throw std::runtime_error("cannot copy " + from + " to " + to + ": " +
                              sqlite3_errmsg(target.get()));
-  // All pages in one step: one read transaction on the source, so one state of it.
-  int rc = sqlite3_backup_step(backup, -1);
-  for (int tries = 0; (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) && tries < 100; ++tries) {
-    sqlite3_sleep(100);
-    rc = sqlite3_backup_step(backup, -1);
-  }
+  // All pages in one step: one read transaction on the source, so one state of it (a lock the
+  // source's writer holds is waited for by the connection's busy timeout).
+  const int rc = sqlite3_backup_step(backup, -1);
   sqlite3_backup_finish(backup);
   if (rc != SQLITE_DONE)
     throw std::runtime_error("cannot copy " + from + " to " + to + ": " + sqlite3_errstr(rc));
