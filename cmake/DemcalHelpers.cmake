@@ -48,12 +48,23 @@ function(demcal_add_library)
   add_library(demcal::${ARG_NAME} ALIAS ${target})
 endfunction()
 
+# A GoogleTest executable's build: gtest with its main, the warnings, and -O1 in optimised builds.
+# A test's own code sets up, drives and checks; what it simulates or fits runs in the libraries it
+# links, built at the build type's level (-O3 in Release), and without -ffast-math the level does not
+# change a floating-point result. The test sources are 80 of the build's 200-odd translation units;
+# at -O1 they compile in about 30 % less time than at -O3.
+function(demcal_test_executable target)
+  target_link_libraries(${target} PRIVATE GTest::gtest GTest::gtest_main demcal_warnings)
+  target_compile_options(${target} PRIVATE $<$<CONFIG:Release,RelWithDebInfo>:-O1>)
+endfunction()
+
 # demcal_add_test(NAME contact_luding SOURCES test.cpp DEPS demcal::core_contact [LABELS peer] [TIMEOUT 60])
 function(demcal_add_test)
   cmake_parse_arguments(ARG "" "NAME;TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
   set(target test_${ARG_NAME})
   add_executable(${target} ${ARG_SOURCES})
-  target_link_libraries(${target} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main demcal_warnings)
+  target_link_libraries(${target} PRIVATE ${ARG_DEPS})
+  demcal_test_executable(${target})
   target_compile_definitions(${target} PRIVATE
     DEMCAL_SOURCE_DIR="${PROJECT_SOURCE_DIR}" DEMCAL_BINARY_DIR="${PROJECT_BINARY_DIR}")
   add_test(NAME ${ARG_NAME} COMMAND ${target})

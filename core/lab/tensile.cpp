@@ -203,11 +203,12 @@ LabOutput TensileTest::run(const MaterialModel& material, const Settings& values
   // A stress still rising at the end of the pull has not peaked: the bed stretches, it has not
   // broken, and its peak is somewhere past the pull distance.
   constexpr double kPeakBefore = 0.9;
-  out.add_phase(pull_clock.stop(w, "pull",
-                                "pull distance travelled, the tensile stress's peak before its "
-                                "last tenth",
-                                static_cast<double>(peak_step) < kPeakBefore * steps),
-                {"tensile_strength"});
+  out.add_phase(
+      pull_clock.stop(w, "pull",
+                      "pull distance travelled, the tensile stress's peak before its "
+                      "last tenth",
+                      static_cast<double>(peak_step) < kPeakBefore * static_cast<double>(steps)),
+      {"tensile_strength"});
   // Powder stuck to the piston: the particles that followed it over the last quarter of the pull.
   double stuck_mass = 0.0;
   const double dz_piston = 0.25 * travel;

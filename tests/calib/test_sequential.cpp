@@ -81,8 +81,12 @@ LoopOutcome run_loop(const Eigen::Vector2d& target, const Eigen::Vector2d& uncer
     if (out.last.step == NextStep::kVerify) {
       const int batch = s.rounds.empty() ? 1 : s.rounds.back().batch + 1;
       for (std::size_t b = 0; b < out.last.batch.size(); ++b) {
-        s.rounds.push_back({out.last.stage, out.last.batch[b], out.last.batch_predicted[b],
-                            sim(out.last.batch[b]), batch});
+        s.rounds.push_back({out.last.stage,
+                            out.last.batch[b],
+                            out.last.batch_predicted[b],
+                            sim(out.last.batch[b]),
+                            batch,
+                            {}});
         s.jobs_used += 1;
       }
     } else {
@@ -184,7 +188,7 @@ SequentialState state_with_a_round_at(const Eigen::VectorXd& hidden) {
   const Eigen::VectorXd y = truth(hidden);
   for (int m = 0; m < 2; ++m)
     s.targets.push_back({"m" + std::to_string(m), y(m), 1.0, 0.01 * std::abs(y(m)), kNoise(m)});
-  s.rounds.push_back({1, hidden, y, y, 1});
+  s.rounds.push_back({1, hidden, y, y, 1, {}});
   s.jobs_used = 1;
   return s;
 }
@@ -223,7 +227,7 @@ TEST(Sequential, ARoundWithinOnlyByAFlaggedValueIsNotAccepted) {
               std::string::npos)
         << d.conclusion;
     // A second round within and unflagged is accepted, and the first stays refused.
-    s.rounds.push_back({1, hidden, truth(hidden), truth(hidden), 2});
+    s.rounds.push_back({1, hidden, truth(hidden), truth(hidden), 2, {}});
     const SequentialDecision second = next_step(s, options);
     EXPECT_TRUE(second.within) << second.conclusion;
     EXPECT_EQ(second.accepted_round, 1);
