@@ -56,10 +56,15 @@ TEST(LabRotatingDrum, ParticleCountFollowsFromTheGeometry) {
 TEST(LabRotatingDrum, SeedDrumAtLambda64HoldsTheSeedsGranuleCount) {
   // Seed 001: log-normal number median 200 um, sigma_g 1.43 (§3.1); the 100 x 44 mm drum 43 %
   // full (§3.2.2) simulated with 200,000 granules at lambda = 64 (§4.2), radii x4 (eq. 15).
-  MaterialModel m;
-  m.sizes = particles::LogNormal{100e-6, 1.43};
-  m.scaling = contact::ScalingLaw::kTiscar2019;
-  m.scale_factor = 64;
+  // Built whole: a size variant assigned after default construction draws a false
+  // -Wmaybe-uninitialized from GCC 12 at -O1.
+  const MaterialModel m{.particle_law = {},
+                        .wall_law = {},
+                        .sizes = particles::LogNormal{100e-6, 1.43},
+                        .scaling = contact::ScalingLaw::kTiscar2019,
+                        .scale_factor = 64,
+                        .shape = {},
+                        .preparation = {}};
   const DrumBed bed = drum_bed(drum_settings({{"max_particles", 1e6}}), m.simulated_sizes(), "s");
   EXPECT_NEAR(double(bed.particles), 2e5, 0.1 * 2e5) << bed.diameter_ratio;  // solid fraction 0.6
   // D/d with d the number-mean simulated diameter (~4 x 208 um)
