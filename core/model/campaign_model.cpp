@@ -243,9 +243,12 @@ std::map<std::string, std::string> instance_switches(
 std::map<std::string, double> taken_parameters(std::map<std::string, double> parameters,
                                                const std::map<std::string, std::string>& switches,
                                                const std::map<std::string, std::string>& taken) {
-  for (const auto& [what, value] : switches)
-    if (!taken.contains(what))
-      std::erase_if(parameters, [&](const auto& p) { return p.first.starts_with(what + "."); });
+  for (const auto& [what, value] : switches) {
+    if (taken.contains(what)) continue;
+    // A named prefix, not the binding: clang 14 cannot capture a structured binding.
+    const std::string prefix = what + ".";
+    std::erase_if(parameters, [&prefix](const auto& p) { return p.first.starts_with(prefix); });
+  }
   return parameters;
 }
 
