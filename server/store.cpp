@@ -601,6 +601,9 @@ std::vector<CalibrationStageRow> Store::calibration_stages(std::int64_t campaign
 }
 
 std::optional<std::pair<std::int64_t, std::string>> Store::next_queued() {
+  // Run order within a campaign and kind, except that a job whose wait has ended goes first: it
+  // starts from the bed its row's other job conditioned, so it is short, and a row's tensile
+  // strength is known before the campaign's later shear cells have run.
   Statement s(*this,
               "SELECT j.id, COALESCE(j.run_key, '') FROM jobs j "
               "JOIN campaigns c ON c.id = j.campaign_id "
@@ -610,7 +613,7 @@ std::optional<std::pair<std::int64_t, std::string>> Store::next_queued() {
               "(j.waits_for = '' OR NOT EXISTS (SELECT 1 FROM jobs w WHERE w.campaign_id = "
               "j.campaign_id AND w.kind = j.kind AND w.std_order = j.std_order AND w.test = "
               "j.waits_for AND w.state IN ('queued', 'leased'))) "
-              "ORDER BY j.campaign_id, j.kind, j.run_order, j.id LIMIT 1");
+              "ORDER BY j.campaign_id, j.kind, j.waits_for = '', j.run_order, j.id LIMIT 1");
   if (!s.step()) return std::nullopt;
   return std::pair{s.i64(0), s.text(1)};
 }

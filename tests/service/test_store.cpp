@@ -402,6 +402,39 @@ TEST(Store, AJobWaitingForAnotherOfItsRowIsLeasedOnceThatOneHasEnded) {
   EXPECT_EQ(s.counts(id).leased, 2);
 }
 
+TEST(Store, AJobWhoseWaitHasEndedIsLeasedBeforeTheJobsLaterInRunOrder) {
+  Store s(":memory:", {10.0, 3});
+  // Two rows of three tests in the run order a verification or a diagnosis gives them (by test):
+  // the compressions, the shear cells, then the tensile jobs, each after its row's compression.
+  std::vector<NewJob> jobs;
+  for (int row = 1; row <= 2; ++row) {
+    jobs.push_back({row, 1, "compression", "design", "{}"});
+    jobs.push_back({row, 2, "shear", "design", "{}"});
+    jobs.push_back({row, 3, "tensile", "design", "{}", RunKey{}, "compression"});
+  }
+  s.create_campaign("c", "{}", "{}", jobs, 0.0);
+  const auto row_of = [](const std::optional<JobRow>& job) {
+    return std::pair(job->test, job->std_order);
+  };
+  const auto first = s.lease("w1", 1.0);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(row_of(first), std::pair(std::string("compression"), 1));
+  EXPECT_EQ(s.complete(first->id, first->attempt, "w1", R"({"x":1})", 1.0, 2.0), kOk);
+  // Row 1's tensile job goes before row 2's compression and both shear cells.
+  const auto second = s.lease("w1", 2.0);
+  ASSERT_TRUE(second);
+  EXPECT_EQ(row_of(second), std::pair(std::string("tensile"), 1));
+  // The rest in run order; row 2's tensile job waits for its compression.
+  const auto third = s.lease("w2", 2.0);
+  const auto fourth = s.lease("w3", 2.0);
+  const auto fifth = s.lease("w4", 2.0);
+  ASSERT_TRUE(third && fourth && fifth);
+  EXPECT_EQ(row_of(third), std::pair(std::string("compression"), 2));
+  EXPECT_EQ(row_of(fourth), std::pair(std::string("shear"), 1));
+  EXPECT_EQ(row_of(fifth), std::pair(std::string("shear"), 2));
+  EXPECT_FALSE(s.lease("w5", 2.0));
+}
+
 TEST(Store, RunsOfAJournalAreTakenByTheJobsOfTheirKeysAndNeverReplaceARunHeld) {
   Store s(":memory:");
   const std::string series = R"({"curve":{"columns":["t"],"rows":[[1.0]]}})";
