@@ -359,9 +359,15 @@ void add_analysis_commands(CLI::App& app) {
       throw InputError("--job",
                        "not with --lab-specs (one writes a job's spec, the other the "
                        "calibrated set's)");
-    with_campaign(e->campaign, e->workdir, e->local, e->verbose, e->channel,
-                  [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
-                      std::int64_t id) { write_export(stub, channel, id, *e); });
+    // One job's spec is written in any state of the job, so a spec's campaign is not run first
+    // for it: the store is read as it stands (a copy when a running coordinator holds it).
+    const bool run_first = e->job == 0;
+    with_campaign(
+        e->campaign, e->workdir, e->local, e->verbose, e->channel,
+        [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
+          write_export(stub, channel, id, *e);
+        },
+        {}, run_first);
   });
 }
 

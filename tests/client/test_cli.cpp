@@ -619,7 +619,8 @@ TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
 /// `expected` holds the stored metrics, which `demcal lab run` reports reproduced; the poured job,
 /// marked failed in the store afterwards, has its spec
 /// written all the same, its error in the comment, and that spec gives the solid fraction its run
-/// stored. A job the campaign does not have, the option outside the yaml format and beside
+/// stored. The grown job, queued again, has its spec written without the campaign being run: it
+/// stays queued. A job the campaign does not have, the option outside the yaml format and beside
 /// --lab-specs are refused, naming --job.
 TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAJobAgain) {
   const fs::path dir = scratch_dir("job");
@@ -677,6 +678,31 @@ TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAJobAgain) {
     EXPECT_EQ(rerun_json["metrics"]["solid_fraction"].get<double>(), stored) << instance;
     EXPECT_EQ(rerun_json.value("reproduced", false), instance == "grown") << rerun.out;
   }
+
+  // A job not yet run, of a campaign running again: its spec is written at once, and the campaign
+  // is not run for it (the job stays queued in the store).
+  const auto queued_id = last_of.at("grown")["job_id"].get<std::int64_t>();
+  const std::string store = (dir / "work" / "campaign.db").string();
+  const auto requeued = demcal::test::run_command(
+      "sqlite3 " + store +
+      " \"DELETE FROM result_series WHERE job_id = " + std::to_string(queued_id) +
+      "; DELETE FROM results WHERE job_id = " + std::to_string(queued_id) +
+      "; UPDATE jobs SET state = 'queued' WHERE id = " + std::to_string(queued_id) +
+      "; UPDATE campaigns SET state = 'running'\" 2>&1");
+  ASSERT_EQ(requeued.exit_code, 0) << requeued.out;
+  const fs::path queued_file = dir / "queued.yaml";
+  const Result queued = demcal("export " + spec + work + " --format yaml --job " +
+                               std::to_string(queued_id) + " -o " + queued_file.string());
+  ASSERT_EQ(queued.exit_code, 0) << queued.out;
+  std::ifstream queued_in(queued_file);
+  const std::string queued_text{std::istreambuf_iterator<char>(queued_in), {}};
+  EXPECT_NE(queued_text.find("\n#   not finished: queued\n"), std::string::npos) << queued_text;
+  EXPECT_TRUE(demcal::lab::read_lab_run(demcal::io::YamlNode::load_file(queued_file.string()))
+                  .expected.empty());
+  const auto state = demcal::test::run_command(
+      "sqlite3 " + store + " \"SELECT state FROM jobs WHERE id = " + std::to_string(queued_id) +
+      "\" 2>&1");
+  EXPECT_EQ(state.out, "queued\n");
 
   const Result unknown = demcal("export " + spec + work + " --format yaml --job 99");
   EXPECT_NE(unknown.exit_code, 0);
