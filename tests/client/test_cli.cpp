@@ -640,11 +640,12 @@ TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAJobAgain) {
   for (const auto& job : exported_jobs)
     if (job["kind"] == "design" && job["state"] == "done") last_of[job["test"]] = job;
   ASSERT_EQ(last_of.size(), 2u);
+  const std::string store = (dir / "work" / "campaign.db").string();
   const std::string failure = "simulation failed (escaped_particles): marked by the test";
   const auto marked = demcal::test::run_command(
-      "sqlite3 " + (dir / "work" / "campaign.db").string() +
-      " \"UPDATE jobs SET state = 'failed', " + "error = '" + failure + "' WHERE id = " +
-      std::to_string(last_of.at("packing")["job_id"].get<std::int64_t>()) + "\" 2>&1");
+      "sqlite3 " + store + " \"UPDATE jobs SET state = 'failed', " + "error = '" + failure +
+      "' WHERE id = " + std::to_string(last_of.at("packing")["job_id"].get<std::int64_t>()) +
+      "\" 2>&1");
   ASSERT_EQ(marked.exit_code, 0) << marked.out;
 
   for (const auto& [instance, job] : last_of) {
@@ -682,7 +683,6 @@ TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAJobAgain) {
   // A job not yet run, of a campaign running again: its spec is written at once, and the campaign
   // is not run for it (the job stays queued in the store).
   const auto queued_id = last_of.at("grown")["job_id"].get<std::int64_t>();
-  const std::string store = (dir / "work" / "campaign.db").string();
   const auto requeued = demcal::test::run_command(
       "sqlite3 " + store +
       " \"DELETE FROM result_series WHERE job_id = " + std::to_string(queued_id) +
