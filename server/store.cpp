@@ -181,7 +181,7 @@ Store::Store(const std::string& path, StoreLimits limits, std::optional<double> 
     require_wal(path);
     exec(limits_.fsync_every_commit ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL");
     // Foreign keys are enforced from here on; migrations that rebuild a table run before.
-    migrate();
+    migrate(path);
     exec("PRAGMA foreign_keys=ON");
     drop_unfinished_campaigns();
     restore_leases(opened.value_or(steady_seconds()));
@@ -317,7 +317,7 @@ std::string Store::journal_mode_unlocked() {
   return s.text(0);
 }
 
-void Store::migrate() {
+void Store::migrate(const std::string& path) {
   Transaction tx(*this);
   // Read through schema_version(): its statement is finalised before a migration drops a table.
   const int version = schema_version();
@@ -329,9 +329,34 @@ void Store::migrate() {
     exec(std::string(schema::migrations()[std::size_t(i)]).c_str());
     exec(("PRAGMA user_version=" + std::to_string(i + 1)).c_str());
   }
-  Statement fk(*this, "PRAGMA foreign_key_check");
-  if (fk.step()) throw std::runtime_error("schema migration broke a foreign key");
+  require_foreign_keys(path, version);
   tx.commit();
+}
+
+void Store::require_foreign_keys(const std::string& path, int version_found) {
+  // Each row of foreign_key_check names a child table, the child's rowid, the parent table and
+  // the constraint's number (https://www.sqlite.org/pragma.html#pragma_foreign_key_check).
+  constexpr int kNamed = 5;
+  Statement fk(*this, "PRAGMA foreign_key_check");
+  std::string rows;
+  int broken = 0;
+  while (fk.step()) {
+    if (++broken > kNamed) continue;
+    rows += (rows.empty() ? "" : "; ") + std::string("row ") +
+            (fk.is_null(1) ? std::string("?") : std::to_string(fk.i64(1))) + " of " + fk.text(0) +
+            " refers to a " + fk.text(2) + " row that does not exist";
+  }
+  if (broken == 0) return;
+  const bool migrated = version_found < latest_schema_version();
+  throw std::runtime_error(
+      "refusing to open " + (path.empty() ? std::string("the temporary database") : path) + ": " +
+      std::to_string(broken) + " row(s) break a foreign key (" + rows +
+      (broken > kNamed ? "; ..." : "") + ")" +
+      (migrated
+           ? ", after migrating it from schema version " + std::to_string(version_found) + " to " +
+                 std::to_string(latest_schema_version()) + "; the migration is rolled back"
+           : "; the file was changed outside the coordinator") +
+      ": restore it from a backup, or mend the rows named in the sqlite3 shell");
 }
 
 std::int64_t Store::create_campaign(const std::string& name, const std::string& spec_json,
@@ -603,7 +628,9 @@ std::vector<CalibrationStageRow> Store::calibration_stages(std::int64_t campaign
 std::optional<std::pair<std::int64_t, std::string>> Store::next_queued() {
   // Run order within a campaign and kind, except that a job whose wait has ended goes first: it
   // starts from the bed its row's other job conditioned, so it is short, and a row's tensile
-  // strength is known before the campaign's later shear cells have run.
+  // strength is known before the campaign's later shear cells have run. jobs.wait_ended (set by
+  // a trigger, server/schema/012_job_wait_ended.sql) puts those jobs first in the jobs_queue
+  // index, so the walk meets them without testing the jobs still waiting.
   Statement s(*this,
               "SELECT j.id, COALESCE(j.run_key, '') FROM jobs j "
               "JOIN campaigns c ON c.id = j.campaign_id "
@@ -613,7 +640,7 @@ std::optional<std::pair<std::int64_t, std::string>> Store::next_queued() {
               "(j.waits_for = '' OR NOT EXISTS (SELECT 1 FROM jobs w WHERE w.campaign_id = "
               "j.campaign_id AND w.kind = j.kind AND w.std_order = j.std_order AND w.test = "
               "j.waits_for AND w.state IN ('queued', 'leased'))) "
-              "ORDER BY j.campaign_id, j.kind, j.waits_for = '', j.run_order, j.id LIMIT 1");
+              "ORDER BY j.campaign_id, j.kind, j.wait_ended DESC, j.run_order, j.id LIMIT 1");
   if (!s.step()) return std::nullopt;
   return std::pair{s.i64(0), s.text(1)};
 }

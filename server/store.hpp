@@ -289,7 +289,12 @@ class Store {
   /// Adds `seconds` to every lease deadline (the lock was held that long).
   void extend_deadlines(double seconds);
   void exec(const char* sql);
-  void migrate();
+  /// Takes the file's schema to the latest version, all in one transaction, and refuses to
+  /// commit it where a row then breaks a foreign key.
+  void migrate(const std::string& path);
+  /// Throws, naming the file and up to five rows that break a foreign key, unless none does;
+  /// `version_found` is the schema version the file had (whether a migration ran).
+  void require_foreign_keys(const std::string& path, int version_found);
   void finish_campaigns(double now);
   /// Inserts jobs[first, end) as queued jobs of the campaign; inside a transaction.
   std::vector<std::int64_t> insert_job_rows(std::int64_t campaign_id,

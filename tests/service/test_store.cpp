@@ -13,6 +13,10 @@
 #include "server/store.hpp"
 
 namespace demcal::server {
+namespace schema {
+// The store's migrations as built into the binary (server/store.cpp).
+const std::vector<std::string_view>& migrations();
+}  // namespace schema
 namespace {
 
 constexpr auto kOk = LeaseAnswer::kOk;
@@ -23,6 +27,15 @@ std::vector<NewJob> jobs(int n) {
   std::vector<NewJob> out;
   for (int i = 0; i < n; ++i) out.push_back({i + 1, n - i, "packing", "design", "{}"});
   return out;
+}
+
+/// Runs SQL on a raw connection (a store written by an older coordinator, or by hand).
+void exec_sql(sqlite3* db, const char* sql) {
+  char* err = nullptr;
+  const int rc = sqlite3_exec(db, sql, nullptr, nullptr, &err);
+  const std::string msg = err ? err : "";
+  sqlite3_free(err);
+  ASSERT_EQ(rc, SQLITE_OK) << msg << " in " << sql;
 }
 
 TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
@@ -170,6 +183,47 @@ TEST(Store, ADamagedFileIsRefusedNamingTheFileAndTheDamageAndIsLeftUnchanged) {
     EXPECT_NE(what.find("quick_check"), std::string::npos) << what;
   }
   EXPECT_EQ(file_bytes(path), bytes) << "the damaged file was modified";
+  remove_all();
+}
+
+TEST(Store, AFileWithARowBreakingAForeignKeyIsRefusedNamingTheFileAndTheRowAndKeepsIt) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("demcal_store_foreign_key_" + std::to_string(::getpid()) + ".db");
+  auto remove_all = [&] {
+    for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(path.string() + suffix);
+  };
+  remove_all();
+  {
+    Store s(path.string());
+    s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
+  }
+  // A checkpoint of a job that does not exist, written by hand with foreign keys off (SQLite's
+  // default for a connection).
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+  exec_sql(db,
+           "INSERT INTO checkpoints (job_id, attempt, worker, stage, state, stored) "
+           "VALUES (77, 1, 'w', 'bed', x'00', 0)");
+  sqlite3_close(db);
+  try {
+    Store s(path.string());
+    FAIL() << "a store with a broken foreign key was opened";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path.string()), std::string::npos) << what;
+    EXPECT_NE(what.find("row 77 of checkpoints refers to a jobs row that does not exist"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("changed outside the coordinator"), std::string::npos) << what;
+  }
+  // Nothing was deleted: the row is still there to be mended.
+  ASSERT_EQ(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  sqlite3_stmt* stmt = nullptr;
+  sqlite3_prepare_v2(db, "SELECT count(*) FROM checkpoints WHERE job_id = 77", -1, &stmt, nullptr);
+  ASSERT_EQ(sqlite3_step(stmt), SQLITE_ROW);
+  EXPECT_EQ(sqlite3_column_int(stmt, 0), 1);
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
   remove_all();
 }
 
@@ -435,6 +489,44 @@ TEST(Store, AJobWhoseWaitHasEndedIsLeasedBeforeTheJobsLaterInRunOrder) {
   EXPECT_FALSE(s.lease("w5", 2.0));
 }
 
+TEST(Store, AStoreOfSchemaElevenMarksTheJobsWhoseWaitHasEndedAndLeasesThemFirst) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("demcal_store_v11_" + std::to_string(::getpid()) + ".db");
+  for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(path.string() + suffix);
+  {
+    // A store as the coordinator of schema version 11 left it: row 1's compression done, its
+    // tensile job queued behind row 2's compression in run order; row 2's tensile job waiting.
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(path.string().c_str(), &db), SQLITE_OK);
+    for (int i = 0; i < 11; ++i) exec_sql(db, std::string(schema::migrations()[i]).c_str());
+    exec_sql(db, "PRAGMA user_version=11");
+    exec_sql(db,
+             "INSERT INTO campaigns (name, state, spec_json, design_json, created, finished) "
+             "VALUES ('c', 'running', '{}', '{}', 1.0, 0.0)");
+    exec_sql(db,
+             "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state, "
+             "waits_for) VALUES (1, 1, 1, 'compression', 'design', '{}', 'done', ''), "
+             "(1, 2, 2, 'compression', 'design', '{}', 'queued', ''), "
+             "(1, 1, 3, 'tensile', 'design', '{}', 'queued', 'compression'), "
+             "(1, 2, 4, 'tensile', 'design', '{}', 'queued', 'compression')");
+    ASSERT_EQ(sqlite3_close(db), SQLITE_OK);
+  }
+  Store s(path.string());
+  EXPECT_EQ(s.schema_version(), 12);
+  const auto first = s.lease("w", 1.0);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->id, 3);  // row 1's tensile job, before row 2's compression
+  const auto second = s.lease("w", 1.0);
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->id, 2);
+  EXPECT_FALSE(s.lease("w", 1.0));  // row 2's tensile job waits for its compression
+  EXPECT_EQ(s.complete(second->id, second->attempt, "w", "{}", 1.0, 2.0), kOk);
+  const auto third = s.lease("w", 2.0);
+  ASSERT_TRUE(third);
+  EXPECT_EQ(third->id, 4);
+  for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(path.string() + suffix);
+}
+
 TEST(Store, RunsOfAJournalAreTakenByTheJobsOfTheirKeysAndNeverReplaceARunHeld) {
   Store s(":memory:");
   const std::string series = R"({"curve":{"columns":["t"],"rows":[[1.0]]}})";
@@ -628,14 +720,6 @@ constexpr const char* kSchemaV1 = R"sql(
         stored REAL NOT NULL);
       )sql";
 
-void exec_v1(sqlite3* db, const char* sql) {
-  char* err = nullptr;
-  const int rc = sqlite3_exec(db, sql, nullptr, nullptr, &err);
-  const std::string msg = err ? err : "";
-  sqlite3_free(err);
-  ASSERT_EQ(rc, SQLITE_OK) << msg << " in " << sql;
-}
-
 TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJobs) {
   const auto path = std::filesystem::temp_directory_path() /
                     ("demcal_store_v1_" + std::to_string(::getpid()) + ".db");
@@ -643,18 +727,18 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(path.string().c_str(), &db), SQLITE_OK);
-    exec_v1(db, kSchemaV1);
-    exec_v1(db, "PRAGMA user_version=1");
-    exec_v1(db,
-            "INSERT INTO campaigns (name, state, spec_json, design_json, created, finished) "
-            "VALUES ('old', 'done', '{\"spec\":1}', '{}', 100.0, 200.0)");
-    exec_v1(db,
-            "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state, "
-            "attempt, counted, worker, finished) "
-            "VALUES (1, 1, 1, 'packing', 'design', '{\"p\":1}', 'done', 1, 1, 'w1', 150.0)");
-    exec_v1(db,
-            "INSERT INTO results (job_id, attempt, worker, metrics_json, wall_seconds, stored) "
-            "VALUES (1, 1, 'w1', '{\"solid_fraction\":0.61}', 12.5, 150.0)");
+    exec_sql(db, kSchemaV1);
+    exec_sql(db, "PRAGMA user_version=1");
+    exec_sql(db,
+             "INSERT INTO campaigns (name, state, spec_json, design_json, created, finished) "
+             "VALUES ('old', 'done', '{\"spec\":1}', '{}', 100.0, 200.0)");
+    exec_sql(db,
+             "INSERT INTO jobs (campaign_id, std_order, run_order, test, kind, payload, state, "
+             "attempt, counted, worker, finished) "
+             "VALUES (1, 1, 1, 'packing', 'design', '{\"p\":1}', 'done', 1, 1, 'w1', 150.0)");
+    exec_sql(db,
+             "INSERT INTO results (job_id, attempt, worker, metrics_json, wall_seconds, stored) "
+             "VALUES (1, 1, 'w1', '{\"solid_fraction\":0.61}', 12.5, 150.0)");
     // Version 1 refuses a diagnosis job: the migration is what admits them.
     char* err = nullptr;
     EXPECT_NE(sqlite3_exec(db,
@@ -668,7 +752,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 11);
+    EXPECT_EQ(Store::latest_schema_version(), 12);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
