@@ -93,9 +93,17 @@ void add_campaign_commands(CLI::App& app) {
       if (!j.error().empty()) std::cout << "  (" << j.error() << ")";
       if (j.reused_from() != 0) std::cout << "  reused from job " << j.reused_from();
       if (!j.reused_journal().empty()) std::cout << "  reused from " << j.reused_journal();
-      if (!j.checkpoint_stage().empty())
+      if (!j.checkpoint_stage().empty()) {
         std::cout << "  checkpoint '" << j.checkpoint_stage() << "' (kept "
-                  << utc_time(j.checkpoint_saved()) << ")";
+                  << utc_time(j.checkpoint_saved());
+        if (j.checkpoint_steps() > 0) {
+          std::ostringstream clock;
+          clock << ", at " << std::setprecision(4) << j.checkpoint_simulated_seconds()
+                << " s simulated, " << j.checkpoint_steps() << " steps";
+          std::cout << clock.str();
+        }
+        std::cout << ")";
+      }
       std::cout << "\n";
       for (const auto& [k, why] : j.flags()) std::cout << "    ! " << k << ": " << why << "\n";
     }

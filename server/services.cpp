@@ -314,6 +314,8 @@ grpc::Status CampaignServiceImpl::GetResults(grpc::ServerContext* ctx, const v1:
       if (const auto m = marks.find(job.id); m != marks.end()) {
         j->set_checkpoint_stage(m->second.stage);
         j->set_checkpoint_saved(m->second.stored);
+        j->set_checkpoint_simulated_seconds(m->second.clock.simulated_seconds);
+        j->set_checkpoint_steps(m->second.clock.steps);
       }
     }
   } catch (const std::exception& e) {
@@ -578,13 +580,18 @@ grpc::Status WorkerServiceImpl::Checkpoint(grpc::ServerContext* ctx,
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
   if (req->stage().empty() || req->stage().size() > 64)
     return {grpc::StatusCode::INVALID_ARGUMENT, "stage: 1-64 characters"};
+  if (!std::isfinite(req->simulated_seconds()) || req->simulated_seconds() < 0.0 ||
+      req->steps() < 0)
+    return {grpc::StatusCode::INVALID_ARGUMENT,
+            "simulated_seconds, steps: must be finite and >= 0"};
   const double max_bytes = config_.max_checkpoint_mb * 1024.0 * 1024.0;
   if (static_cast<double>(req->state().size()) > max_bytes)
     return {grpc::StatusCode::INVALID_ARGUMENT,
             fmt::format("state: {} bytes, more than the coordinator's --max-checkpoint-mb {:g}",
                         req->state().size(), config_.max_checkpoint_mb)};
   if (const auto answer = store_.save_checkpoint(req->job_id(), req->attempt(), req->worker(),
-                                                 req->stage(), req->state(), steady_seconds());
+                                                 req->stage(), req->state(), steady_seconds(),
+                                                 {req->simulated_seconds(), req->steps()});
       answer != LeaseAnswer::kOk)
     return lease_refused(answer, req->job_id(), req->attempt(), req->worker(),
                          "; checkpoint not kept");

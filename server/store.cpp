@@ -821,16 +821,17 @@ LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string&
 }
 
 LeaseAnswer Store::save_checkpoint(std::int64_t job_id, int attempt, const std::string& worker,
-                                   const std::string& stage, const std::string& state, double now) {
+                                   const std::string& stage, const std::string& state, double now,
+                                   const CheckpointClock& clock) {
   Guard lock(*this);
   Transaction tx(*this);
   if (const auto answer = check_lease(job_id, attempt, worker, now); answer != LeaseAnswer::kOk)
     return answer;
   Statement s(*this,
-              "INSERT OR REPLACE INTO checkpoints (job_id, attempt, worker, stage, state, stored) "
-              "VALUES (?, ?, ?, ?, ?, ?)");
+              "INSERT OR REPLACE INTO checkpoints (job_id, attempt, worker, stage, state, stored, "
+              "simulated_seconds, steps) VALUES (?, ?, ?, ?, ?, ?, ?, ?)");
   s.bind(1, job_id).bind(2, attempt).bind(3, worker).bind(4, stage).bind_blob(5, state);
-  s.bind(6, server::wall_seconds()).step();
+  s.bind(6, server::wall_seconds()).bind(7, clock.simulated_seconds).bind(8, clock.steps).step();
   tx.commit();
   return LeaseAnswer::kOk;
 }
@@ -845,13 +846,13 @@ std::optional<CheckpointRow> Store::checkpoint(std::int64_t job_id) {
 
 std::map<std::int64_t, CheckpointMark> Store::checkpoint_marks(std::int64_t campaign_id) {
   Guard lock(*this);
-  Statement s(
-      *this,
-      "SELECT c.job_id, c.stage, c.stored FROM checkpoints c JOIN jobs j ON j.id = c.job_id "
-      "WHERE j.campaign_id = ?");
+  Statement s(*this,
+              "SELECT c.job_id, c.stage, c.stored, c.simulated_seconds, c.steps FROM checkpoints c "
+              "JOIN jobs j ON j.id = c.job_id WHERE j.campaign_id = ?");
   s.bind(1, campaign_id);
   std::map<std::int64_t, CheckpointMark> out;
-  while (s.step()) out.emplace(s.i64(0), CheckpointMark{s.text(1), s.f64(2)});
+  while (s.step())
+    out.emplace(s.i64(0), CheckpointMark{s.text(1), s.f64(2), CheckpointClock{s.f64(3), s.i64(4)}});
   return out;
 }
 

@@ -122,10 +122,18 @@ struct CheckpointRow {
   std::string stage, state;
 };
 
-/// Where a job's latest checkpoint stands, without its state: the stage and when it was kept.
+/// The run's clock at a checkpoint, as the worker sent it: simulated seconds and steps.
+struct CheckpointClock {
+  double simulated_seconds = 0.0;
+  std::int64_t steps = 0;
+};
+
+/// Where a job's latest checkpoint stands, without its state: the stage, when it was kept and
+/// the run's clock there.
 struct CheckpointMark {
   std::string stage;
   double stored = 0.0;
+  CheckpointClock clock;
 };
 
 struct Counts {
@@ -252,10 +260,11 @@ class Store {
   /// Keeps a checkpoint of the current, unexpired lease held by `worker`, in place of the job's
   /// earlier one; a stored result drops it.
   LeaseAnswer save_checkpoint(std::int64_t job_id, int attempt, const std::string& worker,
-                              const std::string& stage, const std::string& state, double now);
+                              const std::string& stage, const std::string& state, double now,
+                              const CheckpointClock& clock = {});
   /// The job's latest checkpoint, if any.
   std::optional<CheckpointRow> checkpoint(std::int64_t job_id);
-  /// Per job of the campaign with a checkpoint, its stage and when it was kept.
+  /// Per job of the campaign with a checkpoint, its stage, when it was kept and its clock.
   std::map<std::int64_t, CheckpointMark> checkpoint_marks(std::int64_t campaign_id);
   /// Expired leases go back to the queue, or fail at the attempt cap. Returns jobs reaped.
   int reap(double now);

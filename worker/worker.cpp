@@ -128,8 +128,10 @@ int job_threads(const v1::JobSpec& job, int worker_threads) {
   return job.threads() > 0 ? std::min(job.threads(), worker_threads) : worker_threads;
 }
 
-/// Sends a checkpoint the job offers (stage, its record) to the coordinator.
-using CheckpointSender = std::function<void(const std::string&, std::string)>;
+/// Sends a checkpoint the job offers (stage, the run's clock there, its record) to the
+/// coordinator.
+using CheckpointSender =
+    std::function<void(const std::string&, const lab::CheckpointClock&, std::string)>;
 
 /// Runs the job's lab test, from the checkpoint the lease carries if any: one that this build
 /// cannot go on from (another format, a stage the test never reaches) is set aside with a
@@ -165,10 +167,10 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
       stop.check();
     };
     ro.checkpoint = [&send_checkpoint, checkpoint_seconds, last = Clock::now()](
-                        const std::string& stage,
+                        const std::string& stage, const lab::CheckpointClock& clock,
                         const std::function<std::string()>& record) mutable {
       if (std::chrono::duration<double>(Clock::now() - last).count() < checkpoint_seconds) return;
-      send_checkpoint(stage, record());
+      send_checkpoint(stage, clock, record());
       last = Clock::now();
     };
     const lab::LabOutput out = run_lab(job, std::move(ro));
@@ -349,15 +351,14 @@ class Worker {
                         job_stop.lease_lost);
     // The simulation runs on its own thread so that a stop request can give the lease back; a
     // detached simulation (give-back on abort) is followed by the process exiting.
-    auto task = std::make_shared<std::packaged_task<Outcome()>>(
-        [this, job, threads = opt_.threads, shared] {
-          return run_job(
-              job, threads, shared->first, shared->second,
-              [this, &job](const std::string& stage, std::string state) {
-                send_checkpoint(job, stage, std::move(state));
-              },
-              opt_.checkpoint_seconds, stage_cache_);
-        });
+    auto task = std::make_shared<std::packaged_task<Outcome()>>([this, job, threads = opt_.threads,
+                                                                 shared] {
+      const CheckpointSender send =
+          [this, &job](const std::string& stage, const lab::CheckpointClock& clock,
+                       std::string state) { send_checkpoint(job, stage, clock, std::move(state)); };
+      return run_job(job, threads, shared->first, shared->second, send, opt_.checkpoint_seconds,
+                     stage_cache_);
+    });
     auto future = task->get_future();
     std::thread sim([task] { (*task)(); });
     if (must_give_back(future, job)) {
@@ -458,18 +459,22 @@ class Worker {
   }
 
   /// One try: a checkpoint that does not arrive costs only the time it would have saved.
-  void send_checkpoint(const v1::JobSpec& job, const std::string& stage, std::string state) {
+  void send_checkpoint(const v1::JobSpec& job, const std::string& stage,
+                       const lab::CheckpointClock& clock, std::string state) {
     const std::size_t bytes = state.size();
     v1::CheckpointRequest c;
     c.set_job_id(job.job_id());
     c.set_attempt(job.attempt());
     c.set_worker(id_);
     c.set_stage(stage);
+    c.set_simulated_seconds(clock.simulated_seconds);
+    c.set_steps(clock.steps);
     c.set_state(std::move(state));
     v1::CheckpointReply cr;
     const auto s = stub_->Checkpoint(rpc::make_context(opt_.channel, 30).get(), c, &cr);
     if (s.ok())
-      spdlog::info("job {}: checkpoint '{}' sent ({} bytes)", job.job_id(), stage, bytes);
+      spdlog::info("job {}: checkpoint '{}' sent ({} bytes, at {:.4g} s simulated, {} steps)",
+                   job.job_id(), stage, bytes, c.simulated_seconds(), c.steps());
     else
       spdlog::warn("job {}: checkpoint '{}' not kept: {}", job.job_id(), stage, s.error_message());
   }

@@ -34,6 +34,15 @@ struct Checkpoint {
   std::string state;  ///< the stage's record (the world's state and what the test keeps of it)
 };
 
+/// Where a run stood when it offered a checkpoint: the simulated time and steps of the world the
+/// checkpoint holds, since the run's start (a resumed run's include the earlier attempts'; a
+/// test that runs a phase on a copy of a state reports the copy's, which count the steps that
+/// made that state).
+struct CheckpointClock {
+  double simulated_seconds = 0.0;
+  std::int64_t steps = 0;
+};
+
 struct LabOutput {
   std::map<std::string, double> metrics;  ///< by the names of the catalogue
   std::map<std::string, Series> series;
@@ -55,9 +64,11 @@ struct RunOptions {
   std::uint64_t seed = 1;
   std::string snapshot_dir;                       ///< empty: no VTK
   std::function<void(double fraction)> progress;  ///< optional, 0..1
-  /// Offered a checkpoint at each stage a test can go on from, with the maker of its record:
-  /// the receiver calls it only for a checkpoint it keeps (a worker, every few minutes).
-  std::function<void(const std::string& stage, const std::function<std::string()>& record)>
+  /// Offered a checkpoint at each stage a test can go on from, with the run's clock there and
+  /// the maker of its record: the receiver calls it only for a checkpoint it keeps (a worker,
+  /// every few minutes).
+  std::function<void(const std::string& stage, const CheckpointClock& clock,
+                     const std::function<std::string()>& record)>
       checkpoint;
   /// Go on from this checkpoint instead of simulating up to its stage (empty stage: start
   /// afresh). run_lab_test refuses one whose stage the test never reached.

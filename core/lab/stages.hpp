@@ -99,7 +99,7 @@ class Stages {
   template <class Phase>
   void offer_within(const std::string& name, const sim::World& world, Phase phase) const {
     if (!options_.checkpoint) return;
-    options_.checkpoint(name, [&] {
+    options_.checkpoint(name, clock_of(world), [&] {
       ByteWriter inner;
       phase(inner);
       ByteWriter record = stage_record(world);
@@ -120,13 +120,16 @@ class Stages {
   /// the receiver keeps it).
   void reached(std::size_t k, const sim::World& world) const {
     if (!options_.checkpoint) return;
-    options_.checkpoint(names_.at(k), [&] { return stage_record(world).take(); });
+    options_.checkpoint(names_.at(k), clock_of(world), [&] { return stage_record(world).take(); });
   }
 
  private:
   auto find_within(const std::string& name) const {
     return std::find_if(within_.begin(), within_.end(),
                         [&](const auto& w) { return w.first == name; });
+  }
+  static CheckpointClock clock_of(const sim::World& world) {
+    return {world.time, world.step_count};
   }
   /// A stage's record: the format, the world's state, the output, the runner's fields.
   ByteWriter stage_record(const sim::World& world) const {

@@ -16,16 +16,26 @@
 namespace demcal::lab {
 namespace {
 
-/// Runs the test once from the start, keeping every checkpoint it offers.
+/// Runs the test once from the start, keeping every checkpoint it offers. The clock of each
+/// (its world's simulated time and steps) is past the first step and within the run's whole.
 LabOutput run_keeping_checkpoints(const std::string& test, const MaterialModel& material,
                                   const Settings& settings, std::vector<Checkpoint>& kept) {
   RunOptions options;
   options.seed = 3;
-  options.checkpoint = [&kept](const std::string& stage,
-                               const std::function<std::string()>& record) {
+  std::vector<std::pair<std::string, CheckpointClock>> clocks;
+  options.checkpoint = [&kept, &clocks](const std::string& stage, const CheckpointClock& clock,
+                                        const std::function<std::string()>& record) {
+    clocks.emplace_back(stage, clock);
     kept.push_back({stage, record()});
   };
-  return run_lab_test(test, material, settings, options);
+  LabOutput out = run_lab_test(test, material, settings, options);
+  for (const auto& [stage, clock] : clocks) {
+    EXPECT_GT(clock.steps, 0) << stage;
+    EXPECT_GT(clock.simulated_seconds, 0.0) << stage;
+    EXPECT_LE(clock.steps, out.cost.steps) << stage;
+    EXPECT_LE(clock.simulated_seconds, out.cost.simulated_time * (1.0 + 1e-12)) << stage;
+  }
+  return out;
 }
 
 LabOutput resumed(const std::string& test, const MaterialModel& material, const Settings& settings,

@@ -7,12 +7,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <set>
 #include <thread>
 
@@ -51,9 +53,12 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
   lab::RunOptions options;
   options.seed = job.seed() ? job.seed() : 1;  // as the worker
   std::vector<lab::Checkpoint> offered;
-  options.checkpoint = [&offered](const std::string& stage,
-                                  const std::function<std::string()>& record) {
+  std::vector<lab::CheckpointClock> clocks;
+  options.checkpoint = [&offered, &clocks](const std::string& stage,
+                                           const lab::CheckpointClock& clock,
+                                           const std::function<std::string()>& record) {
     offered.push_back({stage, record()});
+    clocks.push_back(clock);
   };
   const lab::LabOutput whole = lab::run_lab_test(job.test(), rpc::job_material(job),
                                                  rpc::to_settings(job.settings()), options);
@@ -64,12 +69,16 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
   const auto turns = std::count_if(offered.begin(), offered.end(), is_turn);
   ASSERT_GE(turns, 2);
   const lab::Checkpoint kept = *first_turn;
+  const lab::CheckpointClock kept_clock = clocks[std::size_t(first_turn - offered.begin())];
+  ASSERT_GT(kept_clock.steps, 0);
   v1::CheckpointRequest cp;
   cp.set_job_id(job.job_id());
   cp.set_attempt(job.attempt());
   cp.set_worker("intruder");
   cp.set_stage(kept.stage);
   cp.set_state(kept.state);
+  cp.set_simulated_seconds(kept_clock.simulated_seconds);
+  cp.set_steps(kept_clock.steps);
   v1::CheckpointReply cpr;
   EXPECT_EQ(workers_stub_->Checkpoint(ctx().get(), cp, &cpr).error_code(),
             grpc::StatusCode::PERMISSION_DENIED);
@@ -77,6 +86,17 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
   v1::CheckpointRequest unnamed = cp;
   unnamed.set_stage("");
   EXPECT_EQ(workers_stub_->Checkpoint(ctx().get(), unnamed, &cpr).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  for (const double bad : {std::nan(""), -1.0, HUGE_VAL}) {
+    v1::CheckpointRequest unclocked = cp;
+    unclocked.set_simulated_seconds(bad);
+    EXPECT_EQ(workers_stub_->Checkpoint(ctx().get(), unclocked, &cpr).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT)
+        << bad;
+  }
+  v1::CheckpointRequest negative_steps = cp;
+  negative_steps.set_steps(-1);
+  EXPECT_EQ(workers_stub_->Checkpoint(ctx().get(), negative_steps, &cpr).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
   ASSERT_TRUE(workers_stub_->Checkpoint(ctx().get(), cp, &cpr).ok());
   v1::FailRequest give_back;
@@ -98,6 +118,8 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
       EXPECT_EQ(j.checkpoint_stage(), kept.stage);
       EXPECT_GT(j.checkpoint_saved(), before - 600.0);
       EXPECT_LE(j.checkpoint_saved(), before);
+      EXPECT_EQ(j.checkpoint_simulated_seconds(), kept_clock.simulated_seconds);
+      EXPECT_EQ(j.checkpoint_steps(), kept_clock.steps);
     } else {
       EXPECT_TRUE(j.checkpoint_stage().empty());
     }
@@ -105,8 +127,13 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
       cli_text(dir_, "status_checkpoint.txt", {"status", std::to_string(id), "--jobs"}, channel_);
   EXPECT_NE(listed.find("job " + std::to_string(job.job_id()) + " "), std::string::npos) << listed;
   EXPECT_NE(listed.find("checkpoint '" + kept.stage + "' (kept 20"), std::string::npos) << listed;
-  // A real worker leases the job again with its checkpoint and goes on from it.
-  Process& second = start_worker("second", kToken, {"--max-jobs", "1"});
+  EXPECT_NE(listed.find(" s simulated, " + std::to_string(kept_clock.steps) + " steps)"),
+            std::string::npos)
+      << listed;
+  // A real worker leases the job again with its checkpoint and goes on from it, sending every
+  // checkpoint it passes with the run's clock, which goes on from the kept one's.
+  Process& second =
+      start_worker("second", kToken, {"--max-jobs", "1", "--checkpoint-seconds", "0"});
   std::optional<v1::JobResult> stored;
   ASSERT_TRUE(wait_until(
       [&] {
@@ -119,6 +146,15 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
       << second.log();
   EXPECT_NE(second.log().find("going on from checkpoint '" + kept.stage + "'"), std::string::npos)
       << second.log();
+  const std::regex sent(
+      R"(checkpoint '[^']+' sent \(\d+ bytes, at \S+ s simulated, (\d+) steps\))");
+  std::vector<std::int64_t> sent_steps;
+  const std::string log = second.log();
+  for (auto it = std::sregex_iterator(log.begin(), log.end(), sent); it != std::sregex_iterator();
+       ++it)
+    sent_steps.push_back(std::stoll((*it)[1].str()));
+  ASSERT_FALSE(sent_steps.empty()) << log;
+  for (const auto steps : sent_steps) EXPECT_GT(steps, kept_clock.steps) << log;
   EXPECT_EQ(stored->attempt(), 2);
   ASSERT_EQ(stored->metrics().size(), whole.metrics.size());
   for (const auto& [name, value] : whole.metrics)

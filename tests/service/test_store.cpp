@@ -253,8 +253,13 @@ TEST(Store, KeepsTheLatestCheckpointOfTheLeaseHolderUntilTheResultIsStored) {
   const std::string state("\0binary\xff", 9);
   EXPECT_EQ(s.save_checkpoint(a->id, 1, "intruder", "bed", state, 1.0), kNotHolder);
   EXPECT_FALSE(s.checkpoint(a->id));
-  EXPECT_EQ(s.save_checkpoint(a->id, 1, "w1", "bed", "old", 1.0), kOk);
-  EXPECT_EQ(s.save_checkpoint(a->id, 1, "w1", "bed", state, 2.0), kOk);
+  EXPECT_EQ(s.save_checkpoint(a->id, 1, "w1", "bed", "old", 1.0, {0.5, 1000}), kOk);
+  EXPECT_EQ(s.save_checkpoint(a->id, 1, "w1", "bed", state, 2.0, {0.75, 1500}), kOk);
+  // The latest checkpoint's clock is the one the job list shows.
+  const auto marks = s.checkpoint_marks(1);
+  ASSERT_EQ(marks.count(a->id), 1u);
+  EXPECT_EQ(marks.at(a->id).clock.simulated_seconds, 0.75);
+  EXPECT_EQ(marks.at(a->id).clock.steps, 1500);
   // The lease lapses: the next one is handed the latest checkpoint, bytes intact; the lapsed
   // lease can no longer replace it.
   EXPECT_EQ(s.reap(20.0), 1);
@@ -512,7 +517,7 @@ TEST(Store, AStoreOfSchemaElevenMarksTheJobsWhoseWaitHasEndedAndLeasesThemFirst)
     ASSERT_EQ(sqlite3_close(db), SQLITE_OK);
   }
   Store s(path.string());
-  EXPECT_EQ(s.schema_version(), 12);
+  EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
   const auto first = s.lease("w", 1.0);
   ASSERT_TRUE(first);
   EXPECT_EQ(first->id, 3);  // row 1's tensile job, before row 2's compression
@@ -752,7 +757,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 12);
+    EXPECT_EQ(Store::latest_schema_version(), 13);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
