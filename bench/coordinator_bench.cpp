@@ -1,7 +1,9 @@
 // Coordinator throughput without physics: an in-process coordinator on loopback (real gRPC,
 // real SQLite file with synchronous=NORMAL, the default), N fake workers that Lease and Complete
 // jobs as fast as they can with synthetic metrics, and W clients holding Watch streams on the
-// campaign meanwhile. Prints jobs (lease + complete) per second. Run by bench/coordinator.sh.
+// campaign meanwhile. Prints jobs (lease + complete) per second. With --waiting the campaign's
+// rows are a confined compression and the tensile test that waits for it (half the queue waits),
+// else one packing run. Run by bench/coordinator.sh.
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -41,8 +43,9 @@ constexpr const char* kFactors[][3] = {
 };
 constexpr int kMaxFactors = static_cast<int>(std::size(kFactors));
 
-/// A packing campaign of (2^factors + centre points) x replicates jobs; never simulated here.
-std::string spec_text(int factors, int centre_points, int replicates) {
+/// A campaign of (2^factors + centre points) x replicates rows, one packing job a row or (waiting)
+/// a confined compression and its tensile test; never simulated here.
+std::string spec_text(int factors, int centre_points, int replicates, bool waiting) {
   std::string text = R"(
 name: bench
 material:
@@ -52,10 +55,10 @@ material:
   sizes: {monodisperse: {radius: 0.0005}}
   density: 2500
 tests:
-  - test: packing
-    settings: {particles: 30}
-factors:
 )";
+  text += waiting ? "  - {test: confined_compression}\n  - {test: tensile}\n"
+                  : "  - {test: packing, settings: {particles: 30}}\n";
+  text += "factors:\n";
   for (int k = 0; k < factors; ++k)
     text += std::string("  - {path: ") + kFactors[k][0] + ", low: " + kFactors[k][1] +
             ", high: " + kFactors[k][2] + "}\n";
@@ -77,8 +80,10 @@ int fake_worker(const rpc::ChannelOptions& channel, const std::string& id) {
     c.set_attempt(lease.job().attempt());
     c.set_worker(id);
     c.set_wall_seconds(0.001);
-    (*c.mutable_metrics())["solid_fraction"] = 0.55;
-    (*c.mutable_metrics())["coordination_number"] = 4.0;
+    if (lease.job().test() == "packing") {
+      (*c.mutable_metrics())["solid_fraction"] = 0.55;
+      (*c.mutable_metrics())["coordination_number"] = 4.0;
+    }
     v1::CompleteReply cr;
     if (stub->Complete(rpc::make_context(channel, 30).get(), c, &cr).ok()) ++done;
   }
@@ -103,6 +108,7 @@ int watcher(const rpc::ChannelOptions& channel, std::int64_t id) {
 
 int main(int argc, char** argv) {
   int workers = 8, watchers = 50, factors = 2, centre_points = 64, replicates = 16;
+  bool waiting = false;
   std::string dir = "coordinator-bench";
   CLI::App app{"coordinator throughput: lease + complete per second, no physics"};
   app.add_option("--workers", workers, "fake workers (threads)")->capture_default_str();
@@ -113,6 +119,8 @@ int main(int argc, char** argv) {
   app.add_option("--centre-points", centre_points)->capture_default_str();
   app.add_option("--replicates", replicates)->capture_default_str();
   app.add_option("--dir", dir, "directory of the SQLite file (emptied)")->capture_default_str();
+  app.add_flag("--waiting", waiting,
+               "rows of a confined compression and the tensile test that waits for it");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::warn);
   std::filesystem::remove_all(dir);
@@ -129,7 +137,8 @@ int main(int argc, char** argv) {
 
   v1::SubmitRequest sreq;
   *sreq.mutable_spec() =
-      cli::parse_campaign_spec(spec_text(factors, centre_points, replicates), "bench.yaml").spec;
+      cli::parse_campaign_spec(spec_text(factors, centre_points, replicates, waiting), "bench.yaml")
+          .spec;
   v1::SubmitReply sr;
   const auto submit_start = Clock::now();
   const auto st = v1::CampaignService::NewStub(rpc::make_channel(channel))
