@@ -38,10 +38,31 @@ void exec_sql(sqlite3* db, const char* sql) {
   ASSERT_EQ(rc, SQLITE_OK) << msg << " in " << sql;
 }
 
+/// A store's file in the temporary directory, named for the test and this process; it, its
+/// write-ahead log, its shared memory and its lock file are removed before and after.
+class TempStoreFile {
+ public:
+  explicit TempStoreFile(const std::string& name)
+      : path_(std::filesystem::temp_directory_path() /
+              ("demcal_store_" + name + "_" + std::to_string(::getpid()) + ".db")) {
+    remove_all();
+  }
+  ~TempStoreFile() { remove_all(); }
+  TempStoreFile(const TempStoreFile&) = delete;
+  TempStoreFile& operator=(const TempStoreFile&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  void remove_all() const {
+    for (const char* suffix : {"", "-wal", "-shm", ".lock"})
+      std::filesystem::remove(path_.string() + suffix);
+  }
+  std::filesystem::path path_;
+};
+
 TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("demcal_store_" + std::to_string(::getpid()) + ".db");
-  std::filesystem::remove(path);
+  const TempStoreFile file("reopen");
+  const auto& path = file.path();
   std::int64_t leased = 0;
   {
     Store s(path.string());
@@ -75,15 +96,11 @@ TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
     EXPECT_EQ(s.complete(leased, 1, "w", "{}", 1.0, 1009.5), LeaseAnswer::kOk);
     EXPECT_EQ(s.job(leased)->state, "done");
   }
-  std::filesystem::remove(path);
-  std::filesystem::remove(path.string() + "-wal");
-  std::filesystem::remove(path.string() + "-shm");
 }
 
 TEST(Store, ASecondStoreOnTheSameFileIsRefusedNamingTheFileAndTheHolderUntilTheFirstCloses) {
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("demcal_store_lock_" + std::to_string(::getpid()) + ".db");
-  std::filesystem::remove(path);
+  const TempStoreFile file("lock");
+  const auto& path = file.path();
   {
     Store first(path.string());
     first.create_campaign("c", "{}", "{}", jobs(2), 0.0);
@@ -100,14 +117,11 @@ TEST(Store, ASecondStoreOnTheSameFileIsRefusedNamingTheFileAndTheHolderUntilTheF
   }
   Store again(path.string());  // the lock went with the first store
   EXPECT_EQ(again.counts(1).total(), 2);
-  for (const std::string suffix : {"", "-wal", "-shm", ".lock"})
-    std::filesystem::remove(path.string() + suffix);
 }
 
 TEST(Store, LeasesOfAnEarlierRunOfTheEmbeddedDefaultGoBackUncountedAtOpening) {
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("demcal_store_give_back_" + std::to_string(::getpid()) + ".db");
-  std::filesystem::remove(path);
+  const TempStoreFile file("give_back");
+  const auto& path = file.path();
   StoreLimits embedded{10.0, 1};
   embedded.give_back_leases_at_opening = true;
   std::int64_t leased = 0;
@@ -134,8 +148,6 @@ TEST(Store, LeasesOfAnEarlierRunOfTheEmbeddedDefaultGoBackUncountedAtOpening) {
     EXPECT_EQ(s.checkpoint(leased)->stage, "piston bed");
     EXPECT_EQ(s.complete(leased, 2, "embedded", "{}", 1.0, 1002.0), kOk);
   }
-  for (const std::string suffix : {"", "-wal", "-shm"})
-    std::filesystem::remove(path.string() + suffix);
 }
 
 std::string file_bytes(const std::filesystem::path& path) {
@@ -144,12 +156,8 @@ std::string file_bytes(const std::filesystem::path& path) {
 }
 
 TEST(Store, ADamagedFileIsRefusedNamingTheFileAndTheDamageAndIsLeftUnchanged) {
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("demcal_store_damaged_" + std::to_string(::getpid()) + ".db");
-  auto remove_all = [&] {
-    for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(path.string() + suffix);
-  };
-  remove_all();
+  const TempStoreFile file("damaged");
+  const auto& path = file.path();
   {
     // A real store with enough jobs to fill several pages; closing it copies the write-ahead
     // log into the file and removes the log.
@@ -183,16 +191,11 @@ TEST(Store, ADamagedFileIsRefusedNamingTheFileAndTheDamageAndIsLeftUnchanged) {
     EXPECT_NE(what.find("quick_check"), std::string::npos) << what;
   }
   EXPECT_EQ(file_bytes(path), bytes) << "the damaged file was modified";
-  remove_all();
 }
 
 TEST(Store, AFileWithARowBreakingAForeignKeyIsRefusedNamingTheFileAndTheRowAndKeepsIt) {
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("demcal_store_foreign_key_" + std::to_string(::getpid()) + ".db");
-  auto remove_all = [&] {
-    for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(path.string() + suffix);
-  };
-  remove_all();
+  const TempStoreFile file("foreign_key");
+  const auto& path = file.path();
   {
     Store s(path.string());
     s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
@@ -224,7 +227,6 @@ TEST(Store, AFileWithARowBreakingAForeignKeyIsRefusedNamingTheFileAndTheRowAndKe
   EXPECT_EQ(sqlite3_column_int(stmt, 0), 1);
   sqlite3_finalize(stmt);
   sqlite3_close(db);
-  remove_all();
 }
 
 TEST(Store, LeasesInRunOrderAndStoresAResultExactlyOnce) {
@@ -495,9 +497,8 @@ TEST(Store, AJobWhoseWaitHasEndedIsLeasedBeforeTheJobsLaterInRunOrder) {
 }
 
 TEST(Store, AStoreOfSchemaElevenMarksTheJobsWhoseWaitHasEndedAndLeasesThemFirst) {
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("demcal_store_v11_" + std::to_string(::getpid()) + ".db");
-  for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(path.string() + suffix);
+  const TempStoreFile file("v11");
+  const auto& path = file.path();
   {
     // A store as the coordinator of schema version 11 left it: row 1's compression done, its
     // tensile job queued behind row 2's compression in run order; row 2's tensile job waiting.
@@ -529,7 +530,6 @@ TEST(Store, AStoreOfSchemaElevenMarksTheJobsWhoseWaitHasEndedAndLeasesThemFirst)
   const auto third = s.lease("w", 2.0);
   ASSERT_TRUE(third);
   EXPECT_EQ(third->id, 4);
-  for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(path.string() + suffix);
 }
 
 TEST(Store, RunsOfAJournalAreTakenByTheJobsOfTheirKeysAndNeverReplaceARunHeld) {
@@ -570,9 +570,8 @@ TEST(Store, ACampaignOfManyBatchesIsInsertedWholeInRunOrder) {
 
 TEST(Store, ACampaignWhoseJobsWereNotAllInsertedIsDroppedOnOpening) {
   // A coordinator stopped between two batches of a submission it never answered.
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("demcal_store_partial_" + std::to_string(::getpid()) + ".db");
-  std::filesystem::remove(path);
+  const TempStoreFile file("partial");
+  const auto& path = file.path();
   {
     Store s(path.string());
     s.create_campaign("whole", "{}", "{}", jobs(2), 0.0);
@@ -594,9 +593,6 @@ TEST(Store, ACampaignWhoseJobsWereNotAllInsertedIsDroppedOnOpening) {
     EXPECT_FALSE(s.campaign(2));
     EXPECT_EQ(s.counts(2).total(), 0);
   }
-  std::filesystem::remove(path);
-  std::filesystem::remove(path.string() + "-wal");
-  std::filesystem::remove(path.string() + "-shm");
 }
 
 TEST(Store, TimeTheLockIsHeldByOneLongWriteIsAddedToEveryLeaseDeadline) {
@@ -726,9 +722,8 @@ constexpr const char* kSchemaV1 = R"sql(
       )sql";
 
 TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJobs) {
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("demcal_store_v1_" + std::to_string(::getpid()) + ".db");
-  std::filesystem::remove(path);
+  const TempStoreFile file("v1");
+  const auto& path = file.path();
   {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(path.string().c_str(), &db), SQLITE_OK);
@@ -827,9 +822,6 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
         s.add_calibration_round(1, {1, 1, "{}", 320.0}, {{1, 1, "packing", "verify", "{}"}}));
     EXPECT_EQ(s.jobs(1).size(), 5u);
   }
-  std::filesystem::remove(path);
-  std::filesystem::remove(path.string() + "-wal");
-  std::filesystem::remove(path.string() + "-shm");
 }
 
 // The ETA of a campaign resumed from its journal: 30 of its 51 jobs taken at once, one simulated
