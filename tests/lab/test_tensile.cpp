@@ -1,7 +1,8 @@
 // tensile (seed 000 §2.7.3): about zero without cohesion; rises with the Hamaker constant and
 // with kc/k1; a bed conditioned at a low stress keeps its height through the unload; a peak at
 // the end of the pull is flagged; starts from the bed a confined compression of the same settings
-// conditioned, taken from the stage cache to the bit.
+// conditioned, taken from the stage cache to the bit; a material out of the contact range is
+// refused also when the stage cache holds its bed.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +10,8 @@
 #include <fstream>
 #include <memory>
 
+#include "core/common/error.hpp"
+#include "core/lab/bed.hpp"
 #include "core/lab/confinement.hpp"
 #include "core/lab/lab_run.hpp"
 #include "core/lab/stage_cache.hpp"
@@ -139,6 +142,30 @@ TEST(Tensile, StartsFromTheBedAConfinedCompressionConditionedToTheBit) {
   other_alone.seed = 2;
   EXPECT_EQ(run_lab_test("tensile", m, small(), other).metrics.at("tensile_strength"),
             run_lab_test("tensile", m, small(), other_alone).metrics.at("tensile_strength"));
+}
+
+// A material whose attraction alone overlaps a pair beyond its radius is refused before the
+// first step (sim::check_contact_range), also when the conditioned bed it would start from is in
+// the stage cache: a record made by a build that did not refuse the law (here another material's
+// bed, kept under this one's identity) is never simulated on.
+TEST(Tensile, AMaterialOutOfTheContactRangeIsRefusedAlsoFromAStageRecord) {
+  const auto in_range = testing::soft_luding(1e7, 5.0, 0.5, 1e-18);
+  const auto out_of_range = testing::soft_luding(1e7, 5.0, 0.5, 1e-14);
+  EXPECT_NO_THROW(check_contact_range(in_range));
+  EXPECT_THROW(check_contact_range(out_of_range), SimulationFailure);
+  RunOptions cached;
+  cached.stage_cache = fresh_cache("out_of_range");
+  run_lab_test("confined_compression", in_range, conditioning(), cached);
+  const auto cs = read_settings<ConfinedCompressionSettings>(conditioning(), "settings");
+  const auto record = cached.stage_cache->find(conditioned_bed_identity(in_range, cs, cached));
+  ASSERT_TRUE(record);
+  cached.stage_cache->keep(conditioned_bed_identity(out_of_range, cs, cached), *record);
+  try {
+    run_lab_test("tensile", out_of_range, small(), cached);
+    ADD_FAILURE() << "the tensile test ran on a material out of the contact range";
+  } catch (const SimulationFailure& e) {
+    EXPECT_EQ(e.reason(), SimulationFailure::Reason::kContactOutOfRange) << e.what();
+  }
 }
 
 TEST(StageCache, KeepsARecordUnderItsWholeIdentity) {
