@@ -1,4 +1,5 @@
-// `demcal list | status ID | watch ID | cancel ID`: campaigns on a coordinator.
+// `demcal list | status ID|SPEC | watch ID | cancel ID`: campaigns on a coordinator (status also
+// of a spec's campaign on the embedded default).
 #include <algorithm>
 #include <ctime>
 #include <iomanip>
@@ -8,6 +9,7 @@
 #include <sstream>
 
 #include "client/commands.hpp"
+#include "client/embedded.hpp"
 #include "client/service_client.hpp"
 
 namespace demcal::cli {
@@ -29,12 +31,69 @@ std::string utc_time(double unix_seconds) {
   return s.str();
 }
 
+/// One job of `demcal status --jobs`: its state, metrics (a flagged one marked '!', its reason on
+/// a line of its own), cost, error, reuse, and its checkpoint with the run's clock there.
+void print_job_line(const v1::JobResult& j) {
+  std::cout << "  job " << j.job_id() << " " << j.kind() << " run " << j.std_order() << " "
+            << j.test() << " " << j.state() << " attempt " << j.attempt();
+  for (const auto& [k, v] : j.metrics())
+    std::cout << " " << k << "=" << v << (j.flags().contains(k) ? "!" : "");
+  if (j.has_cost() && j.cost().wall_seconds() > 0.0)
+    std::cout << "  [" << j.cost().steps() << " steps, " << j.cost().wall_seconds() << " s]";
+  if (!j.error().empty()) std::cout << "  (" << j.error() << ")";
+  if (j.reused_from() != 0) std::cout << "  reused from job " << j.reused_from();
+  if (!j.reused_journal().empty()) std::cout << "  reused from " << j.reused_journal();
+  if (!j.checkpoint_stage().empty()) {
+    std::cout << "  checkpoint '" << j.checkpoint_stage() << "' (kept "
+              << utc_time(j.checkpoint_saved());
+    if (j.checkpoint_steps() > 0) {
+      std::ostringstream clock;
+      clock << ", at " << std::setprecision(4) << j.checkpoint_simulated_seconds()
+            << " s simulated, " << j.checkpoint_steps() << " steps";
+      std::cout << clock.str();
+    }
+    std::cout << ")";
+  }
+  std::cout << "\n";
+  for (const auto& [k, why] : j.flags()) std::cout << "    ! " << k << ": " << why << "\n";
+}
+
+/// `demcal status`: the campaign's row, its rounds and flagged results, and with `jobs` every job
+/// (a flagged metric marked '!', its reason on the next line; a checkpoint with its clock).
+void print_status(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                  std::int64_t id, bool jobs, const std::string& format) {
+  v1::GetRequest req;
+  req.set_id(id);
+  v1::Campaign c;
+  check(stub.Get(rpc::make_context(channel, 30).get(), req, &c), "status");
+  v1::ResultsReply r;
+  check(stub.GetResults(rpc::make_context(channel, 30).get(), req, &r), "results");
+  if (format == "json") {
+    nlohmann::json doc = nlohmann::json::parse(message_json(c));
+    if (jobs) doc["jobs"] = nlohmann::json::parse(message_json(r))["jobs"];
+    std::cout << doc.dump(2) << "\n";
+    return;
+  }
+  print_campaign_row(c);
+  if (c.has_fidelity_cost()) print_fidelity_cost(std::cout, c.fidelity_cost());
+  print_rounds(std::cout, c.calibration_rounds());
+  const auto flagged = std::count_if(r.jobs().begin(), r.jobs().end(),
+                                     [](const v1::JobResult& j) { return j.flags_size() > 0; });
+  if (flagged > 0)
+    std::cout << "  " << flagged
+              << " result(s) with flagged metrics: a phase did not reach its target (--jobs)\n";
+  if (!jobs) return;
+  for (const auto& j : r.jobs()) print_job_line(j);
+}
+
 }  // namespace
 
 void add_campaign_commands(CLI::App& app) {
   struct Options {
     rpc::ChannelOptions channel;
     std::int64_t id = 0;
+    std::string campaign;  ///< status: an id, or a spec YAML on the embedded default
+    std::string workdir;   ///< status of a spec: its work directory
     bool jobs = false;
     std::string format = "table";
   };
@@ -52,61 +111,23 @@ void add_campaign_commands(CLI::App& app) {
 
   auto* status = app.add_subcommand("status", "A campaign's state and progress (--jobs: each job)");
   add_connection_options(*status, o->channel);
-  status->add_option("id", o->id, "campaign id")->required();
+  status->add_option("campaign", o->campaign, "campaign id, or a spec YAML (embedded default)")
+      ->required();
+  status->add_option("--workdir", o->workdir, "embedded: directory of the SQLite file");
   status->add_flag("--jobs", o->jobs, "list every job with its state, attempt and metrics");
   status
       ->add_option("--format", o->format,
                    "table or json (one document: the campaign, its calibration rounds, jobs)")
       ->check(CLI::IsMember({"table", "json"}));
   status->callback([o] {
-    auto stub = campaign_stub(o->channel);
-    v1::GetRequest req;
-    req.set_id(o->id);
-    v1::Campaign c;
-    check(stub->Get(rpc::make_context(o->channel, 30).get(), req, &c), "status");
-    v1::ResultsReply r;
-    check(stub->GetResults(rpc::make_context(o->channel, 30).get(), req, &r), "results");
-    if (o->format == "json") {
-      nlohmann::json doc = nlohmann::json::parse(message_json(c));
-      if (o->jobs) doc["jobs"] = nlohmann::json::parse(message_json(r))["jobs"];
-      std::cout << doc.dump(2) << "\n";
-      return;
-    }
-    print_campaign_row(c);
-    if (c.has_fidelity_cost()) print_fidelity_cost(std::cout, c.fidelity_cost());
-    print_rounds(std::cout, c.calibration_rounds());
-    const auto flagged = std::count_if(r.jobs().begin(), r.jobs().end(),
-                                       [](const v1::JobResult& j) { return j.flags_size() > 0; });
-    if (flagged > 0)
-      std::cout << "  " << flagged
-                << " result(s) with flagged metrics: a phase did not reach its target (--jobs)\n";
-    if (!o->jobs) return;
-    // A flagged metric (a phase it is computed from did not reach its target) is marked '!'
-    // and its reason follows the job line.
-    for (const auto& j : r.jobs()) {
-      std::cout << "  job " << j.job_id() << " " << j.kind() << " run " << j.std_order() << " "
-                << j.test() << " " << j.state() << " attempt " << j.attempt();
-      for (const auto& [k, v] : j.metrics())
-        std::cout << " " << k << "=" << v << (j.flags().contains(k) ? "!" : "");
-      if (j.has_cost() && j.cost().wall_seconds() > 0.0)
-        std::cout << "  [" << j.cost().steps() << " steps, " << j.cost().wall_seconds() << " s]";
-      if (!j.error().empty()) std::cout << "  (" << j.error() << ")";
-      if (j.reused_from() != 0) std::cout << "  reused from job " << j.reused_from();
-      if (!j.reused_journal().empty()) std::cout << "  reused from " << j.reused_journal();
-      if (!j.checkpoint_stage().empty()) {
-        std::cout << "  checkpoint '" << j.checkpoint_stage() << "' (kept "
-                  << utc_time(j.checkpoint_saved());
-        if (j.checkpoint_steps() > 0) {
-          std::ostringstream clock;
-          clock << ", at " << std::setprecision(4) << j.checkpoint_simulated_seconds()
-                << " s simulated, " << j.checkpoint_steps() << " steps";
-          std::cout << clock.str();
-        }
-        std::cout << ")";
-      }
-      std::cout << "\n";
-      for (const auto& [k, why] : j.flags()) std::cout << "    ! " << k << ": " << why << "\n";
-    }
+    // A spec's store is read as it stands, from a copy when a coordinator holds it: a look at a
+    // campaign running in another process (a worker's checkpoints and their clocks included).
+    with_campaign(
+        o->campaign, o->workdir, LocalWorkers{}, false, o->channel,
+        [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
+          print_status(stub, channel, id, o->jobs, o->format);
+        },
+        {}, /*run_jobs=*/false);
   });
 
   auto* watch = app.add_subcommand("watch", "Follow a campaign with a progress bar and ETA");

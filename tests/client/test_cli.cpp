@@ -699,6 +699,15 @@ TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAJobAgain) {
   EXPECT_NE(queued_text.find("\n#   not finished: queued\n"), std::string::npos) << queued_text;
   EXPECT_TRUE(demcal::lab::read_lab_run(demcal::io::YamlNode::load_file(queued_file.string()))
                   .expected.empty());
+  // `status` of the spec reads the store as it stands too: the job queued, the failed one with
+  // its error, nothing run.
+  const Result status = demcal("status " + spec + work + " --jobs");
+  ASSERT_EQ(status.exit_code, 0) << status.out;
+  EXPECT_NE(status.out.find("job " + std::to_string(queued_id) + " design run "), std::string::npos)
+      << status.out;
+  EXPECT_NE(status.out.find(" grown queued attempt "), std::string::npos) << status.out;
+  EXPECT_NE(status.out.find(" packing failed attempt "), std::string::npos) << status.out;
+  EXPECT_NE(status.out.find("(" + failure + ")"), std::string::npos) << status.out;
   const auto state = demcal::test::run_command(
       "sqlite3 " + store + " \"SELECT state FROM jobs WHERE id = " + std::to_string(queued_id) +
       "\" 2>&1");
