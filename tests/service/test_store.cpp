@@ -75,9 +75,9 @@ TEST(Store, FileIsWalAtTheLatestSchemaAndKeepsDataAcrossReopen) {
     // Specs and results are the owner's alone: the file and its write-ahead log are 0600.
     namespace fs = std::filesystem;
     const auto others = fs::perms::group_all | fs::perms::others_all;
-    for (const std::string& file : {path.string(), path.string() + "-wal"}) {
-      ASSERT_TRUE(fs::exists(file)) << file;
-      EXPECT_EQ(fs::status(file).permissions() & others, fs::perms::none) << file;
+    for (const std::string& name : {path.string(), path.string() + "-wal"}) {
+      ASSERT_TRUE(fs::exists(name)) << name;
+      EXPECT_EQ(fs::status(name).permissions() & others, fs::perms::none) << name;
     }
   }
   {
