@@ -3,7 +3,6 @@
 #include <chrono>
 
 #include "core/common/error.hpp"
-#include "core/lab/bed.hpp"
 #include "core/lab/run_cancelled.hpp"
 #include "core/model/lab_tests.hpp"
 
@@ -85,10 +84,6 @@ LabOutput run_lab_test(const std::string& name, const MaterialModel& material,
                        const Settings& settings, const RunOptions& options) {
   const LabTestInfo& info = find_lab_info(name);
   admit_lab_test(name, material, settings);
-  // A world checks its laws when it is prepared, but a run that starts from a stage record or a
-  // checkpoint restores a world an earlier run prepared, perhaps under a build that did not refuse
-  // the law: so the material is checked here, before anything is simulated or restored.
-  check_contact_range(material);
   const auto started = std::chrono::steady_clock::now();
   RunOptions run = options;
   if (options.progress)

@@ -2,6 +2,7 @@
 #include <cstring>
 
 #include "core/common/bytes.hpp"
+#include "core/sim/health.hpp"
 #include "core/sim/world.hpp"
 
 namespace demcal::sim {
@@ -184,6 +185,9 @@ void World::restore_state(std::string_view state) {
   w.deferred.clear();
   w.balance_owners();
   w.set_contact_masses();
+  // The record was prepared by the run that wrote it, perhaps under a build that did not refuse
+  // its laws: they are checked as a fresh world's are when it is prepared.
+  check_contact_range(w);
   *this = std::move(w);
 }
 
