@@ -12,6 +12,7 @@
 
 #include "client/commands.hpp"
 #include "client/embedded.hpp"
+#include "core/diagnose/diagnosis.hpp"
 
 namespace demcal::cli {
 namespace {
@@ -25,7 +26,20 @@ struct DiagnoseOptions {
   std::string format = "table";
   std::uint64_t seed = 1;
   std::string journal;  ///< embedded: the campaign journal taken from and kept; empty: none
+  int rounds = 0;       ///< --rounds: the campaign's diagnose.rounds from now on; 0: as stored
 };
+
+/// The verification rounds a candidate to ask for: `--rounds` with a campaign id; with a spec
+/// file its `diagnose.rounds` (the default where it has none), so that a spec whose rounds were
+/// changed goes on from the runs its campaign has.
+int rounds_to_ask(const DiagnoseOptions& o) {
+  if (!std::filesystem::is_regular_file(o.campaign)) return o.rounds;
+  if (o.rounds != 0)
+    throw CLI::ValidationError("--rounds",
+                               "only with a campaign id: a spec file's are its diagnose.rounds");
+  const int rounds = read_campaign_spec(o.campaign).spec.diagnose().rounds();
+  return rounds != 0 ? rounds : diagnose::Options{}.rounds;
+}
 
 /// A relative error as a percentage; "-" while it waits for a simulation.
 std::string pct(bool known, double v) {
@@ -104,6 +118,7 @@ v1::DiagnoseReply drive(v1::CampaignService::Stub& stub, const rpc::ChannelOptio
   v1::DiagnoseRequest req;
   req.set_id(id);
   req.set_seed(o.seed);
+  req.set_rounds(rounds_to_ask(o));
   for (;;) {
     v1::DiagnoseReply reply;
     check(stub.Diagnose(rpc::make_context(channel, 600).get(), req, &reply), "diagnose");
@@ -155,6 +170,10 @@ void add_diagnose_command(CLI::App& app) {
   add_local_worker_options(*cmd, o->local);
   cmd->add_flag("!--no-wait", o->wait, "report the current state and queue the next runs only");
   cmd->add_option("--seed", o->seed, "calibration multi-start seed")->capture_default_str();
+  cmd->add_option("--rounds", o->rounds,
+                  "campaign id: verification rounds a candidate from now on (the runs done are "
+                  "kept)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--format", o->format, "table or json")->check(CLI::IsMember({"table", "json"}));
   cmd->add_flag("-v,--verbose", o->verbose, "embedded: coordinator and worker logs");
   cmd->add_option("--journal", o->journal,

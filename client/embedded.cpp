@@ -217,13 +217,26 @@ EmbeddedService::~EmbeddedService() {
   coordinator_->shutdown();
 }
 
+namespace {
+
+/// The spec as a campaign is resumed by: canonical, without the diagnosis's rounds, which
+/// `demcal diagnose` may change on a stored campaign (its runs kept).
+v1::CampaignSpec resumed_as(const v1::CampaignSpec& spec) {
+  v1::CampaignSpec out = rpc::canonical_spec(spec);
+  if (out.has_diagnose()) out.mutable_diagnose()->clear_rounds();
+  if (out.has_diagnose() && out.diagnose().ByteSizeLong() == 0) out.clear_diagnose();
+  return out;
+}
+
+}  // namespace
+
 void EmbeddedService::refuse_if_another_spec(std::int64_t id, const SpecFile& file) {
   v1::GetRequest req;
   req.set_id(id);
   v1::Campaign stored;
   check(stub_->Get(rpc::make_context(channel_, 60).get(), req, &stored), "get");
-  if (google::protobuf::util::MessageDifferencer::Equals(rpc::canonical_spec(stored.spec()),
-                                                         rpc::canonical_spec(file.spec)))
+  if (google::protobuf::util::MessageDifferencer::Equals(resumed_as(stored.spec()),
+                                                         resumed_as(file.spec)))
     return;
   throw InputError("", "campaign " + std::to_string(id) + " '" + file.spec.name() + "' in " +
                            workdir_.string() + " was submitted with another spec than " +

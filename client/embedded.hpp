@@ -49,7 +49,8 @@ class EmbeddedService {
 
   /// The campaign of the spec's name in this work directory (the newest one not cancelled),
   /// or the spec submitted now (its design summary printed to `out`). Returns its id. A campaign
-  /// of that name submitted with another spec is not resumed: InputError naming the directory.
+  /// of that name submitted with another spec (other than in its diagnosis's rounds) is not
+  /// resumed: InputError naming the directory.
   /// With a `journal`, its runs are offered to the coordinator first (import_journal, its report
   /// on `out`), and it is kept up to date with the campaign's finished jobs while this service
   /// lives (JournalKeeper), with a last update once its workers have stopped, also on a stop
@@ -69,7 +70,8 @@ class EmbeddedService {
   void stop_on_signal(int sig);
 
  private:
-  /// Throws InputError unless campaign `id` was submitted with the spec of `file`.
+  /// Throws InputError unless campaign `id` was submitted with the spec of `file`, up to its
+  /// diagnosis's rounds.
   void refuse_if_another_spec(std::int64_t id, const SpecFile& file);
   /// submit_or_resume without a journal.
   std::int64_t submit_or_resume_campaign(const SpecFile& file, std::ostream& out);

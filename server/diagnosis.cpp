@@ -16,6 +16,8 @@
 #include "server/analysis.hpp"
 #include "server/convert.hpp"
 #include "server/plan.hpp"
+#include "server/plan_input.hpp"
+#include "server/stored_columns.hpp"
 
 namespace demcal::server {
 namespace {
@@ -211,6 +213,28 @@ void add_flagged_notes(v1::DiagnosisReport& report, const std::vector<JobRow>& j
 }
 
 }  // namespace
+
+CampaignRow with_diagnosis_rounds(Store& store, const CampaignRow& row, int rounds) {
+  v1::CampaignSpec spec = spec_from_json(row.spec_json);
+  v1::DiagnoseOptions options = spec.diagnose();
+  options.set_rounds(rounds);
+  int checked = 0;
+  try {
+    checked = diagnose_options(options, "diagnose").rounds;
+  } catch (const InputError& e) {
+    throw InputError("rounds", e.message());  // the request's field, not the spec's
+  }
+  CampaignPlan plan = stored_plan(row);
+  if (plan.diagnosis.rounds == checked) return row;
+  plan.diagnosis.rounds = checked;
+  *spec.mutable_diagnose() = options;
+  CampaignRow changed = row;
+  changed.spec_json = to_json(spec);
+  changed.design_json = plan_to_json(plan);
+  store.set_campaign_plan(row.id, changed.spec_json, changed.design_json);
+  spdlog::info("campaign {}: diagnosis rounds set to {}", row.id, checked);
+  return changed;
+}
 
 v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::uint64_t seed,
                                     bool read_only) {

@@ -18,6 +18,12 @@ namespace demcal::server {
 diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRow>& jobs,
                                std::uint64_t seed);
 
+/// Sets the number of verification rounds of campaign `row`'s diagnosis (`rounds`, in the range
+/// of the spec's diagnose.rounds) in its stored spec and plan, when it differs from theirs, and
+/// returns the row as stored then. Its jobs and results are kept: the diagnosis goes on from them,
+/// queuing the rounds it adds or none more. InputError at "rounds" for a value out of range.
+CampaignRow with_diagnosis_rounds(Store& store, const CampaignRow& row, int rounds);
+
 /// Advances the diagnosis of a campaign: queues the runs it needs that are not stored yet
 /// (unless `read_only`) and fills the reply. Throws InputError when the campaign cannot be
 /// diagnosed.

@@ -409,12 +409,19 @@ grpc::Status CampaignServiceImpl::Diagnose(grpc::ServerContext* ctx, const v1::D
   const auto row = store_.campaign(req->id());
   if (!row) return not_found(req->id());
   if (auto s = refuse_if_cancelled(*row, "diagnose"); !s.ok()) return s;
+  if (req->rounds() != 0 && req->read_only())
+    return {grpc::StatusCode::INVALID_ARGUMENT,
+            "rounds: not with read_only (a look changes nothing)"};
   try {
     // One diagnosis step at a time: two concurrent calls must not queue the same runs twice.
     std::lock_guard lock(diagnose_mutex_);
-    *reply = diagnose_campaign(store_, *row, req->seed(), req->read_only());
+    const CampaignRow stored =
+        req->rounds() != 0 ? with_diagnosis_rounds(store_, *row, req->rounds()) : *row;
+    *reply = diagnose_campaign(store_, stored, req->seed(), req->read_only());
     return grpc::Status::OK;
   } catch (const InputError& e) {
+    // A bad request field is invalid; a campaign that cannot be diagnosed is a precondition.
+    if (e.where() == "rounds") return invalid(e);
     return {grpc::StatusCode::FAILED_PRECONDITION, e.what()};
   } catch (const std::exception& e) {
     return internal(e);

@@ -440,6 +440,13 @@ std::optional<CampaignRow> Store::campaign(std::int64_t id) {
   return CampaignRow{s.i64(0), s.text(1), s.text(2), s.text(3), s.text(4), s.f64(5), s.f64(6)};
 }
 
+void Store::set_campaign_plan(std::int64_t id, const std::string& spec_json,
+                              const std::string& design_json) {
+  Guard lock(*this);
+  Statement s(*this, "UPDATE campaigns SET spec_json = ?, design_json = ? WHERE id = ?");
+  s.bind(1, spec_json).bind(2, design_json).bind(3, id).step();
+}
+
 std::vector<CampaignRow> Store::campaigns() {
   Guard lock(*this);
   Statement s(*this, (std::string(kCampaignColumns) + " ORDER BY id").c_str());

@@ -207,6 +207,10 @@ class Store {
   /// Jobs queued or leased, of the campaigns of `owner` (all campaigns without one).
   std::int64_t unfinished_jobs(const std::optional<std::string>& owner = std::nullopt);
   std::optional<CampaignRow> campaign(std::int64_t id);
+  /// Replaces campaign `id`'s stored spec and plan (an option changed on a running or finished
+  /// campaign); its jobs and results are kept.
+  void set_campaign_plan(std::int64_t id, const std::string& spec_json,
+                         const std::string& design_json);
   std::vector<CampaignRow> campaigns();
   Counts counts(std::int64_t campaign_id, const std::string& kind = "");
   std::vector<JobRow> jobs(std::int64_t campaign_id);

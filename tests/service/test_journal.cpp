@@ -387,6 +387,48 @@ TEST_F(Journal, ADiagnosisLookedAtWithoutWaitingSimulatesNothingAlsoWhileItsStor
   }
 }
 
+// A diagnosis run to its end, its spec then given more verification rounds: the same command in
+// the same work directory goes on from the runs the campaign has (every job kept with its result,
+// only the added round simulated). A spec changed in anything else is still refused there.
+TEST_F(Journal, ASpecGivenMoreDiagnosisRoundsGoesOnFromTheRunsItsCampaignHas) {
+  const auto rounds_done = [&](const std::string& work) {
+    return output(work).at("candidates").at(0).at("rounds").get<int>();
+  };
+  // A solid fraction no poured bed of the box reaches: no round meets it within 1 %.
+  const auto diagnosis_spec = [&](const std::string& options) {
+    const std::string spec = path("rounds.yaml");
+    std::ofstream(spec) << packing_spec("rounds", 0.75) << R"(measurements:
+  - {metric: solid_fraction, value: 0.7, uncertainty: 0.02}
+diagnose: {candidates: [curvature])"
+                        << options << "}\n";
+    return spec;
+  };
+  std::string spec = diagnosis_spec(", rounds: 1");
+  ASSERT_EQ(diagnose(spec, "r", ""), 0) << file_lines(path("r.err")).back();
+  ASSERT_EQ(rounds_done("r"), 1);
+  ASSERT_GT(output("r").at("candidates").at(0).at("verified_rms").get<double>(), 0.01);
+  const auto first = stored_jobs("r");
+
+  spec = diagnosis_spec(", rounds: 2");
+  fs::remove(path("r.json"));  // a process's output is appended to its file
+  ASSERT_EQ(diagnose(spec, "r", ""), 0) << file_lines(path("r.err")).back();
+  EXPECT_EQ(rounds_done("r"), 2);
+  const auto second = stored_jobs("r");
+  ASSERT_EQ(second.size(), first.size() + 1);  // the candidate's second verification
+  for (std::size_t k = 0; k < first.size(); ++k) {
+    EXPECT_EQ(second[k].run_key, first[k].run_key);
+    EXPECT_EQ(second[k].metrics, first[k].metrics);
+    EXPECT_EQ(second[k].attempt, first[k].attempt);
+  }
+
+  spec = diagnosis_spec(", rounds: 2, margin: 0.5");
+  EXPECT_NE(diagnose(spec, "r", ""), 0);
+  EXPECT_NE(file_lines(path("r.err")).back().find("was submitted with another spec"),
+            std::string::npos)
+      << file_lines(path("r.err")).back();
+  EXPECT_EQ(stored_jobs("r").size(), second.size());
+}
+
 TEST_F(Journal, AJournalOfAnotherSpecGivesExactlyTheRunsWhoseKeysMatch) {
   ASSERT_NO_FATAL_FAILURE(run_a());
   const std::string journal = path("a.jsonl");

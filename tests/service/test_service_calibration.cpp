@@ -684,6 +684,104 @@ diagnose: {candidates: [coarse_graining], rounds: 1}
   for (const auto& note : notes) EXPECT_NE(table.find(note), std::string::npos) << table;
 }
 
+// A finished diagnosis given more verification rounds goes on from the runs it has: Diagnose
+// with `rounds` stores the new number in the campaign's spec and plan, keeps every job, and queues
+// only the rounds it adds; fewer rounds queue nothing. A number out of range, or one given with
+// a read-only look, is refused. Results through the real worker protocol, no physics: the
+// candidate's box misses the measured solid fraction, so no round meets it.
+TEST_F(Service, ADiagnosisGivenMoreRoundsGoesOnFromTheRunsItHas) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit("name: more_rounds" + coarse_grained_packing() + R"(
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
+  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
+design: {type: full_factorial}
+measurements:
+  - {metric: solid_fraction, value: 0.6}
+diagnose: {candidates: [coarse_graining], rounds: 1}
+)",
+                     &id)
+                  .ok());
+  const auto fill = [](const v1::JobSpec& job, v1::CompleteRequest& c) {
+    const double scale = job.parameters().count("sizes.scale") ? 0.01 : 0.0;
+    (*c.mutable_metrics())["solid_fraction"] =
+        0.5 + 0.1 * job.parameters().at("particle_law.tangential.mu_s") + scale;
+    (*c.mutable_metrics())["coordination_number"] = 4.0;
+  };
+  v1::DiagnoseRequest diagnose;
+  diagnose.set_id(id);
+  // Drives the diagnosis to its end: each call's queued runs completed. The last reply.
+  const auto drive = [&](v1::DiagnoseRequest req) {
+    v1::DiagnoseReply reply;
+    for (int call = 0; call < 10; ++call) {
+      const auto st = campaigns_->Diagnose(ctx().get(), req, &reply);
+      EXPECT_TRUE(st.ok()) << st.error_message();
+      req.set_rounds(0);  // as stored from the first call on
+      if (reply.state() == "done" || reply.jobs_queued() == 0) break;
+      for (int k = 0; k < reply.jobs_queued(); ++k) complete_fake_job(fill);
+    }
+    return reply;
+  };
+  const auto candidate_rounds = [](const v1::DiagnoseReply& r) {
+    return r.report().candidates_size() == 1 ? r.report().candidates(0).rounds() : -1;
+  };
+  const auto stored_rounds = [&] {
+    v1::GetRequest get;
+    get.set_id(id);
+    v1::Campaign c;
+    EXPECT_TRUE(campaigns_->Get(ctx().get(), get, &c).ok());
+    return c.spec().diagnose().rounds();
+  };
+
+  for (int k = 0; k < 4; ++k) ASSERT_NO_FATAL_FAILURE(complete_fake_job(fill));
+  const auto first = drive(diagnose);
+  ASSERT_EQ(first.state(), "done") << first.conclusion();
+  ASSERT_EQ(candidate_rounds(first), 1);
+  ASSERT_GT(first.report().candidates(0).verified_rms(), 0.01);  // a second round is not moot
+  const auto before = results(id);
+
+  v1::DiagnoseRequest more = diagnose;
+  more.set_rounds(2);
+  v1::DiagnoseReply queued;
+  ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), more, &queued).ok());
+  EXPECT_EQ(queued.jobs_queued(), 1);  // the candidate's second verification
+  EXPECT_EQ(stored_rounds(), 2);
+  const auto after_queue = results(id);
+  ASSERT_EQ(after_queue.jobs_size(), before.jobs_size() + 1);
+  for (int k = 0; k < before.jobs_size(); ++k) {
+    EXPECT_EQ(after_queue.jobs(k).job_id(), before.jobs(k).job_id());
+    EXPECT_EQ(after_queue.jobs(k).state(), "done");
+    EXPECT_EQ(after_queue.jobs(k).run_key(), before.jobs(k).run_key());
+  }
+  EXPECT_EQ(after_queue.jobs(before.jobs_size()).kind(), "diagnose:coarse_graining/verify");
+  ASSERT_NO_FATAL_FAILURE(complete_fake_job(fill));
+  const auto second = drive(diagnose);
+  EXPECT_EQ(second.state(), "done") << second.conclusion();
+  EXPECT_EQ(candidate_rounds(second), 2);
+  EXPECT_EQ(results(id).jobs_size(), before.jobs_size() + 1);
+
+  // Fewer rounds than done: stored, nothing queued.
+  v1::DiagnoseRequest fewer = diagnose;
+  fewer.set_rounds(1);
+  v1::DiagnoseReply none;
+  ASSERT_TRUE(campaigns_->Diagnose(ctx().get(), fewer, &none).ok());
+  EXPECT_EQ(none.jobs_queued(), 0);
+  EXPECT_EQ(stored_rounds(), 1);
+
+  v1::DiagnoseRequest bad = diagnose;
+  bad.set_rounds(11);
+  const auto out_of_range = campaigns_->Diagnose(ctx().get(), bad, &none);
+  EXPECT_EQ(out_of_range.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(out_of_range.error_message().rfind("rounds:", 0), 0u) << out_of_range.error_message();
+  bad.set_rounds(3);
+  bad.set_read_only(true);
+  EXPECT_EQ(campaigns_->Diagnose(ctx().get(), bad, &none).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(stored_rounds(), 1);
+  EXPECT_EQ(results(id).jobs_size(), before.jobs_size() + 1);
+}
+
 TEST_F(Service, GaussianProcessCalibrationVerifiesWholeBatchesAndGivesIntervals) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
