@@ -410,6 +410,7 @@ std::vector<std::int64_t> queue_rounds(Store& store, const CampaignRow& row, con
                                   l.plan.pinned_seeds ? 0 : verify_seed(round, r)));
       jobs.insert(jobs.end(), replicate.begin(), replicate.end());
     }
+    take_held_points(store, jobs);
     const auto queued = store.add_calibration_round(
         row.id,
         {round, d.stage, proposal_to_json(d.batch[b], d.batch_predicted[b], l.responses, batch),
@@ -430,7 +431,8 @@ std::vector<std::int64_t> queue_stage(Store& store, const CampaignRow& row, cons
   const auto runs =
       design_runs(l.plan, box, job_kind::stage(stage), (stage - 1) * l.plan.design.runs(), false);
   admit_runs(l.plan, runs);
-  const auto jobs = jobs_of(l.plan, runs);
+  auto jobs = jobs_of(l.plan, runs);
+  take_held_points(store, jobs);
   spdlog::info("campaign {}: calibration stage {} queued ({} jobs)", row.id, stage, jobs.size());
   return store.add_calibration_stage(row.id, {stage, box_to_json(d.next_box), now_seconds()}, jobs);
 }

@@ -264,6 +264,7 @@ v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::u
   }
   if (read_only) fresh.clear();
   if (!fresh.empty()) {
+    take_held_points(store, fresh);
     store.add_jobs(row.id, fresh);
     spdlog::info("campaign {}: diagnosis queued {} jobs", row.id, fresh.size());
   }

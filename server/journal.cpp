@@ -51,6 +51,7 @@ v1::JournalRun journal_run(const JobRow& job, const std::string* series) {
 
 FinishedRun finished_run(const v1::JournalRun& run) {
   const std::map<std::string, double> metrics(run.metrics().begin(), run.metrics().end());
+  const std::map<std::string, double> parameters(run.parameters().begin(), run.parameters().end());
   return {run.run_key(),
           run.attempt(),
           metrics_to_json(metrics),
@@ -58,7 +59,10 @@ FinishedRun finished_run(const v1::JournalRun& run) {
           flags_to_json(run.flags()),
           to_json(run.cost()),
           series_to_json(run.series()),
-          run.source()};
+          run.source(),
+          run.test(),
+          std::to_string(run.seed()),
+          metrics_to_json(parameters)};
 }
 
 }  // namespace

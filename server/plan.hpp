@@ -126,6 +126,19 @@ std::vector<PlannedRun> runs_at(const CampaignPlan& plan,
 std::vector<NewJob> jobs_of(const CampaignPlan& plan, const std::vector<PlannedRun>& runs,
                             const std::map<std::string, std::string>& switches = {});
 
+/// How near (relative, in every parameter) a proposed point is to a journal run's to be that
+/// run: far above the last digits in which two builds' calibrations land apart, far below any
+/// change a simulation could show.
+inline constexpr double kHeldPointTolerance = 1e-6;
+
+/// Jobs at points an optimizer proposed (verification rounds, stage designs, a diagnosis's
+/// runs) whose run the store does not hold: a job whose point is within kHeldPointTolerance of
+/// a journal run of the same lab test and seed, and whose run key at that run's point is that
+/// run's (so the same material, settings and protocol), takes that point. A journal written by
+/// another build, whose calibration proposes its points a hair away, so serves a campaign planned
+/// again from it instead of every later point being simulated anew.
+void take_held_points(Store& store, std::vector<NewJob>& jobs);
+
 /// Every rule a worker checks before it simulates, on runs planned after Submit (plan_campaign
 /// admits its own); InputError naming the instance's settings and the row.
 void admit_runs(const CampaignPlan& plan, const std::vector<PlannedRun>& runs);

@@ -1,5 +1,6 @@
 // The runs of a plan and the jobs that simulate them (plan.hpp).
 #include <algorithm>
+#include <cmath>
 #include <optional>
 
 #include "core/model/campaign_model.hpp"
@@ -7,6 +8,7 @@
 #include "server/convert.hpp"
 #include "server/plan.hpp"
 #include "server/run_key.hpp"
+#include "server/stored_columns.hpp"
 
 namespace demcal::server {
 namespace {
@@ -127,6 +129,43 @@ std::vector<NewJob> jobs_of(const CampaignPlan& plan, const std::vector<PlannedR
                     run_key(job), instance.waits_for});
   }
   return jobs;
+}
+
+namespace {
+
+/// Whether two points have the same parameter paths and every value within kHeldPointTolerance.
+bool near_point(const google::protobuf::Map<std::string, double>& proposed,
+                const std::map<std::string, double>& held) {
+  if (proposed.size() != held.size()) return false;
+  for (const auto& [path, value] : proposed) {
+    const auto other = held.find(path);
+    if (other == held.end()) return false;
+    const double scale = std::max(std::abs(value), std::abs(other->second));
+    if (!(std::abs(value - other->second) <= kHeldPointTolerance * scale)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void take_held_points(Store& store, std::vector<NewJob>& jobs) {
+  for (auto& job : jobs) {
+    if (job.run_key.key.empty() || store.holds_run(job.run_key.key)) continue;
+    const v1::JobSpec proposed = job_from_payload(job.payload);
+    for (const auto& held :
+         store.journal_runs_at(proposed.test(), std::to_string(proposed.seed()))) {
+      const auto point = metrics_from_json(held.parameters_json);
+      if (!near_point(proposed.parameters(), point)) continue;
+      v1::JobSpec at_held = proposed;
+      at_held.mutable_parameters()->clear();
+      at_held.mutable_parameters()->insert(point.begin(), point.end());
+      RunKey key = run_key(at_held);
+      if (key.key != held.run_key) continue;
+      job.payload = to_json(at_held);
+      job.run_key = std::move(key);
+      break;
+    }
+  }
 }
 
 void admit_runs(const CampaignPlan& plan, const std::vector<PlannedRun>& runs) {

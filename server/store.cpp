@@ -729,17 +729,48 @@ int Store::import_runs(const std::vector<FinishedRun>& runs) {
   int added = 0;
   Statement s(*this,
               "INSERT OR IGNORE INTO journal_runs (run_key, attempt, metrics_json, wall_seconds, "
-              "flags_json, cost_json, series_json, source, imported) "
-              "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+              "flags_json, cost_json, series_json, source, imported, test, seed, "
+              "parameters_json) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  // A run imported before its point was kept (schema 14) gets it now; nothing else changes.
+  Statement point(*this,
+                  "UPDATE journal_runs SET test = ?, seed = ?, parameters_json = ? "
+                  "WHERE run_key = ? AND test = ''");
   for (const auto& run : runs) {
     s.bind(1, run.run_key).bind(2, run.attempt).bind(3, run.metrics_json);
     s.bind(4, run.wall_seconds).bind(5, run.flags_json).bind(6, run.cost_json);
-    s.bind(7, run.series_json).bind(8, run.source).bind(9, imported).step();
-    added += sqlite3_changes(db_);
+    s.bind(7, run.series_json).bind(8, run.source).bind(9, imported).bind(10, run.test);
+    s.bind(11, run.seed).bind(12, run.parameters_json).step();
+    const int changed = sqlite3_changes(db_);
+    added += changed;
     s.reset();
+    if (changed == 0) {
+      point.bind(1, run.test).bind(2, run.seed).bind(3, run.parameters_json).bind(4, run.run_key);
+      point.step();
+      point.reset();
+    }
   }
   tx.commit();
   return added;
+}
+
+bool Store::holds_run(const std::string& run_key) {
+  Guard lock(*this);
+  Statement s(*this,
+              "SELECT 1 FROM jobs WHERE run_key = ? AND state = 'done' UNION ALL "
+              "SELECT 1 FROM journal_runs WHERE run_key = ? LIMIT 1");
+  s.bind(1, run_key).bind(2, run_key);
+  return s.step();
+}
+
+std::vector<HeldRun> Store::journal_runs_at(const std::string& test, const std::string& seed) {
+  Guard lock(*this);
+  Statement s(*this,
+              "SELECT run_key, parameters_json FROM journal_runs WHERE test = ? AND seed = ? "
+              "ORDER BY rowid");
+  s.bind(1, test).bind(2, seed);
+  std::vector<HeldRun> out;
+  while (s.step()) out.push_back({s.text(0), s.text(1)});
+  return out;
 }
 
 void Store::refresh_run_keys(const std::function<RunKey(const std::string& payload)>& key_of) {

@@ -98,6 +98,14 @@ struct FinishedRun {
   std::string flags_json = "{}", cost_json = "{}";
   std::string series_json;  ///< empty: none
   std::string source;       ///< where it was read: FILE:LINE
+  /// What it stands for besides its key: its lab test, seed (decimal) and parameters (JSON).
+  std::string test, seed, parameters_json = "{}";
+};
+
+/// A journal run the store holds: its run key and the parameters of the point it was simulated
+/// at (a JSON object of path -> value).
+struct HeldRun {
+  std::string run_key, parameters_json;
 };
 
 /// One round of the sequential calibration: its proposal as JSON (server/stored_columns.hpp).
@@ -238,8 +246,13 @@ class Store {
   /// run key another job is running waits for that run's result.
   std::optional<JobRow> lease(const std::string& worker, double now);
   /// Keeps runs read from a journal for the jobs with their run keys; a key held already keeps
-  /// the run it has. Returns how many were new.
+  /// the run it has (its test, seed and parameters filled in when it had none). Returns how many
+  /// were new.
   int import_runs(const std::vector<FinishedRun>& runs);
+  /// Whether a finished run of this key is held: a done job's, or a journal run.
+  bool holds_run(const std::string& run_key);
+  /// The journal runs held of lab test `test` at seed `seed` (decimal).
+  std::vector<HeldRun> journal_runs_at(const std::string& test, const std::string& seed);
   /// Sets the run key of every job that has none yet (jobs of a file from before run keys) and of
   /// every job not done to `key_of(payload)`: a job planned under another version of its test's
   /// protocol is simulated under this one and must be known by this one's key. A done job keeps

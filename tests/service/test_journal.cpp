@@ -22,7 +22,9 @@
 #include <vector>
 
 #include "core/lab/protocol.hpp"
+#include "server/run_key.hpp"
 #include "server/store_lock.hpp"
+#include "server/stored_columns.hpp"
 #include "tests/service/service_fixture.hpp"
 
 namespace demcal::test {
@@ -427,6 +429,119 @@ diagnose: {candidates: [curvature])"
             std::string::npos)
       << file_lines(path("r.err")).back();
   EXPECT_EQ(stored_jobs("r").size(), second.size());
+}
+
+// A journal written by a build whose calibration proposed the diagnosis's baseline a hair away
+// (every parameter 1e-9 off, relative) serves the campaign planned again: the baseline takes the
+// journal run's point and its result. A run 1e-4 off is another point, and is simulated. Results
+// through the real worker protocol, no physics.
+TEST_F(Journal, AProposalAHairFromAJournalRunTakesThatRun) {
+  start_server(/*lease=*/30, /*heartbeat=*/5);
+  const std::string spec = tiny_spec(
+      30, 0, "",
+      "calibration: {rounds: 1, stages: 1}\ndiagnose: {candidates: [curvature], rounds: 1}\n");
+  const auto fill = [](const v1::JobSpec& job, v1::CompleteRequest& c) {
+    (*c.mutable_metrics())["solid_fraction"] =
+        0.5 + 0.25 * job.parameters().at("particle_law.tangential.mu_s");
+    (*c.mutable_metrics())["coordination_number"] = 4.0;
+  };
+  const auto diagnose = [&](std::int64_t id) {
+    v1::DiagnoseRequest req;
+    req.set_id(id);
+    v1::DiagnoseReply reply;
+    const auto st = campaigns_->Diagnose(ctx().get(), req, &reply);
+    EXPECT_TRUE(st.ok()) << st.error_message();
+  };
+  const auto cancel = [&](std::int64_t id) {
+    v1::CancelRequest req;
+    req.set_id(id);
+    v1::Campaign c;
+    ASSERT_TRUE(campaigns_->Cancel(ctx().get(), req, &c).ok());
+  };
+  // The baseline job of a campaign: its payload and run key, and the journal line its result
+  // was taken from ('' when none), read from the store's file.
+  struct Baseline {
+    v1::JobSpec job;
+    std::string key, reused_journal, state;
+  };
+  const auto baseline = [&](std::int64_t id) {
+    Baseline b;
+    each_row(path("c.db"),
+             ("SELECT j.payload, j.run_key, COALESCE(r.reused_journal, ''), j.state FROM jobs j "
+              "LEFT JOIN results r ON r.job_id = j.id WHERE j.kind = 'diagnose:baseline' AND "
+              "j.campaign_id = " +
+              std::to_string(id))
+                 .c_str(),
+             [&](sqlite3_stmt* st) {
+               b.job = server::job_from_payload(
+                   reinterpret_cast<const char*>(sqlite3_column_text(st, 0)));
+               b.key = reinterpret_cast<const char*>(sqlite3_column_text(st, 1));
+               b.reused_journal = reinterpret_cast<const char*>(sqlite3_column_text(st, 2));
+               b.state = reinterpret_cast<const char*>(sqlite3_column_text(st, 3));
+             });
+    return b;
+  };
+  // A journal line of the baseline's run at its point with every parameter (1 + shift) times.
+  const auto journal_run = [](const v1::JobSpec& job, double shift, const std::string& source) {
+    v1::JobSpec shifted = job;
+    for (auto& [path, value] : *shifted.mutable_parameters()) value *= 1.0 + shift;
+    v1::ImportRunsRequest req;
+    auto* run = req.add_runs();
+    run->set_run_key(server::run_key(shifted).key);
+    run->set_protocol(lab::protocol_version(job.test()));
+    run->set_test(job.test());
+    run->set_instance(job.test());
+    *run->mutable_parameters() = shifted.parameters();
+    run->set_seed(job.seed());
+    (*run->mutable_metrics())["solid_fraction"] = 0.6;
+    (*run->mutable_metrics())["coordination_number"] = 4.0;
+    run->set_source(source);
+    return std::pair{req, shifted};
+  };
+  // A campaign of the spec whose design takes the first's results (at the first lease), then
+  // its diagnosis queued.
+  const auto planned_again = [&] {
+    std::int64_t id = 0;
+    EXPECT_TRUE(submit(spec, &id).ok());
+    v1::LeaseReply none;
+    lease_as("fake", none);
+    EXPECT_FALSE(none.has_job());
+    diagnose(id);
+    return id;
+  };
+
+  std::int64_t first = 0;
+  ASSERT_TRUE(submit(spec, &first).ok());
+  for (int k = 0; k < 4; ++k) ASSERT_NO_FATAL_FAILURE(complete_fake_job(fill));
+  diagnose(first);
+  const Baseline planned = baseline(first);
+  ASSERT_FALSE(planned.key.empty());
+  ASSERT_EQ(planned.state, "queued");
+  ASSERT_NO_FATAL_FAILURE(cancel(first));
+
+  v1::ImportRunsReply imported;
+  const auto far = journal_run(planned.job, 1e-4, "far.jsonl:2");
+  ASSERT_TRUE(campaigns_->ImportRuns(ctx().get(), far.first, &imported).ok());
+  ASSERT_EQ(imported.kept(), 1);
+  const std::int64_t second = planned_again();
+  const Baseline apart = baseline(second);
+  EXPECT_EQ(apart.key, planned.key);
+  EXPECT_EQ(apart.state, "queued");
+  ASSERT_NO_FATAL_FAILURE(cancel(second));
+
+  const auto near = journal_run(planned.job, 1e-9, "near.jsonl:2");
+  ASSERT_TRUE(campaigns_->ImportRuns(ctx().get(), near.first, &imported).ok());
+  ASSERT_EQ(imported.kept(), 1);
+  const std::int64_t third = planned_again();
+  v1::LeaseReply next;  // the baseline takes the journal run; the candidate's runs are leased
+  ASSERT_NO_FATAL_FAILURE(lease_as("fake", next));
+  const Baseline taken = baseline(third);
+  EXPECT_EQ(taken.key, near.first.runs(0).run_key());
+  EXPECT_NE(taken.key, planned.key);
+  EXPECT_EQ(taken.state, "done");
+  EXPECT_EQ(taken.reused_journal, "near.jsonl:2");
+  for (const auto& [path, value] : near.second.parameters())
+    EXPECT_EQ(taken.job.parameters().at(path), value) << path;
 }
 
 TEST_F(Journal, AJournalOfAnotherSpecGivesExactlyTheRunsWhoseKeysMatch) {

@@ -535,13 +535,25 @@ TEST(Store, AStoreOfSchemaElevenMarksTheJobsWhoseWaitHasEndedAndLeasesThemFirst)
 TEST(Store, RunsOfAJournalAreTakenByTheJobsOfTheirKeysAndNeverReplaceARunHeld) {
   Store s(":memory:");
   const std::string series = R"({"curve":{"columns":["t"],"rows":[[1.0]]}})";
-  const FinishedRun run{"k1",         2, R"({"x":7})", 3.0, "{}", R"({"steps":"5"})", series,
-                        "old.jsonl:2"};
+  // Imported as a store before schema 14 kept it: without its point.
+  const FinishedRun run{"k1",          2,  R"({"x":7})", 3.0, "{}", R"({"steps":"5"})", series,
+                        "old.jsonl:2", "", "",           "{}"};
   EXPECT_EQ(s.import_runs({run}), 1);
+  EXPECT_TRUE(s.holds_run("k1"));
+  EXPECT_FALSE(s.holds_run("k2"));
+  EXPECT_TRUE(s.journal_runs_at("packing", "1").empty());
   FinishedRun other = run;
   other.metrics_json = R"({"x":8})";
   other.source = "new.jsonl:2";
-  EXPECT_EQ(s.import_runs({other}), 0);  // the key is held: the run held stays
+  other.test = "packing";
+  other.seed = "1";
+  other.parameters_json = R"({"particle_law.tangential.mu_s":0.3})";
+  EXPECT_EQ(s.import_runs({other}), 0);  // the key is held: the run held stays, its point added
+  const auto at = s.journal_runs_at("packing", "1");
+  ASSERT_EQ(at.size(), 1u);
+  EXPECT_EQ(at[0].run_key, "k1");
+  EXPECT_EQ(at[0].parameters_json, other.parameters_json);
+  EXPECT_TRUE(s.journal_runs_at("packing", "2").empty());
   const auto id = s.create_campaign("c", "{}", "{}", {keyed_job(1, "k1")}, 0.0);
   EXPECT_FALSE(s.lease("w", 1.0));
   const JobRow job = s.jobs(id)[0];
@@ -752,7 +764,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 13);
+    EXPECT_EQ(Store::latest_schema_version(), 14);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
