@@ -89,6 +89,20 @@ tests:
     settings: {particles: 30})";
 }
 
+/// That packing in a 2^2 of mu_s and restitution, its solid fraction measured, diagnosed with the
+/// coarse_graining candidate in one verification round.
+std::string coarse_graining_diagnosis(const std::string& name) {
+  return "name: " + name + coarse_grained_packing() + R"(
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
+  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
+design: {type: full_factorial}
+measurements:
+  - {metric: solid_fraction, value: 0.6}
+diagnose: {candidates: [coarse_graining], rounds: 1}
+)";
+}
+
 // The coordinator's coarse_graining runs (docs/diagnosis.md): a cohesive material of radius
 // 0.5 mm stating the powder's median radius 0.25 mm. Its four design runs finished (fake
 // metrics), one Diagnose call queues the candidate's runs: the factorial rows at half the
@@ -616,17 +630,7 @@ TEST_F(Service, TheDiagnosisNamesTheFlaggedValuesItUses) {
   // and verifies with them, and its report names each under the metric, as does the table.
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
-  ASSERT_TRUE(submit("name: flagged" + coarse_grained_packing() + R"(
-factors:
-  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
-  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
-design: {type: full_factorial}
-measurements:
-  - {metric: solid_fraction, value: 0.6}
-diagnose: {candidates: [coarse_graining], rounds: 1}
-)",
-                     &id)
-                  .ok());
+  ASSERT_TRUE(submit(coarse_graining_diagnosis("flagged"), &id).ok());
   const std::string settle = "phase 'settle' did not reach its rest within 2 s";
   std::set<std::int64_t> flagged_jobs;
   const auto fill = [&](bool flag) {
@@ -692,17 +696,7 @@ diagnose: {candidates: [coarse_graining], rounds: 1}
 TEST_F(Service, ADiagnosisGivenMoreRoundsGoesOnFromTheRunsItHas) {
   start_server(/*lease=*/30, /*heartbeat=*/5);
   std::int64_t id = 0;
-  ASSERT_TRUE(submit("name: more_rounds" + coarse_grained_packing() + R"(
-factors:
-  - {path: particle_law.tangential.mu_s, low: 0.1, high: 0.5}
-  - {path: particle_law.normal.restitution, low: 0.2, high: 0.6}
-design: {type: full_factorial}
-measurements:
-  - {metric: solid_fraction, value: 0.6}
-diagnose: {candidates: [coarse_graining], rounds: 1}
-)",
-                     &id)
-                  .ok());
+  ASSERT_TRUE(submit(coarse_graining_diagnosis("more_rounds"), &id).ok());
   const auto fill = [](const v1::JobSpec& job, v1::CompleteRequest& c) {
     const double scale = job.parameters().count("sizes.scale") ? 0.01 : 0.0;
     (*c.mutable_metrics())["solid_fraction"] =
