@@ -61,9 +61,13 @@ function(demcal_test_executable target)
   target_compile_options(${target} PRIVATE $<$<CONFIG:Release,RelWithDebInfo>:-O1>)
 endfunction()
 
-# demcal_add_test(NAME contact_luding SOURCES test.cpp DEPS demcal::core_contact [LABELS peer] [TIMEOUT 60])
+# demcal_add_test(NAME contact_luding SOURCES test.cpp DEPS demcal::core_contact [LABELS peer] [TIMEOUT 60]
+#                 [COST 90])
+# COST: the seconds the test took in CI (2 cores). `ctest -j` starts tests in descending cost; a
+# clean checkout has no timing history, so without it the long tests defined last would run
+# alone at the end with a core idle. Given to the tests longer than about a minute.
 function(demcal_add_test)
-  cmake_parse_arguments(ARG "" "NAME;TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;TIMEOUT;COST" "SOURCES;DEPS;LABELS" ${ARGN})
   set(target test_${ARG_NAME})
   add_executable(${target} ${ARG_SOURCES})
   target_link_libraries(${target} PRIVATE ${ARG_DEPS})
@@ -75,6 +79,9 @@ function(demcal_add_test)
   set_tests_properties(${ARG_NAME} PROPERTIES TIMEOUT ${ARG_TIMEOUT})
   if(ARG_LABELS)
     set_tests_properties(${ARG_NAME} PROPERTIES LABELS "${ARG_LABELS}")
+  endif()
+  if(ARG_COST)
+    set_tests_properties(${ARG_NAME} PROPERTIES COST ${ARG_COST})
   endif()
 endfunction()
 
