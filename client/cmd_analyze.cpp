@@ -51,17 +51,21 @@ double parse_number(const std::string& s, const std::string& where) {
   throw InputError(where, "'" + s + "' is not a number");
 }
 
-bool near(double a, double b) {
-  return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(b));
-}
-
-/// Natural range of a factor column from its levels, or nothing when it is not a factor.
+/// Natural range of a factor column from its levels, or nothing when it is not a factor. Two
+/// values are one level when they differ by at most 1e-6 of the column's largest magnitude, so
+/// that levels in SI units (a Hamaker constant of 1e-19 J, a radius of 5e-6 m) are told apart. A
+/// column is coded when its levels are -1 and +1, with or without 0.
 std::optional<doe::Factor> factor_from_levels(const std::string& name, std::vector<double> v) {
   std::sort(v.begin(), v.end());
+  double scale = 0.0;
+  for (const double x : v) scale = std::max(scale, std::abs(x));
+  const auto near = [tolerance = 1e-6 * scale](double a, double b) {
+    return std::abs(a - b) <= tolerance;
+  };
   v.erase(std::unique(v.begin(), v.end(), near), v.end());
-  const bool coded = std::all_of(
-      v.begin(), v.end(), [](double x) { return near(x, -1.0) || near(x, 0.0) || near(x, 1.0); });
-  if (coded && v.size() >= 2) return doe::Factor{name, -1.0, 1.0, doe::Scale::kLinear};
+  const bool coded = (v.size() == 2 || v.size() == 3) && near(v.front(), -1.0) &&
+                     near(v.back(), 1.0) && (v.size() == 2 || near(v[1], 0.0));
+  if (coded) return doe::Factor{name, -1.0, 1.0, doe::Scale::kLinear};
   double lo = 0.0, mid = 0.0, hi = 0.0;
   if (v.size() == 2) return doe::Factor{name, v[0], v[1], doe::Scale::kLinear};
   if (v.size() == 3)

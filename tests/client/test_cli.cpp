@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -123,6 +124,57 @@ TEST(Cli, AnalyzeFindsTheActiveEffectsOfACsv) {
   for (const auto& name : active) interaction_found |= name.find("AC") != std::string::npos;
   EXPECT_TRUE(interaction_found) << "the chain holding AC must be flagged";
   EXPECT_FALSE(active.count("D") || active.count("E")) << "inactive factors stay unflagged";
+  fs::remove_all(dir);
+}
+
+// The seed's screening 2^(12-7) as `demcal export --format csv` writes it: natural units (a
+// Hamaker constant in J, a radius in m, a factor whose levels are 0 and 1) and NA for the four
+// runs of the corner the build refuses (A_H high, r low, Y low). Every factor is read, none as
+// coded unless it is, and the main effects come back from the 28 runs.
+TEST(Cli, AnalyzeReadsFactorsInSiUnitsAndLeavesOutAFailedCorner) {
+  const fs::path dir = scratch_dir("analyze_si");
+  const Result d = demcal("design --factors 12 --runs 32 --format json");
+  ASSERT_EQ(d.exit_code, 0) << d.out;
+  const auto design = nlohmann::json::parse(d.out);
+  // Natural ranges: A_H (J), r (m), Y (Pa), mu_r 0..1, the rest as the seed's Table 17.
+  const std::vector<std::pair<double, double>> range{
+      {1e-18, 1.5e-17}, {5e-6, 5e-5}, {0.1, 0.3}, {0.5, 1.0}, {1e7, 5e7},  {2, 20},
+      {0.5, 5},         {0.2, 1.0},   {0.5, 0.8}, {0.2, 1.0}, {0.02, 0.2}, {0.0, 1.0}};
+  std::ofstream csv(dir / "runs.csv");
+  for (int k = 0; k < 12; ++k) csv << "f" << k << ",";
+  csv << "y\n";
+  demcal::Rng rng(5);
+  int refused = 0;
+  for (const auto& run : design["runs"]) {
+    std::array<double, 12> x{};
+    for (int k = 0; k < 12; ++k) {
+      x[std::size_t(k)] = run["coded"][k];
+      const auto [lo, hi] = range[std::size_t(k)];
+      csv << std::setprecision(17) << lo + (hi - lo) * (x[std::size_t(k)] + 1) / 2 << ",";
+    }
+    const bool corner = x[0] > 0 && x[1] < 0 && x[4] < 0;
+    refused += corner;
+    const double y = 10 + 3 * x[0] + 2 * x[1] - x[4] + 0.8 * x[11] + 0.05 * rng.normal();
+    csv << (corner ? std::string("NA") : std::to_string(y)) << "\n";
+  }
+  csv.close();
+  ASSERT_EQ(refused, 4);
+  const Result r = demcal("analyze --design " + (dir / "runs.csv").string() +
+                          " --response y --model main --format json");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["factor_letters"].size(), 12u) << r.out;
+  EXPECT_EQ(j["factor_letters"][0], "A=f0 [1e-18, 1.5e-17]") << r.out;
+  EXPECT_EQ(j["factor_letters"][11], "M=f11 [0, 1]") << r.out;
+  const auto& y = j["metrics"][0];
+  EXPECT_EQ(y["runs_used"], 28);
+  std::map<std::string, double> effect;
+  for (const auto& e : y["effects"]) effect[e["chain"]] = e["effect"];
+  EXPECT_NEAR(effect.at("A"), 6.0, 0.2) << r.out;
+  EXPECT_NEAR(effect.at("B"), 4.0, 0.2) << r.out;
+  EXPECT_NEAR(effect.at("E"), -2.0, 0.2) << r.out;
+  EXPECT_NEAR(effect.at("M"), 1.6, 0.2) << r.out;
+  EXPECT_NEAR(effect.at("C"), 0.0, 0.2) << r.out;
   fs::remove_all(dir);
 }
 
