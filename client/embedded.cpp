@@ -88,6 +88,24 @@ class StoreCopy {
   std::filesystem::path dir_;
 };
 
+/// Why a look (a command that runs no job) at the store file `store` reads a copy taken now
+/// instead of the file, or nothing when it reads the file. A store a running coordinator holds
+/// (e.g. a diagnosis going on in another process) is not touched, nor is one of an older schema
+/// version: opened as a store, it would be migrated, and the build that wrote it (a campaign's
+/// own, going on from it) would refuse it after.
+std::optional<std::string> why_look_at_a_copy(const std::filesystem::path& store) {
+  if (const auto pid = server::StoreLock::holder(store.string()))
+    return "is held by a running coordinator" + (pid->empty() ? "" : " (pid " + *pid + ")") +
+           ": reporting from a copy of it taken now (its jobs in flight show as queued there)";
+  if (!std::filesystem::is_regular_file(store)) return std::nullopt;
+  const int found = server::Store::file_schema_version(store.string());
+  const int latest = server::Store::latest_schema_version();
+  if (found >= latest) return std::nullopt;
+  return "is at schema version " + std::to_string(found) + ", this build's is " +
+         std::to_string(latest) + ": reporting from a copy migrated from it, the store left at " +
+         std::to_string(found);
+}
+
 }  // namespace
 
 std::filesystem::path work_directory(const std::string& spec, const std::string& workdir) {
@@ -101,17 +119,13 @@ void with_campaign(const std::string& campaign, const std::string& workdir,
   if (std::filesystem::is_regular_file(campaign)) {
     const SpecFile file = read_campaign_spec(campaign);
     std::filesystem::path dir = work_directory(campaign, workdir);
-    // A look at a campaign whose store a running coordinator holds (e.g. a diagnosis going on in
-    // another process) reads a copy taken now; the running one and its journal are not touched.
     std::optional<StoreCopy> copy;
     const std::filesystem::path store = EmbeddedService::store_path(dir);
     if (!run_jobs)
-      if (const auto pid = server::StoreLock::holder(store.string())) {
+      if (const auto why = why_look_at_a_copy(store)) {
         copy.emplace(store);
-        std::cerr << "the store " << store.string() << " is held by a running coordinator"
-                  << (pid->empty() ? std::string() : " (pid " + *pid + ")")
-                  << ": reporting from a copy of it taken now (its jobs in flight show as "
-                     "queued there; what the copy queues is thrown away with it)\n";
+        std::cerr << "the store " << store.string() << " " << *why
+                  << " (what the copy queues is thrown away with it)\n";
         dir = copy->dir();
       }
     // Read before anything starts: a journal with a bad line refuses the command.

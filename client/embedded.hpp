@@ -98,10 +98,11 @@ using CampaignAction = std::function<void(v1::CampaignService::Stub& stub,
 /// Reaches the campaign a command names and runs `act` on it: a spec YAML file on the embedded
 /// default (submitted or resumed in `workdir`, watched until its jobs end; with `run_jobs` false
 /// no local worker starts and `act` sees the store as it stands, in a copy taken now when a
-/// running coordinator holds it), otherwise a campaign id on the coordinator of `channel`. With a
-/// `journal` (spec files only) its runs are taken first and every job finished meanwhile is
-/// appended to it, as `demcal run --journal` does (not in a copy: the journal is its holder's).
-/// CLI::ValidationError for text that is neither, or for a journal with a campaign id.
+/// running coordinator holds it or its schema is older than this build's), otherwise a campaign id
+/// on the coordinator of `channel`. With a `journal` (spec files only) its runs are taken first and
+/// every job finished meanwhile is appended to it, as `demcal run --journal` does (not in a copy:
+/// the journal is its holder's). CLI::ValidationError for text that is neither, or for a journal
+/// with a campaign id.
 void with_campaign(const std::string& campaign, const std::string& workdir,
                    const LocalWorkers& local, bool verbose, const rpc::ChannelOptions& channel,
                    const CampaignAction& act, const std::string& journal = {},

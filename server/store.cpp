@@ -282,6 +282,21 @@ void Store::copy_file(const std::string& from, const std::string& to) {
     throw std::runtime_error("cannot copy " + from + " to " + to + ": " + sqlite3_errstr(rc));
 }
 
+int Store::file_schema_version(const std::string& path) {
+  using Connection = std::unique_ptr<sqlite3, decltype(&sqlite3_close)>;
+  const Connection db(open_connection(path, SQLITE_OPEN_READONLY), &sqlite3_close);
+  sqlite3_stmt* st = nullptr;
+  int version = -1;
+  if (sqlite3_prepare_v2(db.get(), "PRAGMA user_version", -1, &st, nullptr) == SQLITE_OK &&
+      sqlite3_step(st) == SQLITE_ROW)
+    version = sqlite3_column_int(st, 0);
+  sqlite3_finalize(st);
+  if (version < 0)
+    throw std::runtime_error("cannot read the schema version of " + path + ": " +
+                             sqlite3_errmsg(db.get()));
+  return version;
+}
+
 Store::~Store() {
   close();
 }

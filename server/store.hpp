@@ -201,6 +201,10 @@ class Store {
   /// transaction by SQLite's online backup: a consistent state of the store, also while another
   /// store has `from` open and writes it. `from` is only read (its lock is not taken).
   static void copy_file(const std::string& from, const std::string& to);
+  /// The schema version (PRAGMA user_version) of the store file `path`, read without opening it
+  /// as a store: nothing is migrated and its lock is not taken. Throws naming the file when it
+  /// cannot be read.
+  static int file_schema_version(const std::string& path);
   int schema_version();
   std::string journal_mode();
   const StoreLimits& limits() const { return limits_; }

@@ -23,6 +23,7 @@
 
 #include "core/lab/protocol.hpp"
 #include "server/run_key.hpp"
+#include "server/store.hpp"
 #include "server/store_lock.hpp"
 #include "server/stored_columns.hpp"
 #include "tests/service/service_fixture.hpp"
@@ -385,6 +386,66 @@ TEST_F(Journal, ADiagnosisLookedAtWithoutWaitingSimulatesNothingAlsoWhileItsStor
   ASSERT_EQ(after.size(), jobs.size());
   for (std::size_t k = 0; k < jobs.size(); ++k) {
     EXPECT_EQ(after[k].run_key, jobs[k].run_key);
+    EXPECT_EQ(after[k].metrics, jobs[k].metrics);
+  }
+}
+
+// A store an older build wrote (here a finished campaign's, turned back to schema version 13 as
+// that build left it) is looked at from a migrated copy: `demcal status` reports its jobs and the
+// file is left as it was, byte for byte, so the build that wrote it goes on with it. A run of
+// this build then migrates it and simulates nothing again.
+TEST_F(Journal, ALookAtAStoreOfAnOlderSchemaReadsAMigratedCopyAndLeavesTheFileAsItWas) {
+  run_a();
+  const std::string db = path("a/campaign.db");
+  const auto schema_version = [&] {
+    int version = -1;
+    each_row(db, "PRAGMA user_version",
+             [&](sqlite3_stmt* st) { version = sqlite3_column_int(st, 0); });
+    return version;
+  };
+  {
+    sqlite3* file = nullptr;
+    ASSERT_EQ(sqlite3_open(db.c_str(), &file), SQLITE_OK);
+    for (const char* sql :
+         {"DROP INDEX journal_runs_point", "ALTER TABLE journal_runs DROP COLUMN test",
+          "ALTER TABLE journal_runs DROP COLUMN seed",
+          "ALTER TABLE journal_runs DROP COLUMN parameters_json", "PRAGMA user_version=13",
+          "PRAGMA wal_checkpoint(TRUNCATE)"})
+      ASSERT_EQ(sqlite3_exec(file, sql, nullptr, nullptr, nullptr), SQLITE_OK)
+          << sql << ": " << sqlite3_errmsg(file);
+    ASSERT_EQ(sqlite3_close(file), SQLITE_OK);
+  }
+  ASSERT_EQ(schema_version(), 13);
+  ASSERT_LT(13, server::Store::latest_schema_version());
+  const auto bytes = [&] {
+    std::ifstream in(db, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  const std::string before = bytes();
+  const auto jobs = stored_jobs("a");
+
+  Process status({DEMCAL_CLI_BIN, "status", path("a.yaml"), "--workdir", path("a"), "--jobs",
+                  "--format", "json"},
+                 path("status.json"), path("status.err"));
+  ASSERT_EQ(status.wait_exit(60), 0) << file_lines(path("status.err")).back();
+  const auto doc = nlohmann::json::parse(std::ifstream(path("status.json")));
+  ASSERT_EQ(doc.at("jobs").size(), jobs.size());
+  for (const auto& job : doc.at("jobs")) EXPECT_EQ(job.at("state"), "done") << job.dump();
+  const auto err = file_lines(path("status.err"));
+  EXPECT_TRUE(std::any_of(err.begin(), err.end(), [](const std::string& l) {
+    return l.find("is at schema version 13, this build's is " +
+                  std::to_string(server::Store::latest_schema_version())) != std::string::npos;
+  }));
+  EXPECT_EQ(schema_version(), 13);
+  EXPECT_TRUE(bytes() == before) << "a look wrote to the store";
+
+  std::string run_err;
+  ASSERT_EQ(run(path("a.yaml"), "a", "", run_err), 0) << run_err;
+  EXPECT_EQ(schema_version(), server::Store::latest_schema_version());
+  const auto after = stored_jobs("a");
+  ASSERT_EQ(after.size(), jobs.size());
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    EXPECT_EQ(after[k].attempt, jobs[k].attempt);
     EXPECT_EQ(after[k].metrics, jobs[k].metrics);
   }
 }
