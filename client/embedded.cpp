@@ -157,6 +157,21 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
   cmd.add_option("--threads", local.threads, "embedded: simulation threads of each local worker")
       ->check(CLI::Range(1, 256))
       ->capture_default_str();
+  cmd.add_option("--yield-after", local.yield_after,
+                 "embedded: a run that has held its worker this long (doubled per earlier yield) "
+                 "gives it back at its next checkpoint when a run that yielded no more often "
+                 "waits, so short runs finish first (s, 1-86400; 0: never)")
+      ->check(CLI::Validator(
+          [](const std::string& text) -> std::string {
+            double v = -1.0;
+            try {
+              v = std::stod(text);
+            } catch (const std::exception&) {
+            }
+            return v == 0.0 || (v >= 1.0 && v <= 86400.0) ? "" : "0 (never) or 1-86400 s";
+          },
+          "0 or 1-86400"))
+      ->capture_default_str();
 }
 
 EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local,
@@ -187,6 +202,7 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
   // the queue empty takes a job a tenth of a second after it appears, not a second (with jobs
   // of a fraction of a second, one worker would otherwise run them all while the other waits).
   co.idle_retry_seconds = 0.1;
+  co.yield_after_seconds = local.yield_after;
   coordinator_ = std::make_unique<server::Coordinator>(co);
   channel_.address = "127.0.0.1:" + std::to_string(coordinator_->port());
   channel_.token = co.token;

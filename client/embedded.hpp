@@ -26,9 +26,10 @@ namespace demcal::cli {
 struct LocalWorkers {
   int workers = 1;
   int threads = 2;
+  double yield_after = 0.0;  ///< the embedded coordinator's --yield-after (s; 0: never)
 };
 
-/// `--workers` and `--threads` of a command that runs the embedded default.
+/// `--workers`, `--threads` and `--yield-after` of a command that runs the embedded default.
 void add_local_worker_options(CLI::App& cmd, LocalWorkers& local);
 
 class EmbeddedService {

@@ -49,6 +49,9 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
     throw std::invalid_argument("--max-checkpoint-mb must lie in [1, 1024]");
   if (options_.max_jobs_per_client < 1 || options_.max_jobs < 1)
     throw std::invalid_argument("--max-jobs-per-client and --max-jobs must be >= 1");
+  if (!(options_.yield_after_seconds == 0.0 ||
+        (options_.yield_after_seconds >= 1.0 && options_.yield_after_seconds <= 86400.0)))
+    throw std::invalid_argument("--yield-after must be 0 (never) or lie in [1, 86400] s");
   ServiceConfig config{tokens,
                        options_.heartbeat_seconds,
                        std::min(options_.idle_retry_seconds, options_.heartbeat_seconds),
@@ -56,7 +59,8 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
                        options_.max_watch_interval,
                        options_.max_checkpoint_mb,
                        options_.max_jobs_per_client,
-                       options_.max_jobs};
+                       options_.max_jobs,
+                       options_.yield_after_seconds};
   campaigns_ = std::make_unique<CampaignServiceImpl>(*store_, config, stopping_);
   workers_ = std::make_unique<WorkerServiceImpl>(*store_, config);
 

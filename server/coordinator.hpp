@@ -47,6 +47,9 @@ struct CoordinatorOptions {
   /// Unfinished jobs of one token's campaigns, and of the store, at most.
   long max_jobs_per_client = kDefaultMaxJobsPerClient;
   long max_jobs = kDefaultMaxJobs;
+  /// A lease that has run this long (doubled per earlier yield of its job) gives its job back at
+  /// the run's next checkpoint when a job that yielded no more often waits (0: never).
+  double yield_after_seconds = 0.0;
   std::string tls_cert, tls_key;
   bool insecure = false;  ///< plain TCP (behind a trusted network or a TLS-terminating proxy)
 };

@@ -67,6 +67,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-jobs", o.max_jobs, "unfinished jobs of the whole store, at most")
       ->capture_default_str();
+  app.add_option("--yield-after", o.yield_after_seconds,
+                 "a lease that has run this long (doubled per earlier yield of its job) gives "
+                 "its job back at the next checkpoint when a job that yielded no more often "
+                 "waits (s, 1-86400; 0: never)")
+      ->capture_default_str();
   app.add_option("--tls-cert", o.tls_cert, "PEM certificate chain (enables TLS)");
   app.add_option("--tls-key", o.tls_key, "PEM private key");
   app.add_flag("--insecure", o.insecure, "plain TCP: tokens and data in clear text");

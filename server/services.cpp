@@ -527,6 +527,8 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* ctx, const v1::He
       answer != LeaseAnswer::kOk)
     return lease_refused(answer, req->job_id(), req->attempt(), req->worker(), "");
   reply->set_lease_seconds(store_.limits().lease_seconds);
+  reply->set_yield_at_checkpoint(
+      store_.yield_due(req->job_id(), steady_seconds(), config_.yield_after_seconds));
   return grpc::Status::OK;
 }
 
@@ -570,12 +572,18 @@ grpc::Status WorkerServiceImpl::Fail(grpc::ServerContext* ctx, const v1::FailReq
   if (auto s = admit(*ctx, config_.tokens, Caller::kWorker, *req); !s.ok()) return s;
   if (const std::string error = worker_text_error(req->worker(), req->reason()); !error.empty())
     return {grpc::StatusCode::INVALID_ARGUMENT, error};
-  if (const auto answer = store_.fail(req->job_id(), req->attempt(), req->worker(), req->reason(),
-                                      req->retryable(), req->give_back(), steady_seconds());
+  if (req->yielded() && !req->give_back())
+    return {grpc::StatusCode::INVALID_ARGUMENT, "yielded: only with give_back"};
+  if (const auto answer =
+          store_.fail(req->job_id(), req->attempt(), req->worker(), req->reason(), req->retryable(),
+                      req->give_back(), steady_seconds(), req->yielded());
       answer != LeaseAnswer::kOk)
     return lease_refused(answer, req->job_id(), req->attempt(), req->worker(), "");
   spdlog::info("job {} attempt {} {} by {}: {}", req->job_id(), req->attempt(),
-               req->give_back() ? "given back" : "failed", req->worker(), req->reason());
+               req->yielded()     ? "yielded"
+               : req->give_back() ? "given back"
+                                  : "failed",
+               req->worker(), req->reason());
   return grpc::Status::OK;
 }
 

@@ -26,6 +26,8 @@ struct ServiceConfig {
   double max_checkpoint_mb = 64.0;                      ///< a checkpoint's state, at most (MiB)
   long max_jobs_per_client = kDefaultMaxJobsPerClient;  ///< unfinished jobs of a token's campaigns
   long max_jobs = kDefaultMaxJobs;                      ///< unfinished jobs of the store, at most
+  double yield_after_seconds =
+      0.0;  ///< a lease's share before it yields (0: never; Store::yield_due)
 };
 
 /// The shortest Watch interval.

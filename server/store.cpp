@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
@@ -143,6 +144,7 @@ class Store::Guard {
 
 void Store::extend_deadlines(double seconds) {
   for (auto& [job, deadline] : deadlines_) deadline += seconds;
+  for (auto& [job, at] : leased_at_) at += seconds;
 }
 
 namespace {
@@ -252,7 +254,10 @@ void Store::restore_leases(double opened) {
   // leased before a restart has a whole lease from the opening to report or heartbeat again.
   Statement s(*this, "SELECT id FROM jobs WHERE state = 'leased'");
   const double deadline = opened + std::max(limits_.lease_seconds, limits_.restart_grace_seconds);
-  while (s.step()) deadlines_[s.i64(0)] = deadline;
+  while (s.step()) {
+    deadlines_[s.i64(0)] = deadline;
+    leased_at_[s.i64(0)] = opened;
+  }
 }
 
 std::optional<double> Store::lease_deadline(std::int64_t job_id) {
@@ -647,14 +652,15 @@ std::vector<CalibrationStageRow> Store::calibration_stages(std::int64_t campaign
   return out;
 }
 
-std::optional<std::pair<std::int64_t, std::string>> Store::next_queued() {
-  // Run order within a campaign and kind, except that a job whose wait has ended goes first: it
-  // starts from the bed its row's other job conditioned, so it is short, and a row's tensile
-  // strength is known before the campaign's later shear cells have run. jobs.wait_ended (set by
-  // a trigger, server/schema/012_job_wait_ended.sql) puts those jobs first in the jobs_queue
-  // index, so the walk meets them without testing the jobs still waiting.
+std::optional<Store::NextJob> Store::next_queued() {
+  // The jobs that yielded fewest times first (yield_due), then run order within a campaign and
+  // kind, except that a job whose wait has ended goes first: it starts from the bed its row's
+  // other job conditioned, so it is short, and a row's tensile strength is known before the
+  // campaign's later shear cells have run. jobs.wait_ended (set by a trigger,
+  // server/schema/012_job_wait_ended.sql) puts those jobs first in the jobs_queue index, so the
+  // walk meets them without testing the jobs still waiting.
   Statement s(*this,
-              "SELECT j.id, COALESCE(j.run_key, '') FROM jobs j "
+              "SELECT j.id, COALESCE(j.run_key, ''), j.yields FROM jobs j "
               "JOIN campaigns c ON c.id = j.campaign_id "
               "WHERE j.state = 'queued' AND c.state = 'running' AND c.ready = 1 AND "
               "(COALESCE(j.run_key, '') = '' OR NOT EXISTS (SELECT 1 FROM jobs t "
@@ -662,9 +668,10 @@ std::optional<std::pair<std::int64_t, std::string>> Store::next_queued() {
               "(j.waits_for = '' OR NOT EXISTS (SELECT 1 FROM jobs w WHERE w.campaign_id = "
               "j.campaign_id AND w.kind = j.kind AND w.std_order = j.std_order AND w.test = "
               "j.waits_for AND w.state IN ('queued', 'leased'))) "
-              "ORDER BY j.campaign_id, j.kind, j.wait_ended DESC, j.run_order, j.id LIMIT 1");
+              "ORDER BY j.yields, j.campaign_id, j.kind, j.wait_ended DESC, j.run_order, j.id "
+              "LIMIT 1");
   if (!s.step()) return std::nullopt;
-  return std::pair{s.i64(0), s.text(1)};
+  return NextJob{s.i64(0), s.text(1), s.i32(2)};
 }
 
 bool Store::take_finished_run(std::int64_t job_id, const std::string& key) {
@@ -714,7 +721,7 @@ std::optional<JobRow> Store::lease(const std::string& worker, double now) {
   Transaction tx(*this);
   bool reused = false;
   auto next = next_queued();
-  for (; next && !next->second.empty() && take_finished_run(next->first, next->second);
+  for (; next && !next->run_key.empty() && take_finished_run(next->id, next->run_key);
        next = next_queued())
     reused = true;
   if (reused) finish_campaigns(server::wall_seconds());
@@ -722,7 +729,7 @@ std::optional<JobRow> Store::lease(const std::string& worker, double now) {
     tx.commit();
     return std::nullopt;
   }
-  const std::int64_t id = next->first;
+  const std::int64_t id = next->id;
   Statement u(*this,
               "UPDATE jobs SET state = 'leased', attempt = attempt + 1, counted = counted + 1, "
               "worker = ? WHERE id = ? AND state = 'queued'");
@@ -733,6 +740,7 @@ std::optional<JobRow> Store::lease(const std::string& worker, double now) {
   JobRow job = read_job(r);
   tx.commit();
   deadlines_[id] = now + limits_.lease_seconds;
+  leased_at_[id] = now;
   job.lease_deadline = deadlines_[id];
   return job;
 }
@@ -870,6 +878,7 @@ LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string&
   finish_campaigns(stored);
   tx.commit();
   deadlines_.erase(job_id);
+  leased_at_.erase(job_id);
   return LeaseAnswer::kOk;
 }
 
@@ -921,7 +930,8 @@ bool Store::requeue_or_fail(std::int64_t job_id, int counted, const std::string&
 }
 
 LeaseAnswer Store::fail(std::int64_t job_id, int attempt, const std::string& worker,
-                        const std::string& reason, bool retryable, bool give_back, double now) {
+                        const std::string& reason, bool retryable, bool give_back, double now,
+                        bool yielded) {
   Guard lock(*this);
   Transaction tx(*this);
   if (const auto answer = check_lease(job_id, attempt, worker, now); answer != LeaseAnswer::kOk)
@@ -933,15 +943,31 @@ LeaseAnswer Store::fail(std::int64_t job_id, int attempt, const std::string& wor
   if (give_back) {
     Statement u(*this,
                 "UPDATE jobs SET state = 'queued', counted = counted - 1, lease_deadline = 0, "
-                "error = ? WHERE id = ?");
-    u.bind(1, "given back: " + reason).bind(2, job_id).step();
+                "error = ?, yields = yields + ? WHERE id = ?");
+    u.bind(1, "given back: " + reason).bind(2, yielded ? 1 : 0).bind(3, job_id).step();
   } else {
     requeue_or_fail(job_id, counted, reason, retryable, at);
   }
   finish_campaigns(at);
   tx.commit();
   deadlines_.erase(job_id);
+  leased_at_.erase(job_id);
   return LeaseAnswer::kOk;
+}
+
+bool Store::yield_due(std::int64_t job_id, double now, double yield_after) {
+  if (yield_after <= 0.0) return false;
+  Guard lock(*this);
+  const auto began = leased_at_.find(job_id);
+  if (began == leased_at_.end()) return false;
+  Statement s(*this, "SELECT yields FROM jobs WHERE id = ? AND state = 'leased'");
+  s.bind(1, job_id);
+  if (!s.step()) return false;
+  const int yields = s.i32(0);
+  // Each yield doubles the job's share of a lease, so that a long run still ends.
+  if (now - began->second <= std::ldexp(yield_after, std::min(yields, 30))) return false;
+  const auto next = next_queued();
+  return next && next->yields <= yields;
 }
 
 int Store::reap(double now) {
@@ -967,7 +993,10 @@ int Store::reap(double now) {
   }
   if (reaped > 0) finish_campaigns(at);
   tx.commit();
-  for (const auto id : due) deadlines_.erase(id);
+  for (const auto id : due) {
+    deadlines_.erase(id);
+    leased_at_.erase(id);
+  }
   return reaped;
 }
 

@@ -15,7 +15,8 @@
 //                                       leased --Fail(retryable) / lease expired--> queued
 //                                                  (failed once the attempt cap is reached)
 //                                       leased --Fail(not retryable)--> failed
-//                                       leased --Fail(give_back)--> queued (attempt not counted)
+//                                       leased --Fail(give_back)--> queued (attempt not counted;
+//                                                  with `yielded`, the job's yields + 1)
 //                      queued|leased --Cancel--> cancelled
 // Every lease increments the job's attempt number; Heartbeat, Complete and Fail name
 // (job, attempt, worker) and change nothing unless that lease is the current one, has not
@@ -276,8 +277,15 @@ class Store {
   /// The stored curves of the campaign's finished jobs: job id -> series JSON.
   std::map<std::int64_t, std::string> series(std::int64_t campaign_id);
   /// See the state machine above; only the current lease's holder may fail it.
+  /// A give-back that `yielded` (at the coordinator's request, yield_due) counts in the job's
+  /// yields, which order the queue.
   LeaseAnswer fail(std::int64_t job_id, int attempt, const std::string& worker,
-                   const std::string& reason, bool retryable, bool give_back, double now);
+                   const std::string& reason, bool retryable, bool give_back, double now,
+                   bool yielded = false);
+  /// Whether the current lease of `job_id` is to yield at its run's next checkpoint: it began
+  /// more than `yield_after` x 2^yields seconds before `now` (the job's yields so far) and a job
+  /// that yielded no more often is queued and leasable. Always false when `yield_after` is 0.
+  bool yield_due(std::int64_t job_id, double now, double yield_after);
   /// Keeps a checkpoint of the current, unexpired lease held by `worker`, in place of the job's
   /// earlier one; a stored result drops it.
   LeaseAnswer save_checkpoint(std::int64_t job_id, int attempt, const std::string& worker,
@@ -335,8 +343,14 @@ class Store {
   std::vector<std::int64_t> insert_jobs(std::int64_t campaign_id, const std::vector<NewJob>& jobs);
   bool requeue_or_fail(std::int64_t job_id, int counted, const std::string& reason, bool retryable,
                        double now);
-  /// The next queued job a worker may take (see lease()): its id and run key.
-  std::optional<std::pair<std::int64_t, std::string>> next_queued();
+  /// The next queued job a worker may take (see lease()): its id, run key and yields. Inside the
+  /// lock.
+  struct NextJob {
+    std::int64_t id = 0;
+    std::string run_key;
+    int yields = 0;
+  };
+  std::optional<NextJob> next_queued();
   /// Gives the queued job the result of a finished run with run key `key` (see lease()); false
   /// when there is none. Inside a transaction.
   bool take_finished_run(std::int64_t job_id, const std::string& key);
@@ -352,6 +366,7 @@ class Store {
   StoreLimits limits_;
   std::mutex mutex_;
   std::unordered_map<std::int64_t, double> deadlines_;  ///< job -> its lease's deadline
+  std::unordered_map<std::int64_t, double> leased_at_;  ///< job -> when its lease began
 };
 
 }  // namespace demcal::server

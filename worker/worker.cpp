@@ -45,13 +45,15 @@ struct Outcome {
   std::string reason;
   bool retryable = false;
   bool cancelled = false;  ///< stopped on request (lease lost or over the time limit)
+  bool yielded = false;    ///< stopped at a checkpoint kept, the coordinator asking it to yield
 };
 
 /// What may stop a running job from outside, read by its progress callback: the heartbeat
 /// thread learning that the lease is gone (expired, cancelled, taken over) and the worker's
-/// wall-time limit.
+/// wall-time limit; and, read by its checkpoint callback, the coordinator asking it to yield.
 struct JobStop {
   std::atomic<bool> lease_lost{false};
+  std::atomic<bool> yield_asked{false};
   std::optional<Clock::time_point> deadline;  ///< --max-job-seconds after the start
   double max_seconds = 0.0;
 
@@ -129,9 +131,9 @@ int job_threads(const v1::JobSpec& job, int worker_threads) {
 }
 
 /// Sends a checkpoint the job offers (stage, the run's clock there, its record) to the
-/// coordinator.
+/// coordinator; true when the coordinator kept it.
 using CheckpointSender =
-    std::function<void(const std::string&, const lab::CheckpointClock&, std::string)>;
+    std::function<bool(const std::string&, const lab::CheckpointClock&, std::string)>;
 
 /// Runs the job's lab test, from the checkpoint the lease carries if any: one that this build
 /// cannot go on from (another format, a stage the test never reaches) is set aside with a
@@ -157,6 +159,7 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
                 const JobStop& stop, const CheckpointSender& send_checkpoint,
                 double checkpoint_seconds, const std::shared_ptr<const lab::StageCache>& cache) {
   Outcome o;
+  bool yielded = false;
   try {
     lab::RunOptions ro;
     ro.stage_cache = cache;
@@ -166,10 +169,21 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
       progress = f;
       stop.check();
     };
-    ro.checkpoint = [&send_checkpoint, checkpoint_seconds, last = Clock::now()](
+    ro.checkpoint = [&send_checkpoint, &stop, &yielded, checkpoint_seconds, last = Clock::now()](
                         const std::string& stage, const lab::CheckpointClock& clock,
                         const std::function<std::string()>& record) mutable {
-      if (std::chrono::duration<double>(Clock::now() - last).count() < checkpoint_seconds) return;
+      const double since = std::chrono::duration<double>(Clock::now() - last).count();
+      // Asked to yield, the run stops at the first checkpoint the coordinator keeps (tried at
+      // most once a second): the job goes on from it in its next lease, nothing lost.
+      if (stop.yield_asked && since >= std::min(checkpoint_seconds, 1.0)) {
+        last = Clock::now();
+        if (send_checkpoint(stage, clock, record())) {
+          yielded = true;
+          throw lab::RunCancelled("yielded at its checkpoint '" + stage + "'");
+        }
+        return;
+      }
+      if (since < checkpoint_seconds) return;
       send_checkpoint(stage, clock, record());
       last = Clock::now();
     };
@@ -181,6 +195,7 @@ Outcome run_job(const v1::JobSpec& job, int threads, std::atomic<double>& progre
     for (const auto& [name, series] : out.series) o.series.push_back(to_proto(name, series));
   } catch (const lab::RunCancelled& e) {
     o.cancelled = true;
+    o.yielded = yielded;
     o.reason = e.what();
   } catch (const SimulationFailure& e) {
     o.reason = std::string("simulation failed (") + to_string(e.reason()) + "): " + e.what();
@@ -209,18 +224,19 @@ std::string worker_id(const WorkerOptions& opt) {
 }
 
 /// Heartbeats of one lease from their own thread, so that a long simulation step never lets the
-/// lease lapse; a reply saying the lease is gone sets `lease_lost`, which stops the simulation.
+/// lease lapse; a reply saying the lease is gone sets `lease_lost`, which stops the simulation,
+/// and one asking the job to yield sets `yield_asked`, which stops it at its next checkpoint.
 class Heartbeat {
  public:
   Heartbeat(v1::WorkerService::Stub& stub, const rpc::ChannelOptions& channel,
             const v1::JobSpec& job, const std::string& worker, double every,
-            const std::atomic<double>& progress, std::atomic<bool>& lease_lost)
+            const std::atomic<double>& progress, JobStop& stop)
       : thread_([&, job, worker, every] {
           std::unique_lock lock(mutex_);
           while (
               !cv_.wait_for(lock, std::chrono::duration<double>(every), [&] { return stopped_; })) {
             lock.unlock();
-            beat(stub, channel, job, worker, progress, lease_lost);
+            beat(stub, channel, job, worker, progress, stop);
             lock.lock();
           }
         }) {}
@@ -240,7 +256,7 @@ class Heartbeat {
  private:
   static void beat(v1::WorkerService::Stub& stub, const rpc::ChannelOptions& channel,
                    const v1::JobSpec& job, const std::string& worker,
-                   const std::atomic<double>& progress, std::atomic<bool>& lease_lost) {
+                   const std::atomic<double>& progress, JobStop& stop) {
     v1::HeartbeatRequest h;
     h.set_job_id(job.job_id());
     h.set_attempt(job.attempt());
@@ -250,12 +266,15 @@ class Heartbeat {
     const auto s = stub.Heartbeat(rpc::make_context(channel, 5).get(), h, &hr);
     const bool gone = s.error_code() == grpc::StatusCode::FAILED_PRECONDITION ||
                       s.error_code() == grpc::StatusCode::PERMISSION_DENIED;
-    if (gone && !lease_lost) {
-      lease_lost = true;
+    if (gone && !stop.lease_lost) {
+      stop.lease_lost = true;
       spdlog::warn("job {}: lease {} lost ({}); stopping its simulation", job.job_id(),
                    job.attempt(), s.error_message());
-    } else if (!s.ok() && !lease_lost) {
+    } else if (!s.ok() && !stop.lease_lost) {
       spdlog::warn("job {}: heartbeat failed: {}", job.job_id(), s.error_message());
+    } else if (s.ok() && hr.yield_at_checkpoint() && !stop.yield_asked) {
+      stop.yield_asked = true;
+      spdlog::info("job {}: the coordinator asks it to yield at its next checkpoint", job.job_id());
     }
   }
 
@@ -286,10 +305,10 @@ class Worker {
       if (!step()) break;
     }
     spdlog::info(
-        "worker {} stopping: {} done, {} failed, {} refused, {} given back, {} abandoned, {} "
-        "jobs refused",
-        id_, stats_.completed, stats_.failed, stats_.rejected, stats_.given_back, stats_.abandoned,
-        stats_.refused_jobs);
+        "worker {} stopping: {} done, {} failed, {} refused, {} given back, {} yielded, {} "
+        "abandoned, {} jobs refused",
+        id_, stats_.completed, stats_.failed, stats_.rejected, stats_.given_back, stats_.yielded,
+        stats_.abandoned, stats_.refused_jobs);
     return stats_;
   }
 
@@ -348,17 +367,19 @@ class Worker {
                                         std::chrono::duration<double>(opt_.max_job_seconds));
     Heartbeat heartbeat(*stub_, opt_.channel, job, id_,
                         lease.heartbeat_seconds() > 0 ? lease.heartbeat_seconds() : 10.0, progress,
-                        job_stop.lease_lost);
+                        job_stop);
     // The simulation runs on its own thread so that a stop request can give the lease back; a
     // detached simulation (give-back on abort) is followed by the process exiting.
-    auto task = std::make_shared<std::packaged_task<Outcome()>>([this, job, threads = opt_.threads,
-                                                                 shared] {
-      const CheckpointSender send =
-          [this, &job](const std::string& stage, const lab::CheckpointClock& clock,
-                       std::string state) { send_checkpoint(job, stage, clock, std::move(state)); };
-      return run_job(job, threads, shared->first, shared->second, send, opt_.checkpoint_seconds,
-                     stage_cache_);
-    });
+    auto task = std::make_shared<std::packaged_task<Outcome()>>(
+        [this, job, threads = opt_.threads, shared] {
+          const CheckpointSender send = [this, &job](const std::string& stage,
+                                                     const lab::CheckpointClock& clock,
+                                                     std::string state) {
+            return send_checkpoint(job, stage, clock, std::move(state));
+          };
+          return run_job(job, threads, shared->first, shared->second, send, opt_.checkpoint_seconds,
+                         stage_cache_);
+        });
     auto future = task->get_future();
     std::thread sim([task] { (*task)(); });
     if (must_give_back(future, job)) {
@@ -378,6 +399,13 @@ class Worker {
       // job to another worker.
       ++stats_.abandoned;
       spdlog::warn("job {}: simulation stopped after {:.2f} s: {}", job.job_id(), wall, out.reason);
+    } else if (out.yielded) {
+      // Queued again behind the jobs that yielded fewer times; its next lease goes on from the
+      // checkpoint just kept. A give-back the coordinator does not hear ends as a lapsed lease.
+      const auto s = fail(job, out.reason, true, /*give_back=*/true, 10, /*yielded=*/true);
+      ++stats_.yielded;
+      spdlog::info("job {}: {} after {:.2f} s ({})", job.job_id(), out.reason, wall,
+                   s.ok() ? "given back" : s.error_message());
     } else {
       // Heartbeats go on while the report is retried: the lease must outlive a coordinator
       // that is slow or restarting.
@@ -459,7 +487,7 @@ class Worker {
   }
 
   /// One try: a checkpoint that does not arrive costs only the time it would have saved.
-  void send_checkpoint(const v1::JobSpec& job, const std::string& stage,
+  bool send_checkpoint(const v1::JobSpec& job, const std::string& stage,
                        const lab::CheckpointClock& clock, std::string state) {
     const std::size_t bytes = state.size();
     v1::CheckpointRequest c;
@@ -477,10 +505,11 @@ class Worker {
                    job.job_id(), stage, bytes, c.simulated_seconds(), c.steps());
     else
       spdlog::warn("job {}: checkpoint '{}' not kept: {}", job.job_id(), stage, s.error_message());
+    return s.ok();
   }
 
   grpc::Status fail(const v1::JobSpec& job, const std::string& reason, bool retryable,
-                    bool give_back, double deadline_seconds) {
+                    bool give_back, double deadline_seconds, bool yielded = false) {
     v1::FailRequest f;
     f.set_job_id(job.job_id());
     f.set_attempt(job.attempt());
@@ -488,6 +517,7 @@ class Worker {
     f.set_reason(rpc::fail_reason(reason));
     f.set_retryable(retryable);
     f.set_give_back(give_back);
+    f.set_yielded(yielded);
     v1::FailReply fr;
     return stub_->Fail(rpc::make_context(opt_.channel, deadline_seconds).get(), f, &fr);
   }

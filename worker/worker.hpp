@@ -41,6 +41,7 @@ struct StopFlags {
 struct WorkerStats {
   int completed = 0, failed = 0, rejected = 0, given_back = 0;
   int abandoned = 0;     ///< simulations stopped because the lease was gone
+  int yielded = 0;       ///< leases given back at a checkpoint on the coordinator's request
   int refused_jobs = 0;  ///< jobs over this worker's limits, failed back unrun
   bool unauthenticated = false;
   /// The coordinator runs other lab protocol versions than this build.

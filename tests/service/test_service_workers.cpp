@@ -177,6 +177,128 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
   EXPECT_EQ(checkpoints, 0);
 }
 
+// With --yield-after, a lease that has run past its share while a job waits is asked to yield:
+// the job is given back at the checkpoint its run keeps next and goes behind the jobs that
+// yielded fewer times, so the short runs finish first; a real worker does so by itself. A job
+// that yielded twice, once by hand and once by the worker, ends with the result of a run never
+// interrupted, to the bit.
+TEST_F(Service, ALongRunYieldsAtACheckpointAndEndsWithTheUninterruptedResult) {
+  start_server(/*lease=*/30, /*heartbeat=*/0.3, 0, {"--yield-after", "1"});
+  std::int64_t id = 0;
+  // Three runs: a 2^1 in the wall's friction and a centre run.
+  std::string spec = wall_friction_spec("yielding", "");
+  spec.replace(spec.find("  - {path: wall_law.tangential.mu_s, low: 0.2, high: 0.4}\n"),
+               std::string("  - {path: wall_law.tangential.mu_s, low: 0.2, high: 0.4}\n").size(),
+               "");
+  spec.replace(spec.find("design: {type: full_factorial}"),
+               std::string("design: {type: full_factorial}").size(),
+               "design: {type: full_factorial, centre_points: 1}");
+  ASSERT_TRUE(submit(spec, &id).ok());
+  v1::LeaseReply first;
+  ASSERT_NO_FATAL_FAILURE(lease_as("first", first));
+  ASSERT_TRUE(first.has_job());
+  const v1::JobSpec job = first.job();
+  const auto beat = [&](const std::string& worker) {
+    v1::HeartbeatRequest h;
+    h.set_job_id(job.job_id());
+    h.set_attempt(job.attempt());
+    h.set_worker(worker);
+    v1::HeartbeatReply hr;
+    EXPECT_TRUE(workers_stub_->Heartbeat(ctx().get(), h, &hr).ok());
+    return hr.yield_at_checkpoint();
+  };
+  EXPECT_FALSE(beat("first"));  // within its share
+  // Its run as the worker runs it, keeping the checkpoints it offers.
+  lab::RunOptions options;
+  options.seed = job.seed() ? job.seed() : 1;
+  std::vector<lab::Checkpoint> offered;
+  options.checkpoint = [&offered](const std::string& stage, const lab::CheckpointClock&,
+                                  const std::function<std::string()>& record) {
+    offered.push_back({stage, record()});
+  };
+  const auto started = std::chrono::steady_clock::now();
+  const lab::LabOutput whole = lab::run_lab_test(job.test(), rpc::job_material(job),
+                                                 rpc::to_settings(job.settings()), options);
+  std::this_thread::sleep_until(started + std::chrono::milliseconds(1200));
+  EXPECT_TRUE(beat("first"));  // past its second, two jobs waiting
+  ASSERT_GE(offered.size(), 2u);
+  v1::CheckpointRequest cp;
+  cp.set_job_id(job.job_id());
+  cp.set_attempt(job.attempt());
+  cp.set_worker("first");
+  cp.set_stage(offered.front().stage);
+  cp.set_state(offered.front().state);
+  v1::CheckpointReply cpr;
+  ASSERT_TRUE(workers_stub_->Checkpoint(ctx().get(), cp, &cpr).ok());
+  v1::FailRequest yielded;
+  yielded.set_job_id(job.job_id());
+  yielded.set_attempt(job.attempt());
+  yielded.set_worker("first");
+  yielded.set_retryable(true);
+  yielded.set_yielded(true);
+  v1::FailReply fr;
+  EXPECT_EQ(workers_stub_->Fail(ctx().get(), yielded, &fr).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);  // a yield gives the lease back
+  yielded.set_give_back(true);
+  ASSERT_TRUE(workers_stub_->Fail(ctx().get(), yielded, &fr).ok());
+  // The next lease passes it by; held here until a real worker runs the third job, then given
+  // back (not yielded), so that the worker's job has one waiting that never yielded.
+  v1::LeaseReply second;
+  ASSERT_NO_FATAL_FAILURE(lease_as("second", second));
+  ASSERT_TRUE(second.has_job());
+  EXPECT_NE(second.job().job_id(), job.job_id());
+  Process& worker = start_worker("real", kToken, {"--checkpoint-seconds", "60"});
+  ASSERT_TRUE(wait_until(
+      [&] {
+        const auto now = results(id);
+        for (const auto& j : now.jobs())
+          if (j.state() == "leased" && j.job_id() != second.job().job_id()) return true;
+        return false;
+      },
+      30))
+      << worker.log();
+  v1::FailRequest back;
+  back.set_job_id(second.job().job_id());
+  back.set_attempt(second.job().attempt());
+  back.set_worker("second");
+  back.set_retryable(true);
+  back.set_give_back(true);
+  ASSERT_TRUE(workers_stub_->Fail(ctx().get(), back, &fr).ok());
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 180)) << worker.log();
+  // The worker yielded: its job once, and then one of the two that had yielded once.
+  const std::string log = worker.log();
+  std::size_t yields = 0;
+  for (auto at = log.find("yielded at its checkpoint"); at != std::string::npos;
+       at = log.find("yielded at its checkpoint", at + 1))
+    ++yields;
+  EXPECT_GE(yields, 2u) << log;
+  std::map<std::int64_t, int> yields_of;
+  std::map<std::int64_t, double> finished;
+  each_row(path("c.db"), "SELECT id, yields, finished FROM jobs", [&](sqlite3_stmt* st) {
+    yields_of[sqlite3_column_int64(st, 0)] = sqlite3_column_int(st, 1);
+    finished[sqlite3_column_int64(st, 0)] = sqlite3_column_double(st, 2);
+  });
+  EXPECT_GE(yields_of.at(job.job_id()), 1);
+  EXPECT_EQ(yields_of.at(second.job().job_id()), 0);  // given back, never yielded: ran through
+  // The job the second lease passed over finished first; the one yielded by hand goes on from
+  // its checkpoints to the uninterrupted result.
+  std::map<std::int64_t, v1::JobResult> done;
+  const auto stored = results(id);
+  for (const auto& j : stored.jobs()) done[j.job_id()] = j;
+  ASSERT_EQ(done.size(), 3u);
+  for (const auto& [jid, j] : done) {
+    EXPECT_EQ(j.state(), "done");
+    if (jid != second.job().job_id()) {
+      EXPECT_GT(finished.at(jid), finished.at(second.job().job_id()));
+    }
+  }
+  const v1::JobResult& resumed = done.at(job.job_id());
+  ASSERT_EQ(resumed.metrics().size(), whole.metrics.size());
+  for (const auto& [name, value] : whole.metrics)
+    EXPECT_EQ(resumed.metrics().at(name), value) << name;  // exact: the same bits
+  EXPECT_EQ(resumed.cost().steps(), whole.cost.steps);
+}
+
 TEST_F(Service, LateCompleteFromAnExpiredLeaseIsRejectedAndNotStored) {
   start_server(/*lease=*/1.0, /*heartbeat=*/0.2);
   std::int64_t id = 0;

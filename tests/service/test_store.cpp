@@ -655,6 +655,47 @@ TEST(Store, RetryCapFailsTheJobAndGiveBackDoesNotCount) {
   EXPECT_EQ(s.campaign(id)->state, "done");
 }
 
+// A lease that has run past the coordinator's --yield-after while a job waits is asked to yield;
+// a job that yielded goes behind the queued jobs that yielded fewer times, and each yield doubles
+// the time its next lease runs before it is asked again. A give-back does not count as an attempt.
+TEST(Store, ALongLeaseYieldsToTheQueuedJobsAndItsJobGoesBehindThem) {
+  Store s(":memory:", {100.0, 2});
+  s.create_campaign("c", "{}", "{}", jobs(3), 0.0);
+  const auto a = s.lease("w", 0.0);
+  ASSERT_TRUE(a);
+  EXPECT_FALSE(s.yield_due(a->id, 5.0, 0.0));  // 0: never
+  EXPECT_FALSE(s.yield_due(a->id, 1.5, 2.0));  // within its share
+  EXPECT_TRUE(s.yield_due(a->id, 2.5, 2.0));   // past it, two jobs waiting
+  EXPECT_EQ(s.fail(a->id, 1, "w", "yielded at its checkpoint 'settling'", true, true, 3.0, true),
+            kOk);
+  EXPECT_EQ(s.job(a->id)->state, "queued");
+  const auto b = s.lease("w", 3.0);
+  ASSERT_TRUE(b);
+  EXPECT_NE(b->id, a->id);                    // a comes first in run order, but it yielded
+  EXPECT_TRUE(s.yield_due(b->id, 5.5, 2.0));  // the third job waits, never yielded
+  EXPECT_EQ(s.fail(b->id, 1, "w", "yielded", true, true, 6.0, true), kOk);
+  const auto c = s.lease("w", 6.0);
+  ASSERT_TRUE(c);
+  EXPECT_NE(c->id, a->id);
+  EXPECT_NE(c->id, b->id);
+  EXPECT_FALSE(s.yield_due(c->id, 100.0, 2.0));  // the jobs waiting yielded more often
+  EXPECT_EQ(s.complete(c->id, 1, "w", "{}", 1.0, 100.0), kOk);
+  EXPECT_FALSE(s.yield_due(c->id, 200.0, 2.0));  // no lease
+  // a and b yielded once each: a first again by run order, with twice the share (4 s).
+  const auto a2 = s.lease("w", 100.0);
+  ASSERT_TRUE(a2);
+  EXPECT_EQ(a2->id, a->id);
+  EXPECT_EQ(a2->attempt, 2);
+  EXPECT_EQ(a2->counted, 1);  // the yield was not counted against the cap of 2
+  EXPECT_FALSE(s.yield_due(a->id, 103.0, 2.0));
+  EXPECT_TRUE(s.yield_due(a->id, 104.5, 2.0));  // b waits, yielded as often
+  // Once b runs too, nothing waits: a runs on.
+  const auto b2 = s.lease("w", 104.5);
+  ASSERT_TRUE(b2);
+  EXPECT_EQ(b2->id, b->id);
+  EXPECT_FALSE(s.yield_due(a->id, 1000.0, 2.0));
+}
+
 TEST(Store, SimulationFailureFailsAtOnce) {
   Store s(":memory:");
   s.create_campaign("c", "{}", "{}", jobs(1), 0.0);
@@ -764,7 +805,7 @@ TEST(Store, VersionOneDatabaseMigratesKeepingJobsAndResultsAndAdmitsDiagnosisJob
   }
   {
     Store s(path.string());
-    EXPECT_EQ(Store::latest_schema_version(), 14);
+    EXPECT_EQ(Store::latest_schema_version(), 15);
     EXPECT_EQ(s.schema_version(), Store::latest_schema_version());
     ASSERT_EQ(s.campaigns().size(), 1u);
     const auto campaign = s.campaign(1);
