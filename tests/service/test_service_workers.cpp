@@ -33,6 +33,17 @@
 namespace demcal::test {
 namespace {
 
+/// The Fail of a worker giving back its lease of `job` (retryable, not counted).
+v1::FailRequest give_back_request(const v1::JobSpec& job, const std::string& worker) {
+  v1::FailRequest f;
+  f.set_job_id(job.job_id());
+  f.set_attempt(job.attempt());
+  f.set_worker(worker);
+  f.set_retryable(true);
+  f.set_give_back(true);
+  return f;
+}
+
 // A job's checkpoint goes from the lease that sent it to the job's next lease, and a real worker
 // goes on from it to the result of a run that was never interrupted, to the bit.
 TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
@@ -99,14 +110,8 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
   EXPECT_EQ(workers_stub_->Checkpoint(ctx().get(), negative_steps, &cpr).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
   ASSERT_TRUE(workers_stub_->Checkpoint(ctx().get(), cp, &cpr).ok());
-  v1::FailRequest give_back;
-  give_back.set_job_id(job.job_id());
-  give_back.set_attempt(job.attempt());
-  give_back.set_worker("first");
-  give_back.set_retryable(true);
-  give_back.set_give_back(true);
   v1::FailReply fr;
-  ASSERT_TRUE(workers_stub_->Fail(ctx().get(), give_back, &fr).ok());
+  ASSERT_TRUE(workers_stub_->Fail(ctx().get(), give_back_request(job, "first"), &fr).ok());
   // Queued again, the job shows the checkpoint it goes on from, in the results and in the job
   // list of `demcal status --jobs`.
   const double before =
@@ -231,12 +236,9 @@ TEST_F(Service, ALongRunYieldsAtACheckpointAndEndsWithTheUninterruptedResult) {
   cp.set_state(offered.front().state);
   v1::CheckpointReply cpr;
   ASSERT_TRUE(workers_stub_->Checkpoint(ctx().get(), cp, &cpr).ok());
-  v1::FailRequest yielded;
-  yielded.set_job_id(job.job_id());
-  yielded.set_attempt(job.attempt());
-  yielded.set_worker("first");
-  yielded.set_retryable(true);
+  v1::FailRequest yielded = give_back_request(job, "first");
   yielded.set_yielded(true);
+  yielded.set_give_back(false);
   v1::FailReply fr;
   EXPECT_EQ(workers_stub_->Fail(ctx().get(), yielded, &fr).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);  // a yield gives the lease back
@@ -258,13 +260,8 @@ TEST_F(Service, ALongRunYieldsAtACheckpointAndEndsWithTheUninterruptedResult) {
       },
       30))
       << worker.log();
-  v1::FailRequest back;
-  back.set_job_id(second.job().job_id());
-  back.set_attempt(second.job().attempt());
-  back.set_worker("second");
-  back.set_retryable(true);
-  back.set_give_back(true);
-  ASSERT_TRUE(workers_stub_->Fail(ctx().get(), back, &fr).ok());
+  ASSERT_TRUE(
+      workers_stub_->Fail(ctx().get(), give_back_request(second.job(), "second"), &fr).ok());
   ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 180)) << worker.log();
   // The worker yielded: its job once, and then one of the two that had yielded once.
   const std::string log = worker.log();
