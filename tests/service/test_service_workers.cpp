@@ -185,8 +185,8 @@ TEST_F(Service, AReleasedJobGoesOnFromItsCheckpointToTheUninterruptedResult) {
 // With --yield-after, a lease that has run past its share while a job waits is asked to yield:
 // the job is given back at the checkpoint its run keeps next and goes behind the jobs that
 // yielded fewer times, so the short runs finish first; a real worker does so by itself. A job
-// that yielded twice, once by hand and once by the worker, ends with the result of a run never
-// interrupted, to the bit.
+// that yielded by hand, and then went on under the worker (which may make it yield again), ends
+// with the result of a run never interrupted, to the bit.
 TEST_F(Service, ALongRunYieldsAtACheckpointAndEndsWithTheUninterruptedResult) {
   start_server(/*lease=*/30, /*heartbeat=*/0.3, 0, {"--yield-after", "1"});
   std::int64_t id = 0;
