@@ -17,6 +17,7 @@
 
 #include "core/common/error.hpp"
 #include "rpc/material_convert.hpp"
+#include "server/limits.hpp"
 #include "server/store.hpp"
 #include "server/store_lock.hpp"
 
@@ -168,7 +169,7 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
               v = std::stod(text);
             } catch (const std::exception&) {
             }
-            return v == 0.0 || (v >= 1.0 && v <= 86400.0) ? "" : "0 (never) or 1-86400 s";
+            return server::yield_after_admitted(v) ? "" : "0 (never) or 1-86400 s";
           },
           "0 or 1-86400"))
       ->capture_default_str();

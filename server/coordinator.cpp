@@ -30,6 +30,9 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
         "--worker-token-file and --client-token-file)");
   if (!(options_.grace_seconds >= 0.0 && options_.grace_seconds <= 3600.0))
     throw std::invalid_argument("--grace must lie in [0, 3600] s");
+  // Before the store is opened (and migrated).
+  if (!yield_after_admitted(options_.yield_after_seconds))
+    throw std::invalid_argument("--yield-after must be 0 (never) or lie in [1, 86400] s");
   store_ = std::make_unique<Store>(options_.db, StoreLimits{options_.lease_seconds,
                                                             options_.max_attempts,
                                                             options_.grace_seconds,
@@ -49,9 +52,6 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
     throw std::invalid_argument("--max-checkpoint-mb must lie in [1, 1024]");
   if (options_.max_jobs_per_client < 1 || options_.max_jobs < 1)
     throw std::invalid_argument("--max-jobs-per-client and --max-jobs must be >= 1");
-  if (!(options_.yield_after_seconds == 0.0 ||
-        (options_.yield_after_seconds >= 1.0 && options_.yield_after_seconds <= 86400.0)))
-    throw std::invalid_argument("--yield-after must be 0 (never) or lie in [1, 86400] s");
   ServiceConfig config{tokens,
                        options_.heartbeat_seconds,
                        std::min(options_.idle_retry_seconds, options_.heartbeat_seconds),

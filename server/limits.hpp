@@ -9,6 +9,14 @@ namespace demcal::server {
 
 inline constexpr std::size_t kKiB = 1024, kMiB = 1024 * kKiB;
 
+// ---- the coordinator's options ----
+
+/// A lease's share before it yields (--yield-after, s): 0 (never) or within these bounds.
+inline constexpr double kMinYieldAfter = 1.0, kMaxYieldAfter = 86400.0;
+inline bool yield_after_admitted(double seconds) {
+  return seconds == 0.0 || (seconds >= kMinYieldAfter && seconds <= kMaxYieldAfter);
+}
+
 // ---- a campaign ----
 /// Centre points and replicates of a design.
 inline constexpr int kMaxCentrePoints = 64, kMaxReplicates = 16;

@@ -143,8 +143,10 @@ class Store::Guard {
 };
 
 void Store::extend_deadlines(double seconds) {
-  for (auto& [job, deadline] : deadlines_) deadline += seconds;
-  for (auto& [job, at] : leased_at_) at += seconds;
+  for (auto& [job, lease] : leases_) {
+    lease.began += seconds;
+    lease.deadline += seconds;
+  }
 }
 
 namespace {
@@ -254,17 +256,14 @@ void Store::restore_leases(double opened) {
   // leased before a restart has a whole lease from the opening to report or heartbeat again.
   Statement s(*this, "SELECT id FROM jobs WHERE state = 'leased'");
   const double deadline = opened + std::max(limits_.lease_seconds, limits_.restart_grace_seconds);
-  while (s.step()) {
-    deadlines_[s.i64(0)] = deadline;
-    leased_at_[s.i64(0)] = opened;
-  }
+  while (s.step()) leases_[s.i64(0)] = {opened, deadline};
 }
 
 std::optional<double> Store::lease_deadline(std::int64_t job_id) {
   Guard lock(*this);
-  const auto it = deadlines_.find(job_id);
-  if (it == deadlines_.end()) return std::nullopt;
-  return it->second;
+  const auto it = leases_.find(job_id);
+  if (it == leases_.end()) return std::nullopt;
+  return it->second.deadline;
 }
 
 void Store::copy_file(const std::string& from, const std::string& to) {
@@ -739,9 +738,8 @@ std::optional<JobRow> Store::lease(const std::string& worker, double now) {
   r.step();
   JobRow job = read_job(r);
   tx.commit();
-  deadlines_[id] = now + limits_.lease_seconds;
-  leased_at_[id] = now;
-  job.lease_deadline = deadlines_[id];
+  leases_[id] = {now, now + limits_.lease_seconds};
+  job.lease_deadline = leases_[id].deadline;
   return job;
 }
 
@@ -824,8 +822,8 @@ LeaseAnswer Store::check_lease(std::int64_t job_id, int attempt, const std::stri
   Statement s(*this, "SELECT worker FROM jobs WHERE id = ? AND attempt = ? AND state = 'leased'");
   s.bind(1, job_id).bind(2, attempt);
   if (!s.step()) return LeaseAnswer::kStale;
-  const auto it = deadlines_.find(job_id);
-  if (it == deadlines_.end() || it->second < now) return LeaseAnswer::kStale;
+  const auto it = leases_.find(job_id);
+  if (it == leases_.end() || it->second.deadline < now) return LeaseAnswer::kStale;
   return s.text(0) == worker ? LeaseAnswer::kOk : LeaseAnswer::kNotHolder;
 }
 
@@ -843,7 +841,7 @@ LeaseAnswer Store::heartbeat(std::int64_t job_id, int attempt, const std::string
                              double now) {
   Guard lock(*this);
   const LeaseAnswer answer = check_lease(job_id, attempt, worker, now);
-  if (answer == LeaseAnswer::kOk) deadlines_[job_id] = now + limits_.lease_seconds;
+  if (answer == LeaseAnswer::kOk) leases_[job_id].deadline = now + limits_.lease_seconds;
   if (answer == LeaseAnswer::kStale && stored_result(job_id, attempt, worker))
     return LeaseAnswer::kOk;
   return answer;
@@ -877,8 +875,7 @@ LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string&
   d.bind(1, job_id).step();
   finish_campaigns(stored);
   tx.commit();
-  deadlines_.erase(job_id);
-  leased_at_.erase(job_id);
+  leases_.erase(job_id);
   return LeaseAnswer::kOk;
 }
 
@@ -950,22 +947,21 @@ LeaseAnswer Store::fail(std::int64_t job_id, int attempt, const std::string& wor
   }
   finish_campaigns(at);
   tx.commit();
-  deadlines_.erase(job_id);
-  leased_at_.erase(job_id);
+  leases_.erase(job_id);
   return LeaseAnswer::kOk;
 }
 
 bool Store::yield_due(std::int64_t job_id, double now, double yield_after) {
   if (yield_after <= 0.0) return false;
   Guard lock(*this);
-  const auto began = leased_at_.find(job_id);
-  if (began == leased_at_.end()) return false;
+  const auto lease = leases_.find(job_id);
+  if (lease == leases_.end()) return false;
   Statement s(*this, "SELECT yields FROM jobs WHERE id = ? AND state = 'leased'");
   s.bind(1, job_id);
   if (!s.step()) return false;
   const int yields = s.i32(0);
   // Each yield doubles the job's share of a lease, so that a long run still ends.
-  if (now - began->second <= std::ldexp(yield_after, std::min(yields, 30))) return false;
+  if (now - lease->second.began <= std::ldexp(yield_after, std::min(yields, 30))) return false;
   const auto next = next_queued();
   return next && next->yields <= yields;
 }
@@ -973,8 +969,8 @@ bool Store::yield_due(std::int64_t job_id, double now, double yield_after) {
 int Store::reap(double now) {
   Guard lock(*this);
   std::vector<std::int64_t> due;
-  for (const auto& [job, deadline] : deadlines_)
-    if (deadline < now) due.push_back(job);
+  for (const auto& [job, lease] : leases_)
+    if (lease.deadline < now) due.push_back(job);
   if (due.empty()) return 0;
   Transaction tx(*this);
   const double at = wall_seconds();
@@ -993,10 +989,7 @@ int Store::reap(double now) {
   }
   if (reaped > 0) finish_campaigns(at);
   tx.commit();
-  for (const auto id : due) {
-    deadlines_.erase(id);
-    leased_at_.erase(id);
-  }
+  for (const auto id : due) leases_.erase(id);
   return reaped;
 }
 

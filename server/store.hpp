@@ -365,8 +365,11 @@ class Store {
   std::unordered_map<std::string, sqlite3_stmt*> idle_statements_;
   StoreLimits limits_;
   std::mutex mutex_;
-  std::unordered_map<std::int64_t, double> deadlines_;  ///< job -> its lease's deadline
-  std::unordered_map<std::int64_t, double> leased_at_;  ///< job -> when its lease began
+  /// A current lease's clock: when it began and when it expires unless renewed.
+  struct LeaseClock {
+    double began = 0.0, deadline = 0.0;
+  };
+  std::unordered_map<std::int64_t, LeaseClock> leases_;  ///< job -> its current lease
 };
 
 }  // namespace demcal::server
