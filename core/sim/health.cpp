@@ -4,12 +4,40 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
 #include "core/common/error.hpp"
+#include "core/walls/mesh.hpp"
 
 namespace demcal::sim {
+
+namespace {
+
+/// The walls particle i overlaps, named, for the message of an escaped particle: a particle that
+/// leaves the test volume while touching a wall has usually been carried out along it (an
+/// adhesive wall holds it while it slides or rolls), one touching none was thrown.
+std::string touched_walls(const World& w, std::size_t i) {
+  const Vec3& x = w.particles.x[i];
+  const double r = w.particles.radius[i];
+  std::string names;
+  for (const walls::Wall& wall : w.walls) {
+    const bool touching = std::visit(
+        [&](const auto& shape) {
+          walls::WallGeometry g[walls::Mesh::kMaxContacts];
+          if constexpr (std::is_same_v<std::decay_t<decltype(shape)>, walls::Mesh>)
+            return walls::mesh_contacts(shape, x, r, 0.0, g) > 0;
+          else
+            return walls::primitive_geometry(shape, x, r, 0.0, g[0]);
+        },
+        wall.shape);
+    if (touching) names += (names.empty() ? "'" : ", '") + wall.name + "'";
+  }
+  return names.empty() ? "touching no wall" : "touching wall " + names;
+}
+
+}  // namespace
 
 void check_health(const World& w, const HealthLimits& limits) {
   const auto& p = w.particles;
@@ -24,9 +52,11 @@ void check_health(const World& w, const HealthLimits& limits) {
       if (!w.domain.periodic[k] && (p.x[i][k] < limits.lo[k] || p.x[i][k] > limits.hi[k])) {
         char msg[200];
         std::snprintf(msg, sizeof msg,
-                      "particle %zu left the test volume at t = %.6g s (position %.4g %.4g %.4g m)",
-                      i, w.time, p.x[i].x, p.x[i].y, p.x[i].z);
-        throw SimulationFailure(SimulationFailure::Reason::kEscaped, msg);
+                      "particle %zu left the test volume at t = %.6g s (position %.4g %.4g %.4g m, "
+                      "velocity %.3g %.3g %.3g m/s, ",
+                      i, w.time, p.x[i].x, p.x[i].y, p.x[i].z, p.v[i].x, p.v[i].y, p.v[i].z);
+        throw SimulationFailure(SimulationFailure::Reason::kEscaped,
+                                msg + touched_walls(w, i) + ")");
       }
   }
   const double ke = p.kinetic_energy();

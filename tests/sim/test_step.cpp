@@ -6,7 +6,10 @@
 
 #include <cmath>
 
+#include "core/common/error.hpp"
+#include "core/sim/health.hpp"
 #include "core/sim/step.hpp"
+#include "core/walls/mesh.hpp"
 
 namespace demcal {
 namespace {
@@ -154,6 +157,38 @@ TEST(SimStep, ChangedLawOfOtherModelsStartsTheContactHistoryAfresh) {
   EXPECT_FALSE(w.prepared());
   sim::run(w, 1);
   EXPECT_LT(history_norm(w), 0.1 * sheared);  // one step's worth
+}
+
+TEST(SimHealth, AnEscapedParticleIsNamedWithItsVelocityAndTheWallsItTouches) {
+  // Three particles above the volume's top (z <= 0): one pressed into a vertical plane wall and a
+  // mesh quad beside it (the vessel a particle slides up), one in the gap of neither, one free.
+  sim::World w = falling_sphere();
+  w.walls.push_back(walls::make_wall("vessel", walls::Plane{{0, 0, 0}, {1, 0, 0}}));
+  w.walls.push_back(walls::make_wall(
+      "lid", walls::make_quad({-0.01, -0.01, 0.0112}, {0.02, 0, 0}, {0, 0.02, 0})));
+  sim::HealthLimits limits;
+  limits.hi = {1.0, 1.0, 0.0};
+  auto message = [&](const Vec3& x, const Vec3& v) {
+    w.particles.x[0] = x;
+    w.particles.v[0] = v;
+    try {
+      sim::check_health(w, limits);
+    } catch (const SimulationFailure& f) {
+      EXPECT_EQ(f.reason(), SimulationFailure::Reason::kEscaped);
+      return std::string(f.what());
+    }
+    ADD_FAILURE() << "no escape at z = " << x.z;
+    return std::string();
+  };
+  const std::string both = message({0.0009, 0, 0.0105}, {0.3, -1.8, 0.5});
+  EXPECT_NE(both.find("velocity 0.3 -1.8 0.5 m/s, touching wall 'vessel', 'lid')"),
+            std::string::npos)
+      << both;
+  // 0.1 mm from the plane and 0.3 mm below the quad: a gap is not a touch.
+  const std::string gap = message({0.0011, 0, 0.0099}, {0, 0, 1});
+  EXPECT_NE(gap.find("touching no wall)"), std::string::npos) << gap;
+  const std::string vessel = message({0.0005, 0, 0.005}, {0, 0, 1});
+  EXPECT_NE(vessel.find("touching wall 'vessel')"), std::string::npos) << vessel;
 }
 
 }  // namespace
