@@ -798,6 +798,7 @@ void Store::refresh_run_keys(const std::function<RunKey(const std::string& paylo
   Guard lock(*this);
   Transaction tx(*this);
   std::vector<std::pair<std::int64_t, RunKey>> changed;
+  std::vector<std::int64_t> rekeyed;  // had a key, now another: their checkpoints go
   {
     Statement s(
         *this,
@@ -805,14 +806,22 @@ void Store::refresh_run_keys(const std::function<RunKey(const std::string& paylo
         "WHERE run_key IS NULL OR state != 'done'");
     while (s.step()) {
       RunKey key = key_of(s.text(1));
-      if (s.i64(4) != 0 || key.key != s.text(2) || key.protocol != s.i64(3))
+      const bool had_key = s.i64(4) == 0;
+      if (!had_key || key.key != s.text(2) || key.protocol != s.i64(3)) {
+        if (had_key) rekeyed.push_back(s.i64(0));
         changed.emplace_back(s.i64(0), std::move(key));
+      }
     }
   }
   Statement u(*this, "UPDATE jobs SET run_key = ?, run_protocol = ? WHERE id = ?");
   for (const auto& [id, key] : changed) {
     u.bind(1, key.key).bind(2, key.protocol).bind(3, id).step();
     u.reset();
+  }
+  Statement d(*this, "DELETE FROM checkpoints WHERE job_id = ?");
+  for (const std::int64_t id : rekeyed) {
+    d.bind(1, id).step();
+    d.reset();
   }
   tx.commit();
 }

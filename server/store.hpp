@@ -261,7 +261,9 @@ class Store {
   /// Sets the run key of every job that has none yet (jobs of a file from before run keys) and of
   /// every job not done to `key_of(payload)`: a job planned under another version of its test's
   /// protocol is simulated under this one and must be known by this one's key. A done job keeps
-  /// the key its result was simulated under. An empty key marks a job that is never reused.
+  /// the key its result was simulated under. An empty key marks a job that is never reused. A
+  /// job whose key changes loses its checkpoint: the state was simulated as another run (another
+  /// protocol version of its test) and goes on as none under this one.
   void refresh_run_keys(const std::function<RunKey(const std::string& payload)>& key_of);
   /// Extends the current, unexpired lease held by `worker`. A beat of a lease whose result that
   /// worker has stored (a beat sent while its Complete was being answered) is kOk and extends

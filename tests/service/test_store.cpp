@@ -277,6 +277,39 @@ TEST(Store, KeepsTheLatestCheckpointOfTheLeaseHolderUntilTheResultIsStored) {
   EXPECT_FALSE(s.checkpoint(b->id));
 }
 
+// A build that raises a test's protocol version re-keys its jobs not done: a job's checkpoint was
+// simulated under the old protocol, so a re-keyed job starts afresh; a job whose key stays keeps
+// its checkpoint.
+TEST(Store, AJobReKeyedUnderAnotherProtocolLosesItsCheckpoint) {
+  Store s(":memory:", {10.0, 3});
+  s.create_campaign(
+      "c", "{}", "{}",
+      {{1, 1, "shear_cell", "design", R"({"row":1})"}, {2, 2, "packing", "design", R"({"row":2})"}},
+      0.0);
+  s.refresh_run_keys([](const std::string& payload) { return RunKey{"v4 " + payload, 4}; });
+  const auto a = s.lease("w1", 0.0);
+  const auto b = s.lease("w2", 0.0);
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(s.save_checkpoint(a->id, 1, "w1", "settling", "a", 1.0), kOk);
+  EXPECT_EQ(s.save_checkpoint(b->id, 1, "w2", "settling", "b", 1.0), kOk);
+  EXPECT_EQ(s.reap(20.0), 2);
+  s.refresh_run_keys([](const std::string& payload) { return RunKey{"v4 " + payload, 4}; });
+  EXPECT_TRUE(s.checkpoint(a->id));
+  EXPECT_TRUE(s.checkpoint(b->id));
+  // The shear cell's protocol goes to 5; the packing's stays.
+  s.refresh_run_keys([](const std::string& payload) {
+    return payload == R"({"row":1})" ? RunKey{"v5 " + payload, 5} : RunKey{"v4 " + payload, 4};
+  });
+  EXPECT_EQ(s.job(a->id)->run_key, (RunKey{R"(v5 {"row":1})", 5}));
+  EXPECT_FALSE(s.checkpoint(a->id));
+  ASSERT_TRUE(s.checkpoint(b->id));
+  EXPECT_EQ(s.checkpoint(b->id)->state, "b");
+  const auto again = s.lease("w3", 21.0);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->id, a->id);  // run order 1 first
+  EXPECT_FALSE(s.checkpoint(again->id));
+}
+
 TEST(Store, KeepsTheFlagsAndTheCostOfAResult) {
   Store s(":memory:");
   s.create_campaign("c", "{}", "{}", jobs(2), 0.0);
