@@ -160,8 +160,9 @@ TEST(SimStep, ChangedLawOfOtherModelsStartsTheContactHistoryAfresh) {
 }
 
 TEST(SimHealth, AnEscapedParticleIsNamedWithItsVelocityAndTheWallsItTouches) {
-  // Three particles above the volume's top (z <= 0): one pressed into a vertical plane wall and a
-  // mesh quad beside it (the vessel a particle slides up), one in the gap of neither, one free.
+  // A particle above the volume's top (z <= 0), placed three times: pressed into a vertical plane
+  // wall (the vessel a particle slides up) and a mesh quad above it, 0.1 and 0.3 mm short of
+  // both, and against the plane alone.
   sim::World w = falling_sphere();
   w.walls.push_back(walls::make_wall("vessel", walls::Plane{{0, 0, 0}, {1, 0, 0}}));
   w.walls.push_back(walls::make_wall(
