@@ -31,11 +31,14 @@ std::string utc_time(double unix_seconds) {
   return s.str();
 }
 
-/// One job of `demcal status --jobs`: its state, metrics (a flagged one marked '!', its reason on
-/// a line of its own), cost, error, reuse, and its checkpoint with the run's clock there.
+/// One job of `demcal status --jobs`: its state, how often it yielded, metrics (a flagged one
+/// marked '!', its reason on a line of its own), cost, error, reuse, and its checkpoint with the
+/// run's clock there.
 void print_job_line(const v1::JobResult& j) {
   std::cout << "  job " << j.job_id() << " " << j.kind() << " run " << j.std_order() << " "
             << j.test() << " " << j.state() << " attempt " << j.attempt();
+  if (j.yields() > 0)
+    std::cout << " yielded " << j.yields() << (j.yields() == 1 ? " time" : " times");
   for (const auto& [k, v] : j.metrics())
     std::cout << " " << k << "=" << v << (j.flags().contains(k) ? "!" : "");
   if (j.has_cost() && j.cost().wall_seconds() > 0.0)

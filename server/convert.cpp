@@ -157,6 +157,7 @@ v1::JobResult job_message(const JobRow& job) {
   r.set_kind(job.kind);
   r.set_state(job.state);
   r.set_attempt(job.attempt);
+  r.set_yields(job.yields);
   if (job.metrics_json)
     for (const auto& [k, v] : metrics_from_json(*job.metrics_json)) (*r.mutable_metrics())[k] = v;
   r.set_error(job.error);

@@ -502,7 +502,7 @@ constexpr const char* kJobColumns =
     "j.worker, j.error, j.attempt, j.counted, j.lease_deadline, r.metrics_json, "
     "COALESCE(r.wall_seconds, 0), j.finished, COALESCE(r.flags_json, '{}'), "
     "COALESCE(r.cost_json, '{}'), COALESCE(j.run_key, ''), COALESCE(r.attempt, 0), "
-    "COALESCE(r.reused_from, 0), COALESCE(r.reused_journal, ''), j.run_protocol "
+    "COALESCE(r.reused_from, 0), COALESCE(r.reused_journal, ''), j.run_protocol, j.yields "
     "FROM jobs j LEFT JOIN results r ON r.job_id = j.id";
 }
 
@@ -531,6 +531,7 @@ JobRow read_job(const S& s) {
   j.result_attempt = s.i32(19);
   j.reused_from = s.i64(20);
   j.reused_journal = s.text(21);
+  j.yields = s.i32(23);
   return j;
 }
 

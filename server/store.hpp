@@ -77,6 +77,7 @@ struct JobRow {
   std::string test, kind, state, payload, worker, error;
   int attempt = 0;  ///< leases handed out so far (the current lease's number)
   int counted = 0;  ///< attempts counted against the cap (give-backs are not)
+  int yields = 0;   ///< leases given back at a checkpoint to shorter runs (--yield-after)
   double lease_deadline = 0.0;
   std::optional<std::string> metrics_json;  ///< the stored result
   double wall_seconds = 0.0;

@@ -720,6 +720,8 @@ TEST(Store, ALongLeaseYieldsToTheQueuedJobsAndItsJobGoesBehindThem) {
   EXPECT_EQ(a2->id, a->id);
   EXPECT_EQ(a2->attempt, 2);
   EXPECT_EQ(a2->counted, 1);  // the yield was not counted against the cap of 2
+  EXPECT_EQ(a2->yields, 1);
+  EXPECT_EQ(s.job(c->id)->yields, 0);
   EXPECT_FALSE(s.yield_due(a->id, 103.0, 2.0));
   EXPECT_TRUE(s.yield_due(a->id, 104.5, 2.0));  // b waits, yielded as often
   // Once b runs too, nothing waits: a runs on.
