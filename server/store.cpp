@@ -142,6 +142,11 @@ class Store::Guard {
   double start_;
 };
 
+void Store::drop_checkpoint(std::int64_t job_id) {
+  Statement d(*this, "DELETE FROM checkpoints WHERE job_id = ?");
+  d.bind(1, job_id).step();
+}
+
 void Store::extend_deadlines(double seconds) {
   for (auto& [job, lease] : leases_) {
     lease.began += seconds;
@@ -711,8 +716,7 @@ bool Store::take_finished_run(std::int64_t job_id, const std::string& key) {
   }
   Statement u(*this, "UPDATE jobs SET state = 'done', finished = ?, error = '' WHERE id = ?");
   u.bind(1, stored).bind(2, job_id).step();
-  Statement d(*this, "DELETE FROM checkpoints WHERE job_id = ?");
-  d.bind(1, job_id).step();
+  drop_checkpoint(job_id);
   return true;
 }
 
@@ -739,8 +743,9 @@ std::optional<JobRow> Store::lease(const std::string& worker, double now) {
   r.step();
   JobRow job = read_job(r);
   tx.commit();
-  leases_[id] = {now, now + limits_.lease_seconds};
-  job.lease_deadline = leases_[id].deadline;
+  const LeaseClock clock{now, now + limits_.lease_seconds};
+  leases_[id] = clock;
+  job.lease_deadline = clock.deadline;
   return job;
 }
 
@@ -798,8 +803,12 @@ std::vector<HeldRun> Store::journal_runs_at(const std::string& test, const std::
 void Store::refresh_run_keys(const std::function<RunKey(const std::string& payload)>& key_of) {
   Guard lock(*this);
   Transaction tx(*this);
-  std::vector<std::pair<std::int64_t, RunKey>> changed;
-  std::vector<std::int64_t> rekeyed;  // had a key, now another: their checkpoints go
+  struct Change {
+    std::int64_t id;
+    RunKey key;
+    bool had_key;  // and now another: its checkpoint goes
+  };
+  std::vector<Change> changed;
   {
     Statement s(
         *this,
@@ -808,21 +817,15 @@ void Store::refresh_run_keys(const std::function<RunKey(const std::string& paylo
     while (s.step()) {
       RunKey key = key_of(s.text(1));
       const bool had_key = s.i64(4) == 0;
-      if (!had_key || key.key != s.text(2) || key.protocol != s.i64(3)) {
-        if (had_key) rekeyed.push_back(s.i64(0));
-        changed.emplace_back(s.i64(0), std::move(key));
-      }
+      if (!had_key || key.key != s.text(2) || key.protocol != s.i64(3))
+        changed.push_back({s.i64(0), std::move(key), had_key});
     }
   }
   Statement u(*this, "UPDATE jobs SET run_key = ?, run_protocol = ? WHERE id = ?");
-  for (const auto& [id, key] : changed) {
+  for (const auto& [id, key, had_key] : changed) {
     u.bind(1, key.key).bind(2, key.protocol).bind(3, id).step();
     u.reset();
-  }
-  Statement d(*this, "DELETE FROM checkpoints WHERE job_id = ?");
-  for (const std::int64_t id : rekeyed) {
-    d.bind(1, id).step();
-    d.reset();
+    if (had_key) drop_checkpoint(id);
   }
   tx.commit();
 }
@@ -881,8 +884,7 @@ LeaseAnswer Store::complete(std::int64_t job_id, int attempt, const std::string&
     Statement c(*this, "INSERT INTO result_series (job_id, series_json) VALUES (?, ?)");
     c.bind(1, job_id).bind(2, series_json).step();
   }
-  Statement d(*this, "DELETE FROM checkpoints WHERE job_id = ?");
-  d.bind(1, job_id).step();
+  drop_checkpoint(job_id);
   finish_campaigns(stored);
   tx.commit();
   leases_.erase(job_id);

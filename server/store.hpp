@@ -337,6 +337,8 @@ class Store {
   /// `version_found` is the schema version the file had (whether a migration ran).
   void require_foreign_keys(const std::string& path, int version_found);
   void finish_campaigns(double now);
+  /// Deletes the job's checkpoint, if any (inside the caller's transaction).
+  void drop_checkpoint(std::int64_t job_id);
   /// Inserts jobs[first, end) as queued jobs of the campaign; inside a transaction.
   std::vector<std::int64_t> insert_job_rows(std::int64_t campaign_id,
                                             const std::vector<NewJob>& jobs, std::size_t first,
