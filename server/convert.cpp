@@ -101,15 +101,16 @@ v1::Progress progress_message(const CampaignRow& row, const Counts& c, double no
   p.set_reused(c.reused);
   p.set_total(c.total());
   const double end = row.finished > 0 ? row.finished : now;
-  const double elapsed = std::max(0.0, end - row.created);
-  p.set_elapsed_seconds(elapsed);
-  // The rate of the jobs simulated here: a result taken from an earlier run (a journal's, another
-  // campaign's) took no time, and a campaign resumed from its journal takes many at once.
-  const auto simulated = c.done - c.reused + c.failed;
+  p.set_elapsed_seconds(std::max(0.0, end - row.created));
+  // The rate of the jobs simulated since the store was opened: a result taken from an earlier
+  // run (a journal's, another campaign's) took no time, and the days a campaign waited for its
+  // coordinator to run again are no part of its jobs' cost.
+  const double window = std::max(0.0, end - std::max(row.created, c.opening));
   const auto remaining = c.queued + c.leased;
-  p.set_eta_seconds(remaining == 0  ? 0.0
-                    : simulated > 0 ? elapsed / double(simulated) * double(remaining)
-                                    : -1.0);
+  p.set_eta_seconds(remaining == 0 ? 0.0
+                    : c.simulated_since_opening > 0
+                        ? window / double(c.simulated_since_opening) * double(remaining)
+                        : -1.0);
   return p;
 }
 

@@ -179,7 +179,7 @@ sqlite3* open_connection(const std::string& path, int flags) {
 }  // namespace
 
 Store::Store(const std::string& path, StoreLimits limits, std::optional<double> opened)
-    : lock_(path), limits_(limits) {
+    : lock_(path), limits_(limits), opened_wall_(wall_seconds()) {
   create_private_file(path);
   db_ = open_connection(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX);
   try {
@@ -483,15 +483,19 @@ std::vector<CampaignRow> Store::campaigns() {
 Counts Store::counts(std::int64_t campaign_id, const std::string& kind) {
   Guard lock(*this);
   Statement s(*this,
-              "SELECT j.state, COUNT(*), SUM(r.reused_from != 0 OR r.reused_journal != '') "
+              "SELECT j.state, COUNT(*), SUM(r.reused_from != 0 OR r.reused_journal != ''), "
+              "SUM(j.state IN ('done', 'failed') AND j.finished >= ? "
+              "    AND COALESCE(r.reused_from = 0 AND r.reused_journal = '', 1)) "
               "FROM jobs j LEFT JOIN results r ON r.job_id = j.id "
               "WHERE j.campaign_id = ? AND (? = '' OR j.kind = ?) GROUP BY j.state");
-  s.bind(1, campaign_id).bind(2, kind).bind(3, kind);
+  s.bind(1, opened_wall_).bind(2, campaign_id).bind(3, kind).bind(4, kind);
   Counts c;
+  c.opening = opened_wall_;
   while (s.step()) {
     const std::string st = s.text(0);
     const std::int64_t n = s.i64(1);
     c.reused += s.i64(2);  // NULL (0) for the states without results
+    c.simulated_since_opening += s.i64(3);
     if (st == "queued") c.queued = n;
     if (st == "leased") c.leased = n;
     if (st == "done") c.done = n;

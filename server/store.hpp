@@ -149,6 +149,11 @@ struct CheckpointMark {
 struct Counts {
   std::int64_t queued = 0, leased = 0, done = 0, failed = 0, cancelled = 0;
   std::int64_t reused = 0;  ///< of done: results taken from an earlier run with the same run key
+  /// The window a rate is measured over: the jobs simulated (done or failed, not taken from an
+  /// earlier run) since the store was opened, and the wall-clock time of that opening. A campaign
+  /// resumed after days away is rated on this run of its coordinator only.
+  std::int64_t simulated_since_opening = 0;
+  double opening = 0.0;
   std::int64_t total() const { return queued + leased + done + failed + cancelled; }
 };
 
@@ -369,6 +374,7 @@ class Store {
   /// mutex_ like the connection.
   std::unordered_map<std::string, sqlite3_stmt*> idle_statements_;
   StoreLimits limits_;
+  double opened_wall_ = 0.0;  ///< wall-clock seconds of the opening (Counts::opening)
   std::mutex mutex_;
   /// A current lease's clock: when it began and when it expires unless renewed.
   struct LeaseClock {

@@ -920,13 +920,61 @@ TEST(Progress, TheEtaIsRatedOnTheJobsSimulatedNotOnTheResultsTaken) {
   Counts c;
   c.done = 31;
   c.reused = 30;
+  c.simulated_since_opening = 1;
   c.leased = 2;
   c.queued = 18;
   EXPECT_DOUBLE_EQ(progress_message(row, c, 1600.0).eta_seconds(), 600.0 * 20);
   c.done = c.reused;  // nothing simulated yet: no rate, no estimate
+  c.simulated_since_opening = 0;
   EXPECT_EQ(progress_message(row, c, 1600.0).eta_seconds(), -1.0);
   c.queued = c.leased = 0;
   EXPECT_EQ(progress_message(row, c, 1600.0).eta_seconds(), 0.0);
+}
+
+// A campaign created three days ago whose coordinator ran again an hour ago and has simulated two
+// jobs since: the ETA is that hour's rate, not the three days' (whose jobs ran in other runs).
+TEST(Progress, TheEtaOfACampaignResumedAfterDaysIsRatedOnItsCoordinatorsCurrentRun) {
+  CampaignRow row;
+  row.created = 1000.0;
+  Counts c;
+  c.done = 12;
+  c.simulated_since_opening = 2;
+  c.opening = row.created + 3 * 86400.0;
+  c.leased = 1;
+  c.queued = 9;
+  const double now = c.opening + 3600.0;
+  const auto p = progress_message(row, c, now);
+  EXPECT_DOUBLE_EQ(p.elapsed_seconds(), now - row.created);
+  EXPECT_DOUBLE_EQ(p.eta_seconds(), 3600.0 / 2 * 10);
+}
+
+// The store counts a job as simulated in its current opening only if it ended after that opening
+// and its result was simulated, not taken from another job with its run key.
+TEST(Store, CountsTheJobsSimulatedSinceItWasOpened) {
+  const TempStoreFile file("simulated_since_opening");
+  double first_finished = 0.0;
+  {
+    Store s(file.path().string());
+    const auto id = s.create_campaign(
+        "c", "{}", "{}", {keyed_job(1, "k1"), keyed_job(2, "k2"), keyed_job(3, "k1")}, 0.0);
+    const auto a = s.lease("w", 1.0);
+    ASSERT_TRUE(a);
+    EXPECT_EQ(s.complete(a->id, 1, "w", "{}", 1.0, 2.0), kOk);
+    EXPECT_EQ(s.counts(id).simulated_since_opening, 1);
+    first_finished = s.job(a->id)->finished;
+  }
+  Store s(file.path().string());
+  EXPECT_EQ(s.counts(1).simulated_since_opening, 0);  // it ended before this opening
+  EXPECT_GT(s.counts(1).opening, first_finished);
+  const auto b = s.lease("w", 1.0);
+  ASSERT_TRUE(b);
+  EXPECT_EQ(b->run_key.key, "k2");
+  EXPECT_EQ(s.complete(b->id, 1, "w", "{}", 1.0, 2.0), kOk);
+  EXPECT_FALSE(s.lease("w", 3.0));  // run 3 takes run 1's result instead of a lease
+  const auto c = s.counts(1);
+  EXPECT_EQ(c.done, 3);
+  EXPECT_EQ(c.reused, 1);
+  EXPECT_EQ(c.simulated_since_opening, 1);
 }
 
 }  // namespace
