@@ -482,19 +482,22 @@ std::vector<CampaignRow> Store::campaigns() {
 
 Counts Store::counts(std::int64_t campaign_id, const std::string& kind) {
   Guard lock(*this);
+  // `reused`: the job's result was taken from an earlier run (0 for the states without results).
   Statement s(*this,
-              "SELECT j.state, COUNT(*), SUM(r.reused_from != 0 OR r.reused_journal != ''), "
-              "SUM(j.state IN ('done', 'failed') AND j.finished >= ? "
-              "    AND COALESCE(r.reused_from = 0 AND r.reused_journal = '', 1)) "
-              "FROM jobs j LEFT JOIN results r ON r.job_id = j.id "
-              "WHERE j.campaign_id = ? AND (? = '' OR j.kind = ?) GROUP BY j.state");
+              "SELECT state, COUNT(*), SUM(reused), "
+              "SUM(state IN ('done', 'failed') AND finished >= ? AND NOT reused) "
+              "FROM (SELECT j.state, j.finished, "
+              "      COALESCE(r.reused_from != 0 OR r.reused_journal != '', 0) AS reused "
+              "      FROM jobs j LEFT JOIN results r ON r.job_id = j.id "
+              "      WHERE j.campaign_id = ? AND (? = '' OR j.kind = ?)) "
+              "GROUP BY state");
   s.bind(1, opened_wall_).bind(2, campaign_id).bind(3, kind).bind(4, kind);
   Counts c;
   c.opening = opened_wall_;
   while (s.step()) {
     const std::string st = s.text(0);
     const std::int64_t n = s.i64(1);
-    c.reused += s.i64(2);  // NULL (0) for the states without results
+    c.reused += s.i64(2);
     c.simulated_since_opening += s.i64(3);
     if (st == "queued") c.queued = n;
     if (st == "leased") c.leased = n;
