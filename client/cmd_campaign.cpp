@@ -1,5 +1,5 @@
-// `demcal list | status ID|SPEC | watch ID | cancel ID`: campaigns on a coordinator (status also
-// of a spec's campaign on the embedded default).
+// `demcal list | status ID|SPEC | watch ID | cancel ID | give-up ID|SPEC`: campaigns on a
+// coordinator (status and give-up also of a spec's campaign on the embedded default).
 #include <algorithm>
 #include <ctime>
 #include <iomanip>
@@ -99,6 +99,8 @@ void add_campaign_commands(CLI::App& app) {
     std::string workdir;   ///< status of a spec: its work directory
     bool jobs = false;
     std::string format = "table";
+    std::int64_t job = 0;  ///< give-up: the job
+    std::string reason;    ///< give-up: why
   };
   auto o = std::make_shared<Options>();
 
@@ -130,7 +132,7 @@ void add_campaign_commands(CLI::App& app) {
         [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
           print_status(stub, channel, id, o->jobs, o->format);
         },
-        {}, /*run_jobs=*/false);
+        {}, Reach::kLook);
   });
 
   auto* watch = app.add_subcommand("watch", "Follow a campaign with a progress bar and ETA");
@@ -151,6 +153,32 @@ void add_campaign_commands(CLI::App& app) {
     check(campaign_stub(o->channel)->Cancel(rpc::make_context(o->channel, 30).get(), req, &c),
           "cancel");
     print_campaign_row(c);
+  });
+
+  auto* give_up = app.add_subcommand(
+      "give-up", "Give up one queued or running job: it fails, the campaign goes on without it");
+  add_connection_options(*give_up, o->channel);
+  give_up->add_option("campaign", o->campaign, "campaign id, or a spec YAML (embedded default)")
+      ->required();
+  give_up->add_option("--workdir", o->workdir, "embedded: directory of the SQLite file");
+  give_up->add_option("--job", o->job, "the job's id (demcal status --jobs)")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  give_up->add_option("--reason", o->reason, "why, kept as the job's error")->required();
+  give_up->callback([o] {
+    // A spec's store is changed in place, never in a copy: refused while a coordinator holds it.
+    with_campaign(
+        o->campaign, o->workdir, LocalWorkers{}, false, o->channel,
+        [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
+          v1::GiveUpRequest req;
+          req.set_campaign_id(id);
+          req.set_job_id(o->job);
+          req.set_reason(o->reason);
+          v1::JobResult j;
+          check(stub.GiveUp(rpc::make_context(channel, 30).get(), req, &j), "give-up");
+          print_job_line(j);
+        },
+        {}, Reach::kChange);
   });
 }
 

@@ -361,13 +361,13 @@ void add_analysis_commands(CLI::App& app) {
                        "calibrated set's)");
     // One job's spec is written in any state of the job, so a spec's campaign is not run first
     // for it: the store is read as it stands (a copy when a running coordinator holds it).
-    const bool run_first = e->job == 0;
+    const Reach reach = e->job == 0 ? Reach::kRun : Reach::kLook;
     with_campaign(
         e->campaign, e->workdir, e->local, e->verbose, e->channel,
         [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
           write_export(stub, channel, id, *e);
         },
-        {}, run_first);
+        {}, reach);
   });
 }
 

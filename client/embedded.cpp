@@ -107,6 +107,19 @@ std::optional<std::string> why_look_at_a_copy(const std::filesystem::path& store
          std::to_string(found);
 }
 
+/// Throws InputError unless store file `store` exists and no running coordinator holds it: a
+/// change is made to the file itself, never to a copy.
+void require_a_store_to_change(const std::filesystem::path& store) {
+  if (const auto pid = server::StoreLock::holder(store.string()))
+    throw InputError("", "the store " + store.string() + " is held by a running coordinator" +
+                             (pid->empty() ? "" : " (pid " + *pid + ")") +
+                             ": stop it first (SIGTERM gives its leases back), or make the change "
+                             "through that coordinator by campaign id");
+  if (!std::filesystem::is_regular_file(store))
+    throw InputError("", "no campaign store " + store.string() +
+                             " (run the spec there first, or name its --workdir)");
+}
+
 }  // namespace
 
 std::filesystem::path work_directory(const std::string& spec, const std::string& workdir) {
@@ -116,13 +129,14 @@ std::filesystem::path work_directory(const std::string& spec, const std::string&
 
 void with_campaign(const std::string& campaign, const std::string& workdir,
                    const LocalWorkers& local, bool verbose, const rpc::ChannelOptions& channel,
-                   const CampaignAction& act, const std::string& journal, bool run_jobs) {
+                   const CampaignAction& act, const std::string& journal, Reach reach) {
   if (std::filesystem::is_regular_file(campaign)) {
     const SpecFile file = read_campaign_spec(campaign);
     std::filesystem::path dir = work_directory(campaign, workdir);
     std::optional<StoreCopy> copy;
     const std::filesystem::path store = EmbeddedService::store_path(dir);
-    if (!run_jobs)
+    if (reach == Reach::kChange) require_a_store_to_change(store);
+    if (reach == Reach::kLook)
       if (const auto why = why_look_at_a_copy(store)) {
         copy.emplace(store);
         std::cerr << "the store " << store.string() << " " << *why
@@ -132,9 +146,12 @@ void with_campaign(const std::string& campaign, const std::string& workdir,
     // Read before anything starts: a journal with a bad line refuses the command.
     std::optional<CampaignJournal> runs;
     if (!journal.empty() && !copy) runs.emplace(journal);
+    const bool run_jobs = reach == Reach::kRun;
     const LocalWorkers workers = run_jobs ? local : LocalWorkers{.workers = 0};
     EmbeddedService service(dir, workers, verbose);
-    const std::int64_t id = service.submit_or_resume(file, std::cerr, runs ? &*runs : nullptr);
+    const std::int64_t id = reach == Reach::kChange ? service.resume(file, std::cerr)
+                                                    : service.submit_or_resume(
+                                                          file, std::cerr, runs ? &*runs : nullptr);
     if (run_jobs) watch_campaign(service.stub(), service.channel(), id, std::cerr);
     act(service.stub(), service.channel(), id);
     return;
@@ -284,17 +301,36 @@ std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostrea
   return id;
 }
 
-std::int64_t EmbeddedService::submit_or_resume_campaign(const SpecFile& file, std::ostream& out) {
+namespace {
+
+/// Says that campaign `id` of `file` is resumed; returns `id`.
+std::int64_t resuming(std::int64_t id, const SpecFile& file, std::ostream& out) {
+  out << "resuming campaign " << id << " '" << file.spec.name() << "'\n";
+  return id;
+}
+
+}  // namespace
+
+std::int64_t EmbeddedService::resumable_campaign(const SpecFile& file) {
   v1::ListReply list;
   check(stub_->List(rpc::make_context(channel_, 30).get(), {}, &list), "list");
   std::int64_t id = 0;
   for (const auto& c : list.campaigns())
     if (c.name() == file.spec.name() && c.state() != v1::CANCELLED) id = std::max(id, c.id());
-  if (id) {
-    refuse_if_another_spec(id, file);
-    out << "resuming campaign " << id << " '" << file.spec.name() << "'\n";
-    return id;
-  }
+  if (id) refuse_if_another_spec(id, file);
+  return id;
+}
+
+std::int64_t EmbeddedService::resume(const SpecFile& file, std::ostream& out) {
+  const std::int64_t id = resumable_campaign(file);
+  if (!id)
+    throw InputError(
+        "", "no campaign '" + file.spec.name() + "' of " + file.name + " in " + workdir_.string());
+  return resuming(id, file, out);
+}
+
+std::int64_t EmbeddedService::submit_or_resume_campaign(const SpecFile& file, std::ostream& out) {
+  if (const std::int64_t id = resumable_campaign(file)) return resuming(id, file, out);
   v1::SubmitRequest req;
   *req.mutable_spec() = file.spec;
   v1::SubmitReply reply;

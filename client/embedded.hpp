@@ -58,6 +58,9 @@ class EmbeddedService {
   /// signal.
   std::int64_t submit_or_resume(const SpecFile& file, std::ostream& out,
                                 CampaignJournal* journal = nullptr);
+  /// The campaign of the spec's name in this work directory, as submit_or_resume finds it;
+  /// InputError naming the directory when there is none (nothing is submitted).
+  std::int64_t resume(const SpecFile& file, std::ostream& out);
 
   /// Serves the live report page on `address` (HOST:PORT, loopback or with the embedded
   /// token) while this service lives. Returns the page's URL of campaign `id`, the token in
@@ -76,6 +79,9 @@ class EmbeddedService {
   void refuse_if_another_spec(std::int64_t id, const SpecFile& file);
   /// submit_or_resume without a journal.
   std::int64_t submit_or_resume_campaign(const SpecFile& file, std::ostream& out);
+  /// The newest campaign not cancelled of the spec's name in this work directory; 0 when there
+  /// is none. InputError as refuse_if_another_spec.
+  std::int64_t resumable_campaign(const SpecFile& file);
 
   std::filesystem::path workdir_;
   std::string db_;
@@ -96,17 +102,24 @@ std::filesystem::path work_directory(const std::string& spec, const std::string&
 using CampaignAction = std::function<void(v1::CampaignService::Stub& stub,
                                           const rpc::ChannelOptions& channel, std::int64_t id)>;
 
+/// What a command does to a campaign's store on the embedded default.
+enum class Reach {
+  kRun,     ///< runs its jobs on local workers, watched until they end
+  kLook,    ///< runs nothing and reads the store as it stands: a copy taken now when a running
+            ///< coordinator holds it or its schema is older than this build's
+  kChange,  ///< runs nothing and changes the store itself: refused when a running coordinator
+            ///< holds it (a copy's change would be thrown away) or there is none yet
+};
+
 /// Reaches the campaign a command names and runs `act` on it: a spec YAML file on the embedded
-/// default (submitted or resumed in `workdir`, watched until its jobs end; with `run_jobs` false
-/// no local worker starts and `act` sees the store as it stands, in a copy taken now when a
-/// running coordinator holds it or its schema is older than this build's), otherwise a campaign id
-/// on the coordinator of `channel`. With a `journal` (spec files only) its runs are taken first and
+/// default (submitted or resumed in `workdir`, as `reach` says), otherwise a campaign id on the
+/// coordinator of `channel`. With a `journal` (spec files only, kRun) its runs are taken first and
 /// every job finished meanwhile is appended to it, as `demcal run --journal` does (not in a copy:
 /// the journal is its holder's). CLI::ValidationError for text that is neither, or for a journal
-/// with a campaign id.
+/// with a campaign id; InputError naming the store for a change it cannot take.
 void with_campaign(const std::string& campaign, const std::string& workdir,
                    const LocalWorkers& local, bool verbose, const rpc::ChannelOptions& channel,
                    const CampaignAction& act, const std::string& journal = {},
-                   bool run_jobs = true);
+                   Reach reach = Reach::kRun);
 
 }  // namespace demcal::cli

@@ -12,7 +12,7 @@ namespace demcal::server {
 
 /// Who may call what. `both` opens every service (the operator's token); `worker` only the
 /// WorkerService (Lease, Heartbeat, Complete, Fail), `client` only the CampaignService (Submit,
-/// Cancel, queries). All empty: auth disabled (only allowed on loopback).
+/// Cancel, GiveUp, queries). All empty: auth disabled (only allowed on loopback).
 struct Tokens {
   std::string both, worker, client;
   bool empty() const { return both.empty() && worker.empty() && client.empty(); }

@@ -35,8 +35,9 @@ int main(int argc, char** argv) {
                  "read the token from a file (it opens both services: the operator's)");
   app.add_option("--worker-token-file", worker_token_file,
                  "the token of workers: Lease, Heartbeat, Complete, Fail only");
-  app.add_option("--client-token-file", client_token_file,
-                 "the token of clients: the campaign service only (submit, cancel, queries)");
+  app.add_option(
+      "--client-token-file", client_token_file,
+      "the token of clients: the campaign service only (submit, cancel, give-up, queries)");
   app.add_flag("--no-auth", o.no_auth,
                "serve without any token (loopback only); without it a token is required");
   app.add_flag("--reflection", o.reflection,

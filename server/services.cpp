@@ -258,6 +258,28 @@ grpc::Status CampaignServiceImpl::Cancel(grpc::ServerContext* ctx, const v1::Can
   return grpc::Status::OK;
 }
 
+grpc::Status CampaignServiceImpl::GiveUp(grpc::ServerContext* ctx, const v1::GiveUpRequest* req,
+                                         v1::JobResult* reply) {
+  if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
+  if (req->reason().empty() || req->reason().size() > kMaxReason)
+    return {grpc::StatusCode::INVALID_ARGUMENT,
+            fmt::format("reason: {} bytes, must be 1-{} (why the job is given up)",
+                        req->reason().size(), kMaxReason)};
+  if (!store_.campaign(req->campaign_id())) return not_found(req->campaign_id());
+  const std::string job = "job " + std::to_string(req->job_id());
+  if (!store_.give_up(req->campaign_id(), req->job_id(), req->reason())) {
+    const auto row = store_.job(req->job_id());
+    if (!row || row->campaign_id != req->campaign_id())
+      return {grpc::StatusCode::NOT_FOUND,
+              "campaign " + std::to_string(req->campaign_id()) + " has no " + job};
+    return {grpc::StatusCode::FAILED_PRECONDITION,
+            job + " is " + row->state + ": only a queued or running job can be given up"};
+  }
+  spdlog::info("campaign {}: {} given up: {}", req->campaign_id(), job, req->reason());
+  *reply = job_message(*store_.job(req->job_id()));
+  return grpc::Status::OK;
+}
+
 grpc::Status CampaignServiceImpl::Watch(grpc::ServerContext* ctx, const v1::WatchRequest* req,
                                         grpc::ServerWriter<v1::Progress>* writer) {
   if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;

@@ -593,6 +593,22 @@ bool Store::cancel(std::int64_t campaign_id, double now) {
   return true;
 }
 
+bool Store::give_up(std::int64_t campaign_id, std::int64_t job_id, const std::string& reason) {
+  Guard lock(*this);
+  Transaction tx(*this);
+  const double at = wall_seconds();
+  Statement u(*this,
+              "UPDATE jobs SET state = 'failed', error = ?, finished = ?, lease_deadline = 0 "
+              "WHERE id = ? AND campaign_id = ? AND state IN ('queued', 'leased')");
+  u.bind(1, "given up: " + reason).bind(2, at).bind(3, job_id).bind(4, campaign_id).step();
+  if (sqlite3_changes(db_) == 0) return false;
+  drop_checkpoint(job_id);
+  finish_campaigns(at);
+  tx.commit();
+  leases_.erase(job_id);
+  return true;
+}
+
 std::vector<std::int64_t> Store::insert_jobs(std::int64_t campaign_id,
                                              const std::vector<NewJob>& jobs) {
   auto ids = insert_job_rows(campaign_id, jobs, 0, jobs.size());

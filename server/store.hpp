@@ -18,6 +18,7 @@
 //                                       leased --Fail(give_back)--> queued (attempt not counted;
 //                                                  with `yielded`, the job's yields + 1)
 //                      queued|leased --Cancel--> cancelled
+//                      queued|leased --GiveUp--> failed (error "given up: <reason>")
 // Every lease increments the job's attempt number; Heartbeat, Complete and Fail name
 // (job, attempt, worker) and change nothing unless that lease is the current one, has not
 // expired and is the caller's. A result is stored at most once per job (results.job_id is the
@@ -237,6 +238,11 @@ class Store {
   /// Cancels every queued or leased job of a running campaign; false when the campaign does not
   /// exist or is not running (done or already cancelled).
   bool cancel(std::int64_t campaign_id, double now);
+  /// Gives up job `job_id` of campaign `campaign_id`, queued or leased: it fails with the error
+  /// "given up: <reason>", its checkpoint is dropped, its lease (if any) ends and its campaign
+  /// finishes when no other job is left. False, changing nothing, when the campaign has no such
+  /// job or the job has ended (done, failed or cancelled).
+  bool give_up(std::int64_t campaign_id, std::int64_t job_id, const std::string& reason);
   /// Adds jobs to an existing campaign (verification runs); the campaign runs again.
   std::vector<std::int64_t> add_jobs(std::int64_t campaign_id, const std::vector<NewJob>& jobs);
   /// Stores a calibration round and queues its jobs in one transaction.

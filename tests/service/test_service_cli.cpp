@@ -10,10 +10,12 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <thread>
+#include <utility>
 
 #include "client/service_client.hpp"
 #include "client/spec_yaml.hpp"
@@ -173,6 +175,79 @@ TEST_F(Service, TheEmbeddedDefaultInterruptedCountsNoAttemptAgainstItsJobs) {
     given_back += sqlite3_column_int(st, 2) > 1;
   });
   EXPECT_GE(given_back, 1);
+}
+
+// `demcal give-up SPEC` changes the embedded store itself: refused while the campaign's `demcal
+// run` holds it, and where there is no store; done once the run has stopped, after which the run
+// goes on to the campaign's end without the job given up.
+TEST_F(Service, GiveUpOnTheEmbeddedDefaultChangesTheStoreOnlyWhenNoCoordinatorHoldsIt) {
+  const std::string spec = path("gaveup.yaml");
+  std::ofstream(spec) << wall_friction_spec("gaveup", "");
+  const std::string db = path("work/campaign.db");
+  // The last job in `state`, 0 if none; polled while the run creates the file, whose tables may
+  // not be there yet.
+  auto job_in = [&](const std::string& state) {
+    std::int64_t id = 0;
+    sqlite3* file = nullptr;
+    sqlite3_stmt* st = nullptr;
+    const std::string sql = "SELECT id FROM jobs WHERE state = '" + state + "' ORDER BY id";
+    if (fs::exists(db) &&
+        sqlite3_open_v2(db.c_str(), &file, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK &&
+        sqlite3_prepare_v2(file, sql.c_str(), -1, &st, nullptr) == SQLITE_OK)
+      while (sqlite3_step(st) == SQLITE_ROW) id = sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    sqlite3_close(file);
+    return id;
+  };
+  auto give_up = [&](const std::string& log, const std::string& workdir, std::int64_t job) {
+    Process p({DEMCAL_CLI_BIN, "give-up", spec, "--workdir", workdir, "--job", std::to_string(job),
+               "--reason", "creeps"},
+              path(log));
+    const int status = p.wait_exit(60);
+    return std::pair(status, p.log());
+  };
+  const auto [none, none_log] = give_up("none.log", path("elsewhere"), 1);
+  EXPECT_NE(none, 0);
+  EXPECT_NE(none_log.find("no campaign store"), std::string::npos) << none_log;
+  EXPECT_FALSE(fs::exists(path("elsewhere/campaign.db")));
+  const std::vector<std::string> run_argv{
+      DEMCAL_CLI_BIN, "run", spec,        "--workdir", path("work"),
+      "--workers",    "1",   "--threads", "1",         "--no-verify"};
+  auto given_up = [&] {
+    int n = 0;
+    each_row(db, "SELECT COUNT(*) FROM jobs WHERE error LIKE 'given up%'",
+             [&](sqlite3_stmt* st) { n = sqlite3_column_int(st, 0); });
+    return n;
+  };
+  {
+    Process run(run_argv, path("run1.log"));
+    ASSERT_TRUE(wait_until([&] { return job_in("leased") != 0; }, 60)) << run.log();
+    const auto [held, held_log] = give_up("held.log", path("work"), job_in("leased"));
+    EXPECT_NE(held, 0);
+    EXPECT_NE(held_log.find("held by a running coordinator"), std::string::npos) << held_log;
+    EXPECT_NE(held_log.find(db), std::string::npos) << held_log;
+    run.signal(SIGINT);
+    EXPECT_EQ(run.wait_exit(40), 128 + SIGINT) << run.log();
+  }
+  EXPECT_EQ(given_up(), 0);  // the refused give-up changed nothing
+  const std::int64_t queued = job_in("queued");
+  ASSERT_NE(queued, 0);
+  const auto [given, given_log] = give_up("given.log", path("work"), queued);
+  ASSERT_EQ(given, 0) << given_log;
+  EXPECT_NE(given_log.find("given up: creeps"), std::string::npos) << given_log;
+  const auto [again, again_log] = give_up("again.log", path("work"), queued);
+  EXPECT_NE(again, 0);
+  EXPECT_NE(again_log.find("is failed"), std::string::npos) << again_log;
+  Process last(run_argv, path("run2.log"));
+  ASSERT_EQ(last.wait_exit(150), 0) << last.log();
+  std::map<std::string, int> states;
+  each_row(db, "SELECT state FROM jobs", [&](sqlite3_stmt* st) {
+    ++states[reinterpret_cast<const char*>(sqlite3_column_text(st, 0))];
+  });
+  EXPECT_EQ(states["done"], 3);
+  EXPECT_EQ(states["failed"], 1);
+  EXPECT_EQ(job_in("failed"), queued);
+  EXPECT_EQ(given_up(), 1);
 }
 
 TEST_F(Service, AnExportLargerThanAGrpcMessageArrivesWhole) {

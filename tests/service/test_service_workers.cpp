@@ -475,6 +475,64 @@ TEST_F(Service, CancellingACampaignStopsTheWorkersSimulationAndFreesTheWorker) {
   EXPECT_EQ(stored_results().size(), 4u) << "the cancelled job reported nothing";
 }
 
+// Giving up the job a worker runs stops its simulation and fails it with the reason; the worker
+// goes on to the next job. Given up one by one (by the CLI, then by RPC), the campaign ends.
+// Giving up a job that has ended, of another campaign or without a reason is refused.
+TEST_F(Service, GivingUpARunningJobStopsItsSimulationAndTheCampaignGoesOnWithoutIt) {
+  start_server(/*lease=*/30, /*heartbeat=*/0.3);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(tiny_spec(kLongJobParticles), &id).ok());  // jobs of minutes
+  auto& worker = start_worker("w");
+  const std::int64_t running = wait_for_job(id, "leased", 30);
+  ASSERT_NE(running, 0);
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // well into the simulation
+  const std::string printed =
+      cli_text(dir_, "give-up.out",
+               {"give-up", std::to_string(id), "--job", std::to_string(running), "--reason",
+                "creeps toward its step limit"},
+               channel_);
+  EXPECT_NE(printed.find("job " + std::to_string(running)), std::string::npos) << printed;
+  EXPECT_NE(printed.find("failed"), std::string::npos) << printed;
+  ASSERT_TRUE(
+      wait_until([&] { return worker.log().find("simulation stopped") != std::string::npos; }, 60))
+      << worker.log();
+
+  v1::GiveUpRequest req;
+  req.set_campaign_id(id);
+  req.set_job_id(running);
+  req.set_reason("again");
+  v1::JobResult j;
+  EXPECT_EQ(campaigns_->GiveUp(ctx().get(), req, &j).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  req.set_campaign_id(id + 1);
+  EXPECT_EQ(campaigns_->GiveUp(ctx().get(), req, &j).error_code(), grpc::StatusCode::NOT_FOUND);
+  req.set_campaign_id(id);
+  req.set_job_id(running + 100);
+  EXPECT_EQ(campaigns_->GiveUp(ctx().get(), req, &j).error_code(), grpc::StatusCode::NOT_FOUND);
+  // The rest, queued or leased by the freed worker, one by one; a reason is required.
+  const auto before = results(id);
+  for (const auto& job : before.jobs()) {
+    if (job.state() != "queued" && job.state() != "leased") continue;
+    req.set_job_id(job.job_id());
+    req.set_reason("");
+    EXPECT_EQ(campaigns_->GiveUp(ctx().get(), req, &j).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT);
+    req.set_reason("not needed");
+    const auto st = campaigns_->GiveUp(ctx().get(), req, &j);
+    EXPECT_TRUE(st.ok() || st.error_code() == grpc::StatusCode::FAILED_PRECONDITION)
+        << st.error_message();
+  }
+  ASSERT_TRUE(wait_until([&] { return campaign_done(id); }, 30));
+  const auto after = results(id);
+  for (const auto& job : after.jobs()) {
+    EXPECT_EQ(job.state(), "failed") << job.job_id();
+    const std::string reason =
+        job.job_id() == running ? "creeps toward its step limit" : "not needed";
+    EXPECT_EQ(job.error(), "given up: " + reason);
+  }
+  EXPECT_TRUE(stored_results().empty()) << "a job given up reported a result";
+}
+
 TEST_F(Service, AJobOverTheWorkersLimitsFailsWithTheLimitNamed) {
   start_server(/*lease=*/30, /*heartbeat=*/0.3, 0, {"--max-attempts", "1"});
   // More particles than --max-particles: refused unrun.

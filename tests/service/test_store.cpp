@@ -1,10 +1,11 @@
 // The coordinator's store on :memory: and on a real file: migrations, WAL, the lease state
-// machine, exactly-once results, the retry cap, give-back and cancellation. Lease times are
-// seconds of a fake monotonic clock passed in as `now`.
+// machine, exactly-once results, the retry cap, give-back, giving a job up and cancellation. Lease
+// times are seconds of a fake monotonic clock passed in as `now`.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -758,6 +759,58 @@ TEST(Store, CancelStopsLeasingAndRefusesResults) {
   EXPECT_FALSE(s.cancel(done, 5.0));
   EXPECT_EQ(s.campaign(done)->state, "done");
   EXPECT_EQ(s.counts(done).done, 1);
+}
+
+// A job given up fails with its reason, loses its checkpoint and its lease (the worker's next
+// beat and result are refused), and the campaign goes on to its end without it.
+TEST(Store, AJobGivenUpFailsWithItsReasonAndTheCampaignEndsWithoutIt) {
+  Store s(":memory:", {10.0, 3});
+  const auto id = s.create_campaign("c", "{}", "{}", jobs(3), 0.0);
+  const auto creeping = s.lease("w", 0.0);
+  ASSERT_EQ(s.save_checkpoint(creeping->id, 1, "w", "settling", "state", 1.0), kOk);
+  EXPECT_FALSE(s.give_up(id + 1, creeping->id, "another campaign's job"));
+  EXPECT_TRUE(s.give_up(id, creeping->id, "creeps toward its step limit"));
+  EXPECT_FALSE(s.give_up(id, creeping->id, "twice"));  // it has ended
+  const auto row = s.job(creeping->id);
+  EXPECT_EQ(row->state, "failed");
+  EXPECT_EQ(row->error, "given up: creeps toward its step limit");
+  EXPECT_FALSE(s.checkpoint(creeping->id));
+  EXPECT_FALSE(s.lease_deadline(creeping->id));
+  EXPECT_EQ(s.heartbeat(creeping->id, 1, "w", 2.0), kStale);
+  EXPECT_EQ(s.complete(creeping->id, 1, "w", "{}", 1.0, 2.0), kStale);
+  EXPECT_EQ(s.result_count(creeping->id), 0);
+  // A queued job is given up too; a done one is not.
+  const auto next = s.lease("w", 3.0);
+  ASSERT_TRUE(next);
+  ASSERT_EQ(s.complete(next->id, 1, "w", "{}", 1.0, 4.0), kOk);
+  EXPECT_FALSE(s.give_up(id, next->id, "done already"));
+  EXPECT_EQ(s.job(next->id)->state, "done");
+  const auto all = s.jobs(id);
+  const auto queued =
+      std::find_if(all.begin(), all.end(), [](const JobRow& j) { return j.state == "queued"; });
+  ASSERT_NE(queued, all.end());
+  EXPECT_EQ(s.campaign(id)->state, "running");
+  ASSERT_TRUE(s.give_up(id, queued->id, "not needed"));
+  EXPECT_FALSE(s.lease("w", 5.0));
+  const Counts c = s.counts(id);
+  EXPECT_EQ(c.done, 1);
+  EXPECT_EQ(c.failed, 2);
+  EXPECT_EQ(s.campaign(id)->state, "done");
+}
+
+// A job waiting for another of its row is leased once that one is given up.
+TEST(Store, AJobWaitingForAJobGivenUpIsLeased) {
+  Store s(":memory:");
+  std::vector<NewJob> row = {{1, 1, "confined_compression", "design", "{}"},
+                             {1, 2, "tensile", "design", "{}", RunKey{}, "confined_compression"}};
+  const auto id = s.create_campaign("c", "{}", "{}", row, 0.0);
+  const auto first = s.lease("w", 0.0);
+  ASSERT_EQ(first->test, "confined_compression");
+  EXPECT_FALSE(s.lease("w2", 1.0));  // the tensile run waits
+  ASSERT_TRUE(s.give_up(id, first->id, "creeping"));
+  const auto second = s.lease("w2", 2.0);
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->test, "tensile");
 }
 
 TEST(Store, VerificationJobsReopenADoneCampaign) {
