@@ -261,6 +261,21 @@ class Service : public ::testing::Test {
     sqlite3_close(db);
   }
 
+  /// The first column's integers of `sql` on the SQLite file `db_path`, polled while a run may be
+  /// creating it: none while the file or its tables are not there yet.
+  static std::vector<std::int64_t> polled_ids(const std::string& db_path, const std::string& sql) {
+    std::vector<std::int64_t> out;
+    sqlite3* db = nullptr;
+    sqlite3_stmt* st = nullptr;
+    if (fs::exists(db_path) &&
+        sqlite3_open_v2(db_path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK &&
+        sqlite3_prepare_v2(db, sql.c_str(), -1, &st, nullptr) == SQLITE_OK)
+      while (sqlite3_step(st) == SQLITE_ROW) out.push_back(sqlite3_column_int64(st, 0));
+    sqlite3_finalize(st);
+    sqlite3_close(db);
+    return out;
+  }
+
   /// Rows of the results table per job, read from the SQLite file itself.
   std::map<std::int64_t, int> stored_results() {
     std::map<std::int64_t, int> out;

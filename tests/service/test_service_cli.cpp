@@ -128,20 +128,8 @@ TEST_F(Service, TheEmbeddedDefaultInterruptedCountsNoAttemptAgainstItsJobs) {
   const std::string db = path("work/campaign.db");
   const std::vector<std::string> argv{DEMCAL_CLI_BIN, "run", spec,        "--workdir", path("work"),
                                       "--workers",    "1",   "--threads", "1"};
-  // Polled while the run creates the file: a file without its tables yet counts as none leased.
   auto leased = [&] {
-    int n = 0;
-    sqlite3* file = nullptr;
-    sqlite3_stmt* st = nullptr;
-    if (fs::exists(db) &&
-        sqlite3_open_v2(db.c_str(), &file, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK &&
-        sqlite3_prepare_v2(file, "SELECT COUNT(*) FROM jobs WHERE state = 'leased'", -1, &st,
-                           nullptr) == SQLITE_OK &&
-        sqlite3_step(st) == SQLITE_ROW)
-      n = sqlite3_column_int(st, 0);
-    sqlite3_finalize(st);
-    sqlite3_close(file);
-    return n > 0;
+    return !polled_ids(db, "SELECT id FROM jobs WHERE state = 'leased'").empty();
   };
   auto counted = [&] {
     std::map<std::int64_t, int> by_job;
@@ -184,20 +172,11 @@ TEST_F(Service, GiveUpOnTheEmbeddedDefaultChangesTheStoreOnlyWhenNoCoordinatorHo
   const std::string spec = path("gaveup.yaml");
   std::ofstream(spec) << wall_friction_spec("gaveup", "");
   const std::string db = path("work/campaign.db");
-  // The last job in `state`, 0 if none; polled while the run creates the file, whose tables may
-  // not be there yet.
+  // The last job in `state`, 0 if none.
   auto job_in = [&](const std::string& state) {
-    std::int64_t id = 0;
-    sqlite3* file = nullptr;
-    sqlite3_stmt* st = nullptr;
-    const std::string sql = "SELECT id FROM jobs WHERE state = '" + state + "' ORDER BY id";
-    if (fs::exists(db) &&
-        sqlite3_open_v2(db.c_str(), &file, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK &&
-        sqlite3_prepare_v2(file, sql.c_str(), -1, &st, nullptr) == SQLITE_OK)
-      while (sqlite3_step(st) == SQLITE_ROW) id = sqlite3_column_int64(st, 0);
-    sqlite3_finalize(st);
-    sqlite3_close(file);
-    return id;
+    const auto ids =
+        polled_ids(db, "SELECT id FROM jobs WHERE state = '" + state + "' ORDER BY id");
+    return ids.empty() ? std::int64_t{0} : ids.back();
   };
   auto give_up = [&](const std::string& log, const std::string& workdir, std::int64_t job) {
     Process p({DEMCAL_CLI_BIN, "give-up", spec, "--workdir", workdir, "--job", std::to_string(job),
