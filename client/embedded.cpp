@@ -89,30 +89,39 @@ class StoreCopy {
   std::filesystem::path dir_;
 };
 
-/// Why a look (a command that runs no job) at the store file `store` reads a copy taken now
-/// instead of the file, or nothing when it reads the file. A store a running coordinator holds
-/// (e.g. a diagnosis going on in another process) is not touched, nor is one of an older schema
-/// version: opened as a store, it would be migrated, and the build that wrote it (a campaign's
-/// own, going on from it) would refuse it after.
-std::optional<std::string> why_look_at_a_copy(const std::filesystem::path& store) {
-  if (const auto pid = server::StoreLock::holder(store.string()))
-    return "is held by a running coordinator" + (pid->empty() ? "" : " (pid " + *pid + ")") +
-           ": reporting from a copy of it taken now (its jobs in flight show as queued there)";
+/// Why a look (a command that runs no job) reads a copy of a store taken now instead of the
+/// file, and since when the copy rates its jobs (a holder's opening; 0: the copy's own).
+struct CopyToLookAt {
+  std::string why;
+  double rate_since = 0.0;
+};
+
+/// Whether a look at the store file `store` reads a copy, and why; nothing when it reads the
+/// file. A store a running coordinator holds (e.g. a diagnosis going on in another process) is
+/// not touched, nor is one of an older schema version: opened as a store, it would be migrated,
+/// and the build that wrote it (a campaign's own, going on from it) would refuse it after.
+std::optional<CopyToLookAt> copy_to_look_at(const std::filesystem::path& store) {
+  if (const auto held = server::StoreLock::holder(store.string()))
+    return CopyToLookAt{
+        "is held by a running coordinator" + (held->pid.empty() ? "" : " (pid " + held->pid + ")") +
+            ": reporting from a copy of it taken now (its jobs in flight show as queued there)",
+        held->since};
   if (!std::filesystem::is_regular_file(store)) return std::nullopt;
   const int found = server::Store::file_schema_version(store.string());
   const int latest = server::Store::latest_schema_version();
   if (found >= latest) return std::nullopt;
-  return "is at schema version " + std::to_string(found) + ", this build's is " +
-         std::to_string(latest) + ": reporting from a copy migrated from it, the store left at " +
-         std::to_string(found);
+  return CopyToLookAt{"is at schema version " + std::to_string(found) + ", this build's is " +
+                      std::to_string(latest) +
+                      ": reporting from a copy migrated from it, the store left at " +
+                      std::to_string(found)};
 }
 
 /// Throws InputError unless store file `store` exists and no running coordinator holds it: a
 /// change is made to the file itself, never to a copy.
 void require_a_store_to_change(const std::filesystem::path& store) {
-  if (const auto pid = server::StoreLock::holder(store.string()))
+  if (const auto held = server::StoreLock::holder(store.string()))
     throw InputError("", "the store " + store.string() + " is held by a running coordinator" +
-                             (pid->empty() ? "" : " (pid " + *pid + ")") +
+                             (held->pid.empty() ? "" : " (pid " + held->pid + ")") +
                              ": stop it first (SIGTERM gives its leases back), or make the change "
                              "through that coordinator by campaign id");
   if (!std::filesystem::is_regular_file(store))
@@ -134,21 +143,23 @@ void with_campaign(const std::string& campaign, const std::string& workdir,
     const SpecFile file = read_campaign_spec(campaign);
     std::filesystem::path dir = work_directory(campaign, workdir);
     std::optional<StoreCopy> copy;
+    double rate_since = 0.0;
     const std::filesystem::path store = EmbeddedService::store_path(dir);
     if (reach == Reach::kChange) require_a_store_to_change(store);
     if (reach == Reach::kLook)
-      if (const auto why = why_look_at_a_copy(store)) {
+      if (const auto look = copy_to_look_at(store)) {
         copy.emplace(store);
-        std::cerr << "the store " << store.string() << " " << *why
+        std::cerr << "the store " << store.string() << " " << look->why
                   << " (what the copy queues is thrown away with it)\n";
         dir = copy->dir();
+        rate_since = look->rate_since;
       }
     // Read before anything starts: a journal with a bad line refuses the command.
     std::optional<CampaignJournal> runs;
     if (!journal.empty() && !copy) runs.emplace(journal);
     const bool run_jobs = reach == Reach::kRun;
     const LocalWorkers workers = run_jobs ? local : LocalWorkers{.workers = 0};
-    EmbeddedService service(dir, workers, verbose);
+    EmbeddedService service(dir, workers, verbose, rate_since);
     const std::int64_t id = reach == Reach::kChange ? service.resume(file, std::cerr)
                                                     : service.submit_or_resume(
                                                           file, std::cerr, runs ? &*runs : nullptr);
@@ -193,7 +204,7 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
 }
 
 EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local,
-                                 bool verbose)
+                                 bool verbose, double rate_since)
     : workdir_(workdir) {
   watch_stop_signals();
   // The work directory holds the campaign's database: a new one is its owner's alone (0700).
@@ -221,6 +232,7 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
   // of a fraction of a second, one worker would otherwise run them all while the other waits).
   co.idle_retry_seconds = 0.1;
   co.yield_after_seconds = local.yield_after;
+  co.rate_since = rate_since;
   coordinator_ = std::make_unique<server::Coordinator>(co);
   channel_.address = "127.0.0.1:" + std::to_string(coordinator_->port());
   channel_.token = co.token;

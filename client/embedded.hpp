@@ -34,7 +34,9 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local);
 
 class EmbeddedService {
  public:
-  EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local, bool verbose);
+  /// `rate_since`: CoordinatorOptions::rate_since (0: its own start).
+  EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local, bool verbose,
+                  double rate_since = 0.0);
   ~EmbeddedService();
   EmbeddedService(const EmbeddedService&) = delete;
   EmbeddedService& operator=(const EmbeddedService&) = delete;

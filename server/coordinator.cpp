@@ -3,6 +3,7 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <stdexcept>
 
 #include "rpc/channel.hpp"
@@ -30,6 +31,8 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
         "--worker-token-file and --client-token-file)");
   if (!(options_.grace_seconds >= 0.0 && options_.grace_seconds <= 3600.0))
     throw std::invalid_argument("--grace must lie in [0, 3600] s");
+  if (!(std::isfinite(options_.rate_since) && options_.rate_since >= 0.0))
+    throw std::invalid_argument("the rate's start must be a finite time >= 0");
   // Before the store is opened (and migrated).
   if (!yield_after_admitted(options_.yield_after_seconds))
     throw std::invalid_argument("--yield-after must be 0 (never) or lie in [1, 86400] s");
@@ -38,7 +41,8 @@ Coordinator::Coordinator(CoordinatorOptions options) : options_(std::move(option
                                                             options_.grace_seconds,
                                                             {},
                                                             options_.fsync_every_commit,
-                                                            options_.give_back_leases_at_start});
+                                                            options_.give_back_leases_at_start,
+                                                            options_.rate_since});
   // Jobs of a file from before run keys get theirs, so that later jobs can take their results,
   // and jobs still to run the keys of this build's protocol versions.
   store_->refresh_run_keys(payload_run_key);

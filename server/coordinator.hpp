@@ -37,6 +37,9 @@ struct CoordinatorOptions {
   /// The leases found in the file at start-up go back to the queue uncounted instead: its
   /// workers lived and died with the process that held them (the embedded default).
   bool give_back_leases_at_start = false;
+  /// The wall-clock time (s) the progress's ETA rates jobs from; 0: the coordinator's start.
+  /// A coordinator reading a copy of a store another one holds rates from that one's start.
+  double rate_since = 0.0;
   int max_attempts = 3;
   /// Sync the SQLite file at every commit (power-cut durability; store.hpp), not only at
   /// checkpoints.

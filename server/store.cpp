@@ -179,7 +179,9 @@ sqlite3* open_connection(const std::string& path, int flags) {
 }  // namespace
 
 Store::Store(const std::string& path, StoreLimits limits, std::optional<double> opened)
-    : lock_(path), limits_(limits), opened_wall_(wall_seconds()) {
+    : lock_(path),
+      limits_(limits),
+      opened_wall_(limits.rate_since > 0.0 ? limits.rate_since : wall_seconds()) {
   create_private_file(path);
   db_ = open_connection(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX);
   try {

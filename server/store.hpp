@@ -151,8 +151,9 @@ struct Counts {
   std::int64_t queued = 0, leased = 0, done = 0, failed = 0, cancelled = 0;
   std::int64_t reused = 0;  ///< of done: results taken from an earlier run with the same run key
   /// The window a rate is measured over: the jobs simulated (done or failed, not taken from an
-  /// earlier run) since the store was opened, and the wall-clock time of that opening. A campaign
-  /// resumed after days away is rated on this run of its coordinator only.
+  /// earlier run) since the store was opened (or since StoreLimits::rate_since), and the
+  /// wall-clock time of that opening. A campaign resumed after days away is rated on this run of
+  /// its coordinator only.
   std::int64_t simulated_since_opening = 0;
   double opening = 0.0;
   std::int64_t total() const { return queued + leased + done + failed + cancelled; }
@@ -174,6 +175,9 @@ struct StoreLimits {
   /// counted: for a coordinator whose workers lived in the process that wrote the file (the
   /// embedded default), so that none of them can still be working on its job.
   bool give_back_leases_at_opening = false;
+  /// The wall-clock time (s) the jobs' rate is measured from (Counts::opening); 0: this opening.
+  /// A copy of a store that a running coordinator holds is rated from that holder's opening.
+  double rate_since = 0.0;
 };
 
 /// Seconds on the monotonic clock the store's lease deadlines are kept on.

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -53,15 +54,20 @@ StoreLock::StoreLock(const std::string& db_path) {
   (void)write_own_pid(fd_);
 }
 
-std::optional<std::string> StoreLock::holder(const std::string& db_path) {
+std::optional<StoreLock::Holder> StoreLock::holder(const std::string& db_path) {
   if (db_path.empty() || db_path == ":memory:") return std::nullopt;
   const int fd = ::open((db_path + ".lock").c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return std::nullopt;
   // A shared lock is refused while a store holds the exclusive one; taken, it is let go at once.
-  std::optional<std::string> pid;
-  if (::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK) pid = holder_pid(fd);
+  std::optional<Holder> held;
+  if (::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK) {
+    struct stat st {};
+    held = Holder{holder_pid(fd), ::fstat(fd, &st) == 0 ? double(st.st_mtim.tv_sec) +
+                                                              1e-9 * double(st.st_mtim.tv_nsec)
+                                                        : 0.0};
+  }
   ::close(fd);
-  return pid;
+  return held;
 }
 
 StoreLock::~StoreLock() {

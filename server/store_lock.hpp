@@ -14,9 +14,15 @@ class StoreLock {
   /// Takes the lock of `db_path` (nothing for ":memory:"). Throws std::runtime_error naming
   /// the file and the holder's pid when another store holds it.
   explicit StoreLock(const std::string& db_path);
-  /// Whether another process holds the lock of `db_path` now: its pid ("" when its lock file
-  /// names none), or nothing when the store is free (or has no lock file yet).
-  static std::optional<std::string> holder(const std::string& db_path);
+  /// Who holds a store's lock: the pid its lock file names ("" when none) and since when (the
+  /// lock file's modification time, wall-clock seconds: its holder wrote its pid on opening).
+  struct Holder {
+    std::string pid;
+    double since = 0.0;
+  };
+  /// Whether another process holds the lock of `db_path` now, and who; nothing when the store is
+  /// free (or has no lock file yet).
+  static std::optional<Holder> holder(const std::string& db_path);
   ~StoreLock();
   StoreLock(const StoreLock&) = delete;
   StoreLock& operator=(const StoreLock&) = delete;

@@ -229,6 +229,34 @@ TEST_F(Service, GiveUpOnTheEmbeddedDefaultChangesTheStoreOnlyWhenNoCoordinatorHo
   EXPECT_EQ(given_up(), 1);
 }
 
+// `demcal status SPEC` of a campaign whose `demcal run` holds the store reads a copy of it, rated
+// from that run's start (its lock file's date): once a job of the run has ended, it shows an ETA.
+TEST_F(Service, StatusOfACampaignRunningInAnotherProcessShowsAnEta) {
+  const std::string spec = path("held.yaml");
+  std::ofstream(spec) << wall_friction_spec("held", "");
+  const std::string db = path("work/campaign.db");
+  Process run({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--workers", "1",
+               "--threads", "1", "--no-verify"},
+              path("run.log"));
+  ASSERT_TRUE(wait_until(
+      [&] {
+        return !polled_ids(db, "SELECT id FROM jobs WHERE state = 'done'").empty() &&
+               !polled_ids(db, "SELECT id FROM jobs WHERE state = 'queued'").empty();
+      },
+      90))
+      << run.log();
+  run.signal(SIGSTOP);  // the run holds its store, its progress frozen while the copy is read
+  Process status({DEMCAL_CLI_BIN, "status", spec, "--workdir", path("work")}, path("status.log"));
+  const int exit_status = status.wait_exit(60);
+  run.signal(SIGCONT);
+  run.signal(SIGINT);
+  EXPECT_EQ(run.wait_exit(40), 128 + SIGINT) << run.log();
+  ASSERT_EQ(exit_status, 0) << status.log();
+  EXPECT_NE(status.log().find("held by a running coordinator"), std::string::npos) << status.log();
+  EXPECT_NE(status.log().find(", ETA "), std::string::npos) << status.log();
+  EXPECT_EQ(status.log().find("ETA --:--"), std::string::npos) << status.log();
+}
+
 TEST_F(Service, AnExportLargerThanAGrpcMessageArrivesWhole) {
   // Synthetic results through the real worker protocol, no physics: each with a cost block of
   // 5,000 long-named phases (about 1.5 MB of JSON), so that the export exceeds gRPC's 4 MB.

@@ -1030,5 +1030,32 @@ TEST(Store, CountsTheJobsSimulatedSinceItWasOpened) {
   EXPECT_EQ(c.simulated_since_opening, 1);
 }
 
+// A look at a store a running coordinator holds reads a copy; the copy rates its jobs from the
+// holder's opening, which the holder's lock file dates, so the jobs the holder ended count.
+TEST(Store, ACopyOfAHeldStoreIsRatedFromItsHoldersOpening) {
+  const TempStoreFile file("held"), copy("held_copy");
+  const double before = wall_seconds();
+  Store held(file.path().string());
+  const double after = wall_seconds();
+  const auto id = held.create_campaign("c", "{}", "{}", jobs(2), 0.0);
+  const auto a = held.lease("w", 1.0);
+  ASSERT_TRUE(a);
+  ASSERT_EQ(held.complete(a->id, 1, "w", "{}", 1.0, 2.0), kOk);
+  const auto holder = StoreLock::holder(file.path().string());
+  ASSERT_TRUE(holder);
+  EXPECT_EQ(holder->pid, std::to_string(::getpid()));
+  EXPECT_GE(holder->since, before - 0.01);  // file times and the wall clock, to their resolution
+  EXPECT_LE(holder->since, after + 0.01);
+  Store::copy_file(file.path().string(), copy.path().string());
+  {
+    Store look(copy.path().string(), {.rate_since = holder->since});
+    const Counts c = look.counts(id);
+    EXPECT_EQ(c.opening, holder->since);
+    EXPECT_EQ(c.simulated_since_opening, 1);
+  }
+  Store look(copy.path().string());  // rated from its own opening, it has simulated nothing
+  EXPECT_EQ(look.counts(id).simulated_since_opening, 0);
+}
+
 }  // namespace
 }  // namespace demcal::server
