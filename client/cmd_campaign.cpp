@@ -174,9 +174,14 @@ void add_campaign_commands(CLI::App& app) {
           req.set_campaign_id(id);
           req.set_job_id(o->job);
           req.set_reason(o->reason);
-          v1::JobResult j;
-          check(stub.GiveUp(rpc::make_context(channel, 30).get(), req, &j), "give-up");
-          print_job_line(j);
+          v1::GiveUpReply reply;
+          check(stub.GiveUp(rpc::make_context(channel, 30).get(), req, &reply), "give-up");
+          print_job_line(reply.job());
+          for (const auto& j : reply.released())
+            std::cout << "  job " << j.job_id() << " (" << j.test()
+                      << ") waited for it and runs now, without what it would have left (a "
+                         "tensile run conditions its own bed): give it up "
+                         "too if that costs what this one did\n";
         },
         {}, Reach::kChange);
   });

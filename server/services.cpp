@@ -259,7 +259,7 @@ grpc::Status CampaignServiceImpl::Cancel(grpc::ServerContext* ctx, const v1::Can
 }
 
 grpc::Status CampaignServiceImpl::GiveUp(grpc::ServerContext* ctx, const v1::GiveUpRequest* req,
-                                         v1::JobResult* reply) {
+                                         v1::GiveUpReply* reply) {
   if (auto s = admit(*ctx, config_.tokens, Caller::kClient, *req); !s.ok()) return s;
   if (req->reason().empty() || req->reason().size() > kMaxReason)
     return {grpc::StatusCode::INVALID_ARGUMENT,
@@ -267,7 +267,8 @@ grpc::Status CampaignServiceImpl::GiveUp(grpc::ServerContext* ctx, const v1::Giv
                         req->reason().size(), kMaxReason)};
   if (!store_.campaign(req->campaign_id())) return not_found(req->campaign_id());
   const std::string job = "job " + std::to_string(req->job_id());
-  if (!store_.give_up(req->campaign_id(), req->job_id(), req->reason())) {
+  const auto released = store_.give_up(req->campaign_id(), req->job_id(), req->reason());
+  if (!released) {
     const auto row = store_.job(req->job_id());
     if (!row || row->campaign_id != req->campaign_id())
       return {grpc::StatusCode::NOT_FOUND,
@@ -276,7 +277,8 @@ grpc::Status CampaignServiceImpl::GiveUp(grpc::ServerContext* ctx, const v1::Giv
             job + " is " + row->state + ": only a queued or running job can be given up"};
   }
   spdlog::info("campaign {}: {} given up: {}", req->campaign_id(), job, req->reason());
-  *reply = job_message(*store_.job(req->job_id()));
+  *reply->mutable_job() = job_message(*store_.job(req->job_id()));
+  for (const auto id : *released) *reply->add_released() = job_message(*store_.job(id));
   return grpc::Status::OK;
 }
 

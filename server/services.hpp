@@ -99,7 +99,7 @@ class CampaignServiceImpl final : public v1::CampaignService::Service {
   grpc::Status Get(grpc::ServerContext*, const v1::GetRequest*, v1::Campaign*) override;
   grpc::Status List(grpc::ServerContext*, const v1::ListRequest*, v1::ListReply*) override;
   grpc::Status Cancel(grpc::ServerContext*, const v1::CancelRequest*, v1::Campaign*) override;
-  grpc::Status GiveUp(grpc::ServerContext*, const v1::GiveUpRequest*, v1::JobResult*) override;
+  grpc::Status GiveUp(grpc::ServerContext*, const v1::GiveUpRequest*, v1::GiveUpReply*) override;
   grpc::Status Watch(grpc::ServerContext*, const v1::WatchRequest*,
                      grpc::ServerWriter<v1::Progress>*) override;
   grpc::Status GetDesign(grpc::ServerContext*, const v1::GetRequest*, v1::DesignReply*) override;

@@ -595,7 +595,9 @@ bool Store::cancel(std::int64_t campaign_id, double now) {
   return true;
 }
 
-bool Store::give_up(std::int64_t campaign_id, std::int64_t job_id, const std::string& reason) {
+std::optional<std::vector<std::int64_t>> Store::give_up(std::int64_t campaign_id,
+                                                        std::int64_t job_id,
+                                                        const std::string& reason) {
   Guard lock(*this);
   Transaction tx(*this);
   const double at = wall_seconds();
@@ -603,12 +605,19 @@ bool Store::give_up(std::int64_t campaign_id, std::int64_t job_id, const std::st
               "UPDATE jobs SET state = 'failed', error = ?, finished = ?, lease_deadline = 0 "
               "WHERE id = ? AND campaign_id = ? AND state IN ('queued', 'leased')");
   u.bind(1, "given up: " + reason).bind(2, at).bind(3, job_id).bind(4, campaign_id).step();
-  if (sqlite3_changes(db_) == 0) return false;
+  if (sqlite3_changes(db_) == 0) return std::nullopt;
   drop_checkpoint(job_id);
   finish_campaigns(at);
+  Statement w(*this,
+              "SELECT w.id FROM jobs w JOIN jobs g ON g.id = ? WHERE w.campaign_id = g.campaign_id "
+              "AND w.kind = g.kind AND w.std_order = g.std_order AND w.waits_for = g.test AND "
+              "w.state = 'queued' ORDER BY w.id");
+  w.bind(1, job_id);
+  std::vector<std::int64_t> waited;
+  while (w.step()) waited.push_back(w.i64(0));
   tx.commit();
   leases_.erase(job_id);
-  return true;
+  return waited;
 }
 
 std::vector<std::int64_t> Store::insert_jobs(std::int64_t campaign_id,

@@ -244,9 +244,11 @@ class Store {
   bool cancel(std::int64_t campaign_id, double now);
   /// Gives up job `job_id` of campaign `campaign_id`, queued or leased: it fails with the error
   /// "given up: <reason>", its checkpoint is dropped, its lease (if any) ends and its campaign
-  /// finishes when no other job is left. False, changing nothing, when the campaign has no such
+  /// finishes when no other job is left. Returns the queued jobs of its row that waited for it
+  /// (NewJob::waits_for), leasable now; nothing, changing nothing, when the campaign has no such
   /// job or the job has ended (done, failed or cancelled).
-  bool give_up(std::int64_t campaign_id, std::int64_t job_id, const std::string& reason);
+  std::optional<std::vector<std::int64_t>> give_up(std::int64_t campaign_id, std::int64_t job_id,
+                                                   const std::string& reason);
   /// Adds jobs to an existing campaign (verification runs); the campaign runs again.
   std::vector<std::int64_t> add_jobs(std::int64_t campaign_id, const std::vector<NewJob>& jobs);
   /// Stores a calibration round and queues its jobs in one transaction.

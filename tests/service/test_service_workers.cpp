@@ -12,6 +12,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -501,7 +502,7 @@ TEST_F(Service, GivingUpARunningJobStopsItsSimulationAndTheCampaignGoesOnWithout
   req.set_campaign_id(id);
   req.set_job_id(running);
   req.set_reason("again");
-  v1::JobResult j;
+  v1::GiveUpReply j;
   EXPECT_EQ(campaigns_->GiveUp(ctx().get(), req, &j).error_code(),
             grpc::StatusCode::FAILED_PRECONDITION);
   req.set_campaign_id(id + 1);
@@ -531,6 +532,57 @@ TEST_F(Service, GivingUpARunningJobStopsItsSimulationAndTheCampaignGoesOnWithout
     EXPECT_EQ(job.error(), "given up: " + reason);
   }
   EXPECT_TRUE(stored_results().empty()) << "a job given up reported a result";
+}
+
+// Giving up a row's compression names the tensile job that waited for it (it conditions its own
+// bed now), over gRPC and in the CLI's words.
+TEST_F(Service, GivingUpACompressionNamesTheTensileJobThatWaitedForIt) {
+  start_server(/*lease=*/30, /*heartbeat=*/0.3);
+  std::int64_t id = 0;
+  ASSERT_TRUE(submit(R"(name: waits
+material:
+  particle_law:
+    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, kc_ratio: 0.5, phi_f: 0.05, restitution: 0.3}
+    cohesion: {model: van_der_waals, hamaker: 1.0e-18, d_max: 1.0e-5}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 1.0e-3}}
+  density: 1500
+tests:
+  - {test: tensile, settings: {particles: 100}}
+  - {test: confined_compression, settings: {particles: 100}}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.2, high: 0.4}
+  - {path: particle_law.normal.restitution, low: 0.3, high: 0.5}
+design: {type: full_factorial}
+)",
+                     &id)
+                  .ok());
+  std::map<int, std::int64_t> compression, tensile;  // design row -> job
+  const auto jobs = results(id);
+  for (const auto& j : jobs.jobs())
+    (j.test() == "tensile" ? tensile : compression)[j.std_order()] = j.job_id();
+  ASSERT_EQ(compression.size(), 4u);
+  v1::GiveUpRequest req;
+  req.set_campaign_id(id);
+  req.set_job_id(compression[1]);
+  req.set_reason("creeping");
+  v1::GiveUpReply reply;
+  ASSERT_TRUE(campaigns_->GiveUp(ctx().get(), req, &reply).ok());
+  EXPECT_EQ(reply.job().state(), "failed");
+  ASSERT_EQ(reply.released_size(), 1);
+  EXPECT_EQ(reply.released(0).job_id(), tensile[1]);
+  EXPECT_EQ(reply.released(0).state(), "queued");
+  // A tensile job waits for nothing: giving it up releases none.
+  req.set_job_id(tensile[2]);
+  ASSERT_TRUE(campaigns_->GiveUp(ctx().get(), req, &reply).ok());
+  EXPECT_EQ(reply.released_size(), 0);
+  const std::string printed = cli_text(
+      dir_, "give-up.out",
+      {"give-up", std::to_string(id), "--job", std::to_string(compression[3]), "--reason", "x"},
+      channel_);
+  EXPECT_NE(printed.find("job " + std::to_string(tensile[3]) + " (tensile) waited for it"),
+            std::string::npos)
+      << printed;
 }
 
 TEST_F(Service, AJobOverTheWorkersLimitsFailsWithTheLimitNamed) {

@@ -769,7 +769,9 @@ TEST(Store, AJobGivenUpFailsWithItsReasonAndTheCampaignEndsWithoutIt) {
   const auto creeping = s.lease("w", 0.0);
   ASSERT_EQ(s.save_checkpoint(creeping->id, 1, "w", "settling", "state", 1.0), kOk);
   EXPECT_FALSE(s.give_up(id + 1, creeping->id, "another campaign's job"));
-  EXPECT_TRUE(s.give_up(id, creeping->id, "creeps toward its step limit"));
+  const auto released = s.give_up(id, creeping->id, "creeps toward its step limit");
+  ASSERT_TRUE(released);
+  EXPECT_TRUE(released->empty());                      // no job waits for it
   EXPECT_FALSE(s.give_up(id, creeping->id, "twice"));  // it has ended
   const auto row = s.job(creeping->id);
   EXPECT_EQ(row->state, "failed");
@@ -798,8 +800,8 @@ TEST(Store, AJobGivenUpFailsWithItsReasonAndTheCampaignEndsWithoutIt) {
   EXPECT_EQ(s.campaign(id)->state, "done");
 }
 
-// A job waiting for another of its row is leased once that one is given up.
-TEST(Store, AJobWaitingForAJobGivenUpIsLeased) {
+// A job waiting for another of its row is named when that one is given up, and leased.
+TEST(Store, AJobWaitingForAJobGivenUpIsNamedAndLeased) {
   Store s(":memory:");
   std::vector<NewJob> row = {{1, 1, "confined_compression", "design", "{}"},
                              {1, 2, "tensile", "design", "{}", RunKey{}, "confined_compression"}};
@@ -807,10 +809,13 @@ TEST(Store, AJobWaitingForAJobGivenUpIsLeased) {
   const auto first = s.lease("w", 0.0);
   ASSERT_EQ(first->test, "confined_compression");
   EXPECT_FALSE(s.lease("w2", 1.0));  // the tensile run waits
-  ASSERT_TRUE(s.give_up(id, first->id, "creeping"));
+  const auto released = s.give_up(id, first->id, "creeping");
+  ASSERT_TRUE(released);
+  ASSERT_EQ(released->size(), 1u);
   const auto second = s.lease("w2", 2.0);
   ASSERT_TRUE(second);
   EXPECT_EQ(second->test, "tensile");
+  EXPECT_EQ(second->id, released->front());
 }
 
 TEST(Store, VerificationJobsReopenADoneCampaign) {
