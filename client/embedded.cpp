@@ -90,10 +90,10 @@ class StoreCopy {
 };
 
 /// Why a look (a command that runs no job) reads a copy of a store taken now instead of the
-/// file, and since when the copy rates its jobs (a holder's opening; 0: the copy's own).
+/// file, and, for a store a running coordinator holds, since when that one holds it.
 struct CopyToLookAt {
   std::string why;
-  double rate_since = 0.0;
+  std::optional<double> held_since;
 };
 
 /// Whether a look at the store file `store` reads a copy, and why; nothing when it reads the
@@ -102,10 +102,10 @@ struct CopyToLookAt {
 /// and the build that wrote it (a campaign's own, going on from it) would refuse it after.
 std::optional<CopyToLookAt> copy_to_look_at(const std::filesystem::path& store) {
   if (const auto held = server::StoreLock::holder(store.string()))
-    return CopyToLookAt{
-        "is held by a running coordinator" + (held->pid.empty() ? "" : " (pid " + held->pid + ")") +
-            ": reporting from a copy of it taken now (its jobs in flight show as queued there)",
-        held->since};
+    return CopyToLookAt{"is held by a running coordinator" +
+                            (held->pid.empty() ? "" : " (pid " + held->pid + ")") +
+                            ": reporting from a copy of it taken now",
+                        held->since};
   if (!std::filesystem::is_regular_file(store)) return std::nullopt;
   const int found = server::Store::file_schema_version(store.string());
   const int latest = server::Store::latest_schema_version();
@@ -143,7 +143,7 @@ void with_campaign(const std::string& campaign, const std::string& workdir,
     const SpecFile file = read_campaign_spec(campaign);
     std::filesystem::path dir = work_directory(campaign, workdir);
     std::optional<StoreCopy> copy;
-    double rate_since = 0.0;
+    std::optional<double> held_since;
     const std::filesystem::path store = EmbeddedService::store_path(dir);
     if (reach == Reach::kChange) require_a_store_to_change(store);
     if (reach == Reach::kLook)
@@ -152,14 +152,14 @@ void with_campaign(const std::string& campaign, const std::string& workdir,
         std::cerr << "the store " << store.string() << " " << look->why
                   << " (what the copy queues is thrown away with it)\n";
         dir = copy->dir();
-        rate_since = look->rate_since;
+        held_since = look->held_since;
       }
     // Read before anything starts: a journal with a bad line refuses the command.
     std::optional<CampaignJournal> runs;
     if (!journal.empty() && !copy) runs.emplace(journal);
     const bool run_jobs = reach == Reach::kRun;
     const LocalWorkers workers = run_jobs ? local : LocalWorkers{.workers = 0};
-    EmbeddedService service(dir, workers, verbose, rate_since);
+    EmbeddedService service(dir, workers, verbose, held_since);
     const std::int64_t id = reach == Reach::kChange ? service.resume(file, std::cerr)
                                                     : service.submit_or_resume(
                                                           file, std::cerr, runs ? &*runs : nullptr);
@@ -204,7 +204,7 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
 }
 
 EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local,
-                                 bool verbose, double rate_since)
+                                 bool verbose, std::optional<double> held_since)
     : workdir_(workdir) {
   watch_stop_signals();
   // The work directory holds the campaign's database: a new one is its owner's alone (0700).
@@ -225,14 +225,15 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
   co.token = random_token();
   // Its workers die with it: no lease of an earlier run is still worked on, and none was the
   // job's fault (the run was stopped), so the jobs go back to the queue uncounted, to go on
-  // from their latest checkpoint.
-  co.give_back_leases_at_start = true;
+  // from their latest checkpoint. A copy of a store another coordinator holds keeps that one's
+  // leases, which are running there, and rates its jobs from that one's start.
+  co.give_back_leases_at_start = !held_since;
+  co.rate_since = held_since.value_or(0.0);
   // Its workers ask over loopback, where an empty poll costs microseconds: a worker that found
   // the queue empty takes a job a tenth of a second after it appears, not a second (with jobs
   // of a fraction of a second, one worker would otherwise run them all while the other waits).
   co.idle_retry_seconds = 0.1;
   co.yield_after_seconds = local.yield_after;
-  co.rate_since = rate_since;
   coordinator_ = std::make_unique<server::Coordinator>(co);
   channel_.address = "127.0.0.1:" + std::to_string(coordinator_->port());
   channel_.token = co.token;

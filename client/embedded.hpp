@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -34,9 +35,11 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local);
 
 class EmbeddedService {
  public:
-  /// `rate_since`: CoordinatorOptions::rate_since (0: its own start).
+  /// `held_since`: the store in `workdir` is a copy of one that a running coordinator has held
+  /// since then (wall-clock s): the copy keeps that one's leases (its jobs in flight show as
+  /// running) and rates its jobs from that time.
   EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local, bool verbose,
-                  double rate_since = 0.0);
+                  std::optional<double> held_since = std::nullopt);
   ~EmbeddedService();
   EmbeddedService(const EmbeddedService&) = delete;
   EmbeddedService& operator=(const EmbeddedService&) = delete;

@@ -229,8 +229,9 @@ TEST_F(Service, GiveUpOnTheEmbeddedDefaultChangesTheStoreOnlyWhenNoCoordinatorHo
   EXPECT_EQ(given_up(), 1);
 }
 
-// `demcal status SPEC` of a campaign whose `demcal run` holds the store reads a copy of it, rated
-// from that run's start (its lock file's date): once a job of the run has ended, it shows an ETA.
+// `demcal status SPEC` of a campaign whose `demcal run` holds the store reads a copy of it, with
+// that run's lease (its job in flight shows as running) and rated from that run's start (its lock
+// file's date): once a job of the run has ended, it shows an ETA.
 TEST_F(Service, StatusOfACampaignRunningInAnotherProcessShowsAnEta) {
   const std::string spec = path("held.yaml");
   std::ofstream(spec) << wall_friction_spec("held", "");
@@ -238,14 +239,21 @@ TEST_F(Service, StatusOfACampaignRunningInAnotherProcessShowsAnEta) {
   Process run({DEMCAL_CLI_BIN, "run", spec, "--workdir", path("work"), "--workers", "1",
                "--threads", "1", "--no-verify"},
               path("run.log"));
-  ASSERT_TRUE(wait_until(
-      [&] {
-        return !polled_ids(db, "SELECT id FROM jobs WHERE state = 'done'").empty() &&
-               !polled_ids(db, "SELECT id FROM jobs WHERE state = 'queued'").empty();
-      },
-      90))
-      << run.log();
-  run.signal(SIGSTOP);  // the run holds its store, its progress frozen while the copy is read
+  auto in = [&](const char* state) {
+    return !polled_ids(db, std::string("SELECT id FROM jobs WHERE state = '") + state + "'")
+                .empty();
+  };
+  // Frozen (SIGSTOP: the run holds its store, its progress stops while the copy is read) with a
+  // job done, one running and one queued; a freeze between two leases is thawed and tried again.
+  bool frozen = false;
+  for (int attempt = 0; attempt < 5 && !frozen; ++attempt) {
+    ASSERT_TRUE(wait_until([&] { return in("done") && in("leased") && in("queued"); }, 90))
+        << run.log();
+    run.signal(SIGSTOP);
+    frozen = in("leased") && in("queued");
+    if (!frozen) run.signal(SIGCONT);
+  }
+  ASSERT_TRUE(frozen) << run.log();
   Process status({DEMCAL_CLI_BIN, "status", spec, "--workdir", path("work")}, path("status.log"));
   const int exit_status = status.wait_exit(60);
   run.signal(SIGCONT);
@@ -253,6 +261,7 @@ TEST_F(Service, StatusOfACampaignRunningInAnotherProcessShowsAnEta) {
   EXPECT_EQ(run.wait_exit(40), 128 + SIGINT) << run.log();
   ASSERT_EQ(exit_status, 0) << status.log();
   EXPECT_NE(status.log().find("held by a running coordinator"), std::string::npos) << status.log();
+  EXPECT_NE(status.log().find(", 1 running,"), std::string::npos) << status.log();  // its lease
   EXPECT_NE(status.log().find(", ETA "), std::string::npos) << status.log();
   EXPECT_EQ(status.log().find("ETA --:--"), std::string::npos) << status.log();
 }
