@@ -89,6 +89,11 @@ class StoreCopy {
   std::filesystem::path dir_;
 };
 
+/// "held by a running coordinator (pid N)": who holds a store, for the messages below.
+std::string held_by(const server::StoreLock::Holder& holder) {
+  return "held by a running coordinator" + (holder.pid.empty() ? "" : " (pid " + holder.pid + ")");
+}
+
 /// Why a look (a command that runs no job) reads a copy of a store taken now instead of the
 /// file, and, for a store a running coordinator holds, since when that one holds it.
 struct CopyToLookAt {
@@ -102,9 +107,7 @@ struct CopyToLookAt {
 /// and the build that wrote it (a campaign's own, going on from it) would refuse it after.
 std::optional<CopyToLookAt> copy_to_look_at(const std::filesystem::path& store) {
   if (const auto held = server::StoreLock::holder(store.string()))
-    return CopyToLookAt{"is held by a running coordinator" +
-                            (held->pid.empty() ? "" : " (pid " + held->pid + ")") +
-                            ": reporting from a copy of it taken now",
+    return CopyToLookAt{"is " + held_by(*held) + ": reporting from a copy of it taken now",
                         held->since};
   if (!std::filesystem::is_regular_file(store)) return std::nullopt;
   const int found = server::Store::file_schema_version(store.string());
@@ -120,8 +123,7 @@ std::optional<CopyToLookAt> copy_to_look_at(const std::filesystem::path& store) 
 /// change is made to the file itself, never to a copy.
 void require_a_store_to_change(const std::filesystem::path& store) {
   if (const auto held = server::StoreLock::holder(store.string()))
-    throw InputError("", "the store " + store.string() + " is held by a running coordinator" +
-                             (held->pid.empty() ? "" : " (pid " + held->pid + ")") +
+    throw InputError("", "the store " + store.string() + " is " + held_by(*held) +
                              ": stop it first (SIGTERM gives its leases back), or make the change "
                              "through that coordinator by campaign id");
   if (!std::filesystem::is_regular_file(store))
