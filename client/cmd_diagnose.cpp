@@ -78,15 +78,23 @@ void print_metrics(std::ostream& out, const v1::DiagnosisReport& r) {
   out << "baseline RMS error: predicted " << pct(b.has_predicted_rms(), b.predicted_rms())
       << ", verified " << pct(b.has_verified_rms(), b.verified_rms())
       << (b.has_verified_rms_se() ? " +- " + pct(true, b.verified_rms_se()) : "") << ", held out "
-      << pct(b.has_holdout_rms(), b.holdout_rms()) << "\n";
+      << pct(b.has_holdout_rms(), b.holdout_rms())
+      << (b.has_holdout_rms_se() ? " +- " + pct(true, b.holdout_rms_se()) : "") << "\n";
+}
+
+/// What a candidate explains: the calibrated misfit, the held-out one, both or neither.
+std::string explains(const v1::DiagnosisCandidate& c) {
+  if (c.explains() && c.explains_holdout()) return "both";
+  if (c.explains()) return "yes";
+  return c.explains_holdout() ? "held out" : "no";
 }
 
 void print_candidates(std::ostream& out, const v1::DiagnosisReport& r) {
   out << "\ncandidate causes, each tested by simulation (best first)\n";
   out << std::left << std::setw(14) << "candidate" << std::right << std::setw(6) << "runs"
       << std::setw(13) << "mispredicted" << std::setw(11) << "predicted" << std::setw(10)
-      << "verified" << std::setw(8) << "round" << std::setw(10) << "held out" << std::setw(10)
-      << "explains"
+      << "verified" << std::setw(8) << "round" << std::setw(10) << "held out" << std::setw(8)
+      << "gain" << std::setw(10) << "explains"
       << "\n";
   for (const auto& c : r.candidates()) {
     out << std::left << std::setw(14) << c.id() << std::right << std::setw(6) << c.runs()
@@ -94,8 +102,8 @@ void print_candidates(std::ostream& out, const v1::DiagnosisReport& r) {
         << std::setw(11) << pct(c.has_predicted_rms(), c.predicted_rms()) << std::setw(10)
         << pct(c.has_verified_rms(), c.verified_rms()) << std::setw(8)
         << (std::to_string(c.best_round()) + "/" + std::to_string(c.rounds())) << std::setw(10)
-        << pct(c.has_holdout_rms(), c.holdout_rms()) << std::setw(10)
-        << (c.explains() ? "yes" : "no") << "\n";
+        << pct(c.has_holdout_rms(), c.holdout_rms()) << std::setw(8)
+        << pct(c.has_holdout_gain(), c.holdout_gain()) << std::setw(10) << explains(c) << "\n";
     out << "    " << c.cause() << " [" << c.state() << "]";
     if (!c.evidence().empty()) out << ": " << c.evidence();
     out << "\n";

@@ -114,9 +114,10 @@ std::optional<CopyToLookAt> copy_to_look_at(const std::filesystem::path& store) 
   const int latest = server::Store::latest_schema_version();
   if (found >= latest) return std::nullopt;
   return CopyToLookAt{"is at schema version " + std::to_string(found) + ", this build's is " +
-                      std::to_string(latest) +
-                      ": reporting from a copy migrated from it, the store left at " +
-                      std::to_string(found)};
+                          std::to_string(latest) +
+                          ": reporting from a copy migrated from it, the store left at " +
+                          std::to_string(found),
+                      std::nullopt};
 }
 
 /// Throws InputError unless store file `store` exists and no running coordinator holds it: a

@@ -56,6 +56,59 @@ void describe_size(const CampaignPlan& plan, diagnose::Problem& p) {
   }
 }
 
+/// The instance a response ("instance.metric") is of; nullptr for none.
+const PlannedInstance* instance_of(const CampaignPlan& plan, const std::string& response) {
+  const auto dot = response.rfind('.');
+  for (const auto& i : plan.instances)
+    if (dot != std::string::npos && response.compare(0, dot, i.name) == 0 && i.name.size() == dot)
+      return &i;
+  return nullptr;
+}
+
+/// The settings by which an instance consolidates its bed (LabTestInfo::consolidation), at the
+/// design's values (the low fidelity level the diagnosis runs at); empty where it does not.
+std::map<std::string, double> consolidation_settings(const PlannedInstance& instance) {
+  const auto& info = lab::find_lab_info(instance.test);
+  std::map<std::string, double> out;
+  if (!info.consolidation) return out;
+  out[info.consolidation->stress] =
+      lab::setting_value(info, instance.settings_low, info.consolidation->stress);
+  for (const auto& name : info.consolidation->scaled)
+    out[name] = lab::setting_value(info, instance.settings_low, name);
+  return out;
+}
+
+/// consolidation: a measurement of the solid fraction a consolidation leaves (the density metric
+/// of an instance's test), calibrated or held out (then it describes the held-out compact and is
+/// left out of the calibration with it), and every other held-out measurement of one instance
+/// that consolidates its bed; both instances' consolidation settings are what its runs scale.
+void describe_conditioning(const CampaignPlan& plan, diagnose::Problem& p) {
+  const Target* density = nullptr;
+  const PlannedInstance* measuring = nullptr;
+  for (const auto& t : plan.targets) {
+    measuring = instance_of(plan, t.response);
+    if (!measuring) continue;
+    const auto& c = lab::find_lab_info(measuring->test).consolidation;
+    if (c && !c->density_metric.empty() &&
+        t.response == measuring->name + "." + c->density_metric) {
+      density = &t;
+      break;
+    }
+  }
+  if (!density) return;
+  std::set<const PlannedInstance*> held;
+  for (const auto& t : plan.targets)
+    if (t.holdout && &t != density) held.insert(instance_of(plan, t.response));
+  if (held.size() != 1 || !*held.begin()) return;
+  const PlannedInstance& held_out = **held.begin();
+  const auto& info = lab::find_lab_info(held_out.test);
+  if (!info.consolidation) return;
+  diagnose::Conditioning out{held_out.name, info.consolidation->stress, density->response};
+  out.scaled[held_out.name] = consolidation_settings(held_out);
+  out.scaled[measuring->name] = consolidation_settings(*measuring);
+  p.conditioning = std::move(out);
+}
+
 }  // namespace
 
 diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRow>& jobs,
@@ -84,6 +137,7 @@ diagnose::Problem make_problem(const CampaignPlan& plan, const std::vector<JobRo
   p.agitation_time_max = lab::default_agitation_time(model);
   for (const auto& info : lab::parameters(model)) p.valid[info.path] = {info.lo, info.hi};
   describe_size(plan, p);
+  describe_conditioning(plan, p);
   p.options = plan.diagnosis;
   if (p.options.nested) p.nested_rows = doe::main_effect_half(plan.design);
   p.options.seed = seed ? seed : 1;
@@ -159,6 +213,10 @@ v1::DiagnosisCandidate candidate_message(const diagnose::CandidateOutcome& c) {
   if (std::isfinite(c.holdout_rms)) out.set_holdout_rms(c.holdout_rms);
   out.set_explains(c.explains);
   out.set_within_noise(c.within_noise);
+  out.set_conditioning(c.conditioning);
+  if (std::isfinite(c.holdout_rms_se)) out.set_holdout_rms_se(c.holdout_rms_se);
+  if (std::isfinite(c.holdout_gain)) out.set_holdout_gain(c.holdout_gain);
+  out.set_explains_holdout(c.explains_holdout);
   out.set_evidence(c.evidence);
   return out;
 }
@@ -168,6 +226,7 @@ v1::DiagnosisReport report_message(const diagnose::Report& r) {
   out.set_state(r.state);
   out.set_named_cause(r.named_cause);
   for (const auto& id : r.rivals) out.add_rivals(id);
+  out.set_holdout_cause(r.holdout_cause);
   out.set_conclusion(r.conclusion);
   for (const auto& m : r.metrics) *out.add_metrics() = metric_message(m);
   auto* b = out.mutable_baseline();
@@ -176,6 +235,7 @@ v1::DiagnosisReport report_message(const diagnose::Report& r) {
   if (std::isfinite(r.baseline_verified_rms)) b->set_verified_rms(r.baseline_verified_rms);
   if (std::isfinite(r.baseline_verified_rms_se)) b->set_verified_rms_se(r.baseline_verified_rms_se);
   if (std::isfinite(r.baseline_holdout_rms)) b->set_holdout_rms(r.baseline_holdout_rms);
+  if (std::isfinite(r.baseline_holdout_rms_se)) b->set_holdout_rms_se(r.baseline_holdout_rms_se);
   for (const auto& c : r.conflicts) {
     auto* m = out.add_conflicts();
     m->set_fitted(c.fitted);
@@ -202,6 +262,26 @@ std::vector<RunsOfKind> diagnosis_runs(const std::vector<JobRow>& jobs) {
     kinds.push_back({job_kind::diagnosis(g), which});
   }
   return kinds;
+}
+
+/// The runs a request of the diagnosis asks for, at the low fidelity level (the level of the design
+/// the diagnosis fits): every instance's, or those it names, with the settings it gives them
+/// (admitted as a spec's runs are: its settings are not the spec's).
+std::vector<PlannedRun> requested_runs(const CampaignPlan& plan, const diagnose::RunRequest& req,
+                                       const std::string& kind) {
+  auto runs = runs_at(plan, req.parameters, false, req.row, kind,
+                      static_cast<std::uint64_t>(req.replicate));
+  if (req.tests.empty()) return runs;
+  std::erase_if(runs, [&](const PlannedRun& run) {
+    return std::find(req.tests.begin(), req.tests.end(), plan.instances[run.instance].name) ==
+           req.tests.end();
+  });
+  for (auto& run : runs)
+    if (const auto it = req.settings.find(plan.instances[run.instance].name);
+        it != req.settings.end())
+      run.settings = it->second;
+  admit_runs(plan, runs);
+  return runs;
 }
 
 /// Under each metric of the report, the flagged values the diagnosis uses for it.
@@ -255,11 +335,7 @@ v1::DiagnoseReply diagnose_campaign(Store& store, const CampaignRow& row, std::u
   for (const auto& req : step.requests) {
     const std::string kind = job_kind::diagnosis(req.group);
     if (stored.count({kind, req.row})) continue;
-    // At the low fidelity level: the level of the design the diagnosis fits.
-    const auto add = jobs_of(plan,
-                             runs_at(plan, req.parameters, false, req.row, kind,
-                                     static_cast<std::uint64_t>(req.replicate)),
-                             req.switches);
+    const auto add = jobs_of(plan, requested_runs(plan, req, kind), req.switches);
     fresh.insert(fresh.end(), add.begin(), add.end());
   }
   if (read_only) fresh.clear();

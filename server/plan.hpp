@@ -105,7 +105,12 @@ struct PlannedRun {
   std::map<std::string, double> parameters;  ///< run_parameters
   bool high = false;
   std::uint64_t seed = 1;
+  lab::Settings settings = {};  ///< settings it runs with where they differ from its instance's
 };
+
+/// The settings a run simulates its instance with: the instance's at the run's fidelity level,
+/// the run's own in their place.
+lab::Settings run_settings(const CampaignPlan& plan, const PlannedRun& run);
 
 /// One run per design row and instance, the plan's design laid over `box` (the campaign's
 /// factors or a calibration stage's narrowed box), at the low fidelity level (`high`: the high).

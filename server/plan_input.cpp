@@ -124,6 +124,12 @@ diagnose::Options diagnose_options(const v1::DiagnoseOptions& o, const std::stri
     throw InputError(where + ".rounds", "must be 0 (the default, 3) or in [1, " +
                                             std::to_string(kMaxDiagnosisRounds) + "]");
   if (o.rounds() > 0) out.rounds = o.rounds();
+  if (o.consolidation_min() != 0.0) {
+    if (!(o.consolidation_min() >= 0.01 && o.consolidation_min() <= 0.9))
+      throw InputError(where + ".consolidation_min",
+                       "must be 0 (the default, 0.1) or in [0.01, 0.9]");
+    out.consolidation_min = o.consolidation_min();
+  }
   if (o.rows() == "nested")
     out.nested = true;
   else if (!o.rows().empty() && o.rows() != "all")

@@ -78,15 +78,11 @@ void calibration_from(const Json& j, CampaignPlan& p) {
 }
 
 Json diagnosis_json(const diagnose::Options& o) {
-  return {{"candidates", o.candidates},
-          {"aspect_ratio_max", o.aspect_ratio_max},
-          {"rolling_max", o.rolling_max},
-          {"sigma_g_max", o.sigma_g_max},
-          {"fixed_span", o.fixed_span},
-          {"margin", o.margin},
-          {"replicates", o.replicates},
-          {"nested", o.nested},
-          {"rounds", o.rounds}};
+  return {{"candidates", o.candidates},   {"aspect_ratio_max", o.aspect_ratio_max},
+          {"rolling_max", o.rolling_max}, {"sigma_g_max", o.sigma_g_max},
+          {"fixed_span", o.fixed_span},   {"margin", o.margin},
+          {"replicates", o.replicates},   {"nested", o.nested},
+          {"rounds", o.rounds},           {"consolidation_min", o.consolidation_min}};
 }
 
 void diagnosis_from(const Json& j, diagnose::Options& o) {
@@ -101,6 +97,7 @@ void diagnosis_from(const Json& j, diagnose::Options& o) {
   o.nested = j.value("nested", false);
   // ... and verify up to the default number of rounds.
   o.rounds = j.value("rounds", diagnose::Options{}.rounds);
+  o.consolidation_min = j.value("consolidation_min", diagnose::Options{}.consolidation_min);
 }
 
 /// The design, its responses, targets and fidelity axis: what every form of the plan holds.

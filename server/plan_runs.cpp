@@ -26,8 +26,7 @@ v1::JobSpec job_spec(const CampaignPlan& plan, const PlannedRun& run,
   const auto& instance = plan.instances[run.instance];
   v1::JobSpec job;
   job.set_test(instance.test);
-  for (const auto& [name, value] : run.high ? instance.settings_high : instance.settings_low)
-    (*job.mutable_settings())[name] = value;
+  for (const auto& [name, value] : run_settings(plan, run)) (*job.mutable_settings())[name] = value;
   *job.mutable_material() = material;
   for (const auto& [path, value] : run.parameters) (*job.mutable_parameters())[path] = value;
   job.set_seed(run.seed);
@@ -36,6 +35,13 @@ v1::JobSpec job_spec(const CampaignPlan& plan, const PlannedRun& run,
 }
 
 }  // namespace
+
+lab::Settings run_settings(const CampaignPlan& plan, const PlannedRun& run) {
+  const auto& instance = plan.instances[run.instance];
+  lab::Settings out = run.high ? instance.settings_high : instance.settings_low;
+  for (const auto& [name, value] : run.settings) out[name] = value;
+  return out;
+}
 
 std::map<std::string, double> run_parameters(const CampaignPlan& plan,
                                              const std::map<std::string, double>& factors,
@@ -172,8 +178,7 @@ void admit_runs(const CampaignPlan& plan, const std::vector<PlannedRun>& runs) {
   for (const auto& run : runs) {
     const auto& instance = plan.instances[run.instance];
     const std::string where = "spec.tests[" + std::to_string(run.instance) + "]";
-    lab::admit_run(instance.test, instance.material, run.parameters,
-                   run.high ? instance.settings_high : instance.settings_low,
+    lab::admit_run(instance.test, instance.material, run.parameters, run_settings(plan, run),
                    lab::instance_fields(where, instance.material, plan.material), run.std_order);
   }
 }

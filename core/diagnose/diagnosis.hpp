@@ -18,13 +18,18 @@
 //       coarse_graining  particles of the powder's real median radius at the same Bond number
 //                    (its cohesion rescaled) where the material's particles are larger;
 //       fixed:<p>    a parameter held fixed, varied over [v / span, v * span];
+//       consolidation  the held-out test's bed consolidated to the powder's measured solid
+//                    fraction instead of at the design's stress (no model change: its gain is on
+//                    the held-out metrics);
 //       curvature    non-linearity: axial runs, main effects and squares;
 //       interaction  a two-factor interaction aliased in the design: the fold-over;
 //     each extended model is fitted, calibrated and its proposed set verified by simulation,
 //     the verified run joining its data for up to `rounds` rounds;
 //   - the named cause (the candidate whose verified error is lowest, if it cuts the baseline's
 //     verified error by the stated margin) and the gain, on the calibrated metrics and on
-//     metrics held out of the calibration.
+//     metrics held out of the calibration; and the named cause of the held-out misfit (the
+//     candidate whose verified held-out error is lowest, if it cuts the baseline's by the margin
+//     without a worse calibrated error).
 // The diagnosis is a pure function of the stored results: advance() says which runs it still
 // needs and reports what can be said so far, so the coordinator can persist it as jobs.
 #include <Eigen/Dense>
@@ -99,6 +104,21 @@ struct Options {
   /// The model extensions repeat only half the base factorial runs, chosen for a main-effect
   /// model (`Problem::nested_rows`), not all of them.
   bool nested = false;
+  /// consolidation: the lowest stress it conditions the held-out test's bed at, as a fraction of
+  /// the design's; it runs that one and their geometric middle.
+  double consolidation_min = 0.1;
+};
+
+/// consolidation: the held-out measurements are all of one test instance that consolidates its
+/// bed before it measures (a tensile test's compact), and the solid fraction such a
+/// consolidation leaves is measured (a confined compression's final solid fraction).
+struct Conditioning {
+  std::string held_out;  ///< the held-out test instance
+  std::string stress;    ///< its setting of the consolidation stress
+  std::string density;   ///< the measured response of the consolidated solid fraction
+  /// The settings its runs scale with the consolidation stress, per instance they run (the
+  /// held-out one and the density's): setting -> value in the design's runs.
+  std::map<std::string, std::map<std::string, double>> scaled = {};
 };
 
 /// The campaign as the diagnosis sees it.
@@ -132,6 +152,7 @@ struct Problem {
   /// Rows (0-based) of `design`: half its factorial runs, chosen for a main-effect model
   /// (doe::main_effect_half); used when `options.nested`.
   std::vector<int> nested_rows;
+  std::optional<Conditioning> conditioning;  ///< where consolidation applies
   Options options;
 };
 
@@ -145,6 +166,10 @@ struct RunRequest {
                  ///< "preparation" -> "clusters"
   std::map<std::string, double> parameters;
   int replicate = 0;  ///< a replicated verification's lab-seed offset, 0..replicates - 1
+  /// The test instances it runs (empty: every one) and the settings it runs them with where they
+  /// differ from the design's (instance -> setting -> value).
+  std::vector<std::string> tests = {};
+  std::map<std::string, std::map<std::string, double>> settings = {};
 };
 
 /// Finished runs of a group: row -> response -> value (NaN = the run failed).
@@ -172,7 +197,10 @@ struct Conflict {
 
 struct CandidateOutcome {
   std::string id, cause;
-  std::string state;                       ///< pending | designed | verified | failed
+  std::string state;  ///< pending | designed | verified | failed
+  /// It changes how a test conditions its bed (consolidation), not the model: its calibrated
+  /// metrics are the baseline's, its verified_rms is pending, and it is judged on the held-out.
+  bool conditioning = false;
   int runs = 0;                            ///< simulations of its augmented design
   std::vector<Factor> factors;             ///< the extended factor box
   std::map<std::string, double> proposed;  ///< its calibrated set (natural)
@@ -195,7 +223,13 @@ struct CandidateOutcome {
   double design_misprediction = kPending;
   std::map<std::string, double> simulated;  ///< verified metrics
   double holdout_rms = kPending;
+  double holdout_rms_se = kPending;  ///< as verified_rms_se, on the held-out metrics
+  /// 1 - holdout_rms / the baseline's: the verified gain on the held-out metrics.
+  double holdout_gain = kPending;
   bool explains = false;
+  /// Cuts the baseline's held-out error by the margin beyond the seeds' noise, with a calibrated
+  /// error no worse than the baseline's (a conditioning's is the baseline's).
+  bool explains_holdout = false;
   /// Cuts the baseline's verified error by the margin, but by no more than `noise_z` standard
   /// errors of the difference: not told from the seeds' noise, so it does not explain.
   bool within_noise = false;
@@ -209,6 +243,7 @@ struct Report {
   double baseline_predicted_rms = kPending, baseline_verified_rms = kPending;
   double baseline_verified_rms_se = kPending;  ///< as CandidateOutcome::verified_rms_se
   double baseline_holdout_rms = kPending;
+  double baseline_holdout_rms_se = kPending;
   std::vector<Conflict> conflicts;
   std::vector<CandidateOutcome> candidates;  ///< ranked once verified (best first)
   std::string named_cause;                   ///< candidate id, empty when none is named
@@ -216,6 +251,9 @@ struct Report {
   /// named cause's (below its error / (1 - margin), or both below `converged`): the data do not
   /// tell them apart from it.
   std::vector<std::string> rivals;
+  /// The named cause of the held-out misfit: the candidate that explains it with the lowest
+  /// verified held-out error; empty when none does.
+  std::string holdout_cause;
   std::string conclusion;  ///< plain words
 };
 

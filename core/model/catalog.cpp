@@ -119,6 +119,13 @@ bool reports_metric(const LabTestInfo& info, const std::string& metric) {
          std::ranges::find(info.also_reported, metric) != info.also_reported.end();
 }
 
+double setting_value(const LabTestInfo& info, const Settings& settings, const std::string& name) {
+  if (const auto it = settings.find(name); it != settings.end()) return it->second;
+  for (const auto& doc : info.settings)
+    if (doc.name == name) return doc.fallback;
+  throw InputError("settings." + name, "not a setting of the " + info.name + " test");
+}
+
 bool accepts_preparation(const std::string& test, PreparationMethod method) {
   return runs_preparation(find_lab_info(test), method);
 }

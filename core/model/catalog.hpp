@@ -4,6 +4,7 @@
 // metric names, settings) without linking the DEM engine. The tests are listed in lab_tests.hpp;
 // their runners are in core/lab.
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,16 @@ struct RuleDoc {
   Settings breaking;
 };
 
+/// How a test consolidates its bed before it measures: the setting of the stress it is consolidated
+/// at and the settings of the consolidation's cycles that scale with it (a bed conditioned at a
+/// k times lower stress has every one of them k times lower), and the metric that measures the
+/// solid fraction the consolidation leaves, where the test reports one.
+struct Consolidation {
+  std::string stress;
+  std::vector<std::string> scaled;
+  std::string density_metric = {};
+};
+
 struct LabTestInfo {
   std::string name;
   std::string description;
@@ -55,6 +66,8 @@ struct LabTestInfo {
   /// when a run of it with the same material, settings and seed kept it (core/lab/stage_cache.hpp):
   /// the coordinator leases this test's job of a design row after that test's job of the row.
   std::string starts_from = {};
+  /// How it consolidates its bed; absent where it does not.
+  std::optional<Consolidation> consolidation = {};
   /// Filled in by the registry from the test's type (lab_catalog()):
   std::vector<RuleDoc> rules = {};                   ///< cross-setting rules
   std::vector<PreparationMethod> preparations = {};  ///< the bed preparations it can run
@@ -63,6 +76,10 @@ struct LabTestInfo {
 /// Whether a run of the test `info` describes reports a metric of that name: one of its metrics
 /// or of what it also reports (a result naming anything else is refused by the coordinator).
 bool reports_metric(const LabTestInfo& info, const std::string& metric);
+
+/// A setting's value in `settings`, or its default where they do not set it; InputError for a name
+/// the test has no setting of.
+double setting_value(const LabTestInfo& info, const Settings& settings, const std::string& name);
 
 /// All lab tests, in a fixed order.
 const std::vector<LabTestInfo>& lab_catalog();

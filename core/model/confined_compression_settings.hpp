@@ -67,7 +67,10 @@ struct ConfinedCompressionTest {
          {"confined_modulus", "MPa",
           "E' = (sigma_max - sigma_min) / (eps_max - eps_min) of the last cycle, eps = "
           "(h0 - h) / h0 (seed 001 eq. 19)"}},
-        settings_docs<ConfinedCompressionSettings>()};
+        settings_docs<ConfinedCompressionSettings>(),
+        {},
+        {},
+        Consolidation{"max_stress", {"min_stress"}, "final_solid_fraction"}};
   }
   static LabOutput run(const MaterialModel& material, const Settings& settings,
                        const RunOptions& options);

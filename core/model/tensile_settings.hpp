@@ -85,7 +85,8 @@ struct TensileTest {
               "the piston area"}},
             settings_docs<TensileSettings>(),
             {},
-            "confined_compression"};
+            "confined_compression",
+            Consolidation{"consolidation_stress", {"min_stress"}}};
   }
   static LabOutput run(const MaterialModel& material, const Settings& settings,
                        const RunOptions& options);

@@ -99,9 +99,12 @@ struct Driven {
 /// What a test adds to the simulated responses of one request (noise, a drift between rounds).
 using Disturbance = std::function<void(const RunRequest&, Responses&)>;
 
+/// A simulator that sees the whole request (the tests it runs, their settings).
+using RequestSimulator = std::function<Responses(const RunRequest&)>;
+
 /// Calls advance(), simulates every request not answered yet, until the report is done.
-Driven drive(const Problem& p, const Simulator& sim, int max_calls = 30,
-             const Disturbance& disturb = {}) {
+Driven drive_requests(const Problem& p, const RequestSimulator& sim, int max_calls = 30,
+                      const Disturbance& disturb = {}) {
   Driven d;
   std::map<std::string, GroupResults> groups;
   for (d.calls = 1; d.calls <= max_calls; ++d.calls) {
@@ -111,7 +114,7 @@ Driven drive(const Problem& p, const Simulator& sim, int max_calls = 30,
     for (const auto& r : d.step.requests) {
       auto& g = groups[r.group];
       if (g.count(r.row)) continue;
-      g[r.row] = sim(r.parameters, r.switches);
+      g[r.row] = sim(r);
       if (disturb) disturb(r, g[r.row]);
       ++added;
       ++d.simulations;
@@ -123,6 +126,13 @@ Driven drive(const Problem& p, const Simulator& sim, int max_calls = 30,
   }
   ADD_FAILURE() << "not done after " << max_calls << " calls of advance()";
   return d;
+}
+
+/// As drive_requests, for a simulator of the parameters and switches.
+Driven drive(const Problem& p, const Simulator& sim, int max_calls = 30,
+             const Disturbance& disturb = {}) {
+  return drive_requests(
+      p, [&](const RunRequest& r) { return sim(r.parameters, r.switches); }, max_calls, disturb);
 }
 
 const CandidateOutcome* candidate(const Report& r, const std::string& id) {
@@ -1046,6 +1056,171 @@ TEST(Diagnosis, AVerificationOnOneSeedHasNoStandardError) {
   EXPECT_FALSE(std::isfinite(rolling->verified_rms_se));
   EXPECT_FALSE(rolling->within_noise);
   EXPECT_EQ(r.named_cause, "rolling") << r.conclusion;
+}
+
+// --- g) the held-out test's consolidation -------------------------------------------------
+
+const char* const kCompressibility = "cc.compressibility";
+const char* const kDensity = "cc.final_solid_fraction";
+const char* const kStrength = "tensile.tensile_strength";
+constexpr double kStress = 10000.0;  ///< both tests' consolidation stress in the design (Pa)
+
+/// A compression ("cc") and a tensile test of a bed consolidated alike: the solid fraction the
+/// consolidation leaves rises with the log of its stress S, the strength is a function of that
+/// solid fraction alone (with a weak dependence on B), and the model packs `offset` looser than
+/// the formula (the truth's unreachable part). A test the request does not run gives NaN.
+Responses consolidated_truth(const RunRequest& r, double offset = 0.0,
+                             double strength_factor = 1.0) {
+  const auto [a, b, c] = coded_point(r.parameters);
+  const auto stress = [&](const char* test, const char* setting) {
+    const auto t = r.settings.find(test);
+    return t == r.settings.end() ? kStress : t->second.at(setting);
+  };
+  const auto density = [&](double s) {
+    return 0.45 - 0.02 * a + 0.01 * b + 0.05 * std::log10(s / kStress) - offset;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const auto runs = [&](const char* test) {
+    return r.tests.empty() || std::find(r.tests.begin(), r.tests.end(), test) != r.tests.end();
+  };
+  const double s_cc = stress("cc", "max_stress");
+  const double compact = density(stress("tensile", "consolidation_stress"));
+  return {{kCompressibility,
+           runs("cc") ? (20.0 + 3.0 * a - 2.0 * c) * std::pow(s_cc / kStress, 0.3) : nan},
+          {kDensity, runs("cc") ? density(s_cc) : nan},
+          {kStrength, runs("tensile") ? strength_factor * 0.5 * std::exp(30.0 * (compact - 0.45)) *
+                                            (1.0 + 0.05 * b)
+                                      : nan}};
+}
+
+/// The design's runs of a consolidated truth, the compressibility and the solid fraction measured
+/// at the truth's point, the strength held out; the conditioning the server states for it.
+Problem consolidation_problem(const std::function<Responses(const RunRequest&)>& truth,
+                              const Responses& measured) {
+  const Simulator design = [&](const Parameters& x, const Switches&) {
+    return truth(RunRequest{"design", 1, {}, x});
+  };
+  std::vector<Measurement> ms = targets_at(measured, {kCompressibility, kDensity, kStrength});
+  ms.back().holdout = true;
+  Problem p = make_problem(design, {kCompressibility, kDensity, kStrength}, ms);
+  p.conditioning = Conditioning{"tensile", "consolidation_stress", kDensity};
+  p.conditioning->scaled["tensile"] = {{"consolidation_stress", kStress}, {"min_stress", 500.0}};
+  p.conditioning->scaled["cc"] = {{"max_stress", kStress}, {"min_stress", 500.0}};
+  return p;
+}
+
+TEST(Diagnosis, AHeldOutCompactConsolidatedToTheMeasuredDensityIsNamed) {
+  // The truth packs 0.04 looser than any point of the box at the design's stress: the lab's
+  // compression measures a solid fraction the model cannot reach, and its tensile compact (at
+  // that solid fraction) is far weaker than the model's at the design's stress. Consolidated to
+  // the measured solid fraction, the model's compact is the truth's within B's weak effect.
+  const auto truth_point = natural_point(0.2, -0.3, 0.1);
+  const auto measured = consolidated_truth(RunRequest{"truth", 1, {}, truth_point}, 0.04);
+  const Problem p =
+      consolidation_problem([](const RunRequest& r) { return consolidated_truth(r); }, measured);
+  const Driven d = drive_requests(p, [](const RunRequest& r) { return consolidated_truth(r); });
+  const Report& r = d.step.report;
+  ASSERT_EQ(r.state, "done") << r.conclusion;
+  const CandidateOutcome* c = candidate(r, "consolidation");
+  ASSERT_NE(c, nullptr);
+  EXPECT_TRUE(c->conditioning);
+  EXPECT_EQ(c->state, "verified") << c->evidence;
+  EXPECT_EQ(c->runs, 2);
+  EXPECT_FALSE(c->explains);  // its calibrated metrics are the baseline's
+  EXPECT_TRUE(std::isnan(c->verified_rms));
+
+  // Its runs: the compression and the tensile test at the baseline's set, their consolidation
+  // settings at sqrt(0.1) and 0.1 of the design's, then at the stress where the solid fraction
+  // meets the measured one.
+  const auto runs = of_group(d.step.requests, "consolidation");
+  ASSERT_EQ(runs.size(), 2u);
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const double ratio = i == 0 ? std::sqrt(0.1) : 0.1;
+    EXPECT_EQ(runs[i].row, int(i) + 1);
+    EXPECT_EQ(runs[i].tests, (std::vector<std::string>{"cc", "tensile"}));
+    EXPECT_EQ(runs[i].parameters, r.baseline_proposed);
+    EXPECT_NEAR(runs[i].settings.at("cc").at("max_stress"), ratio * kStress, 1e-9);
+    EXPECT_NEAR(runs[i].settings.at("cc").at("min_stress"), ratio * 500.0, 1e-9);
+    EXPECT_NEAR(runs[i].settings.at("tensile").at("consolidation_stress"), ratio * kStress, 1e-9);
+    EXPECT_NEAR(runs[i].settings.at("tensile").at("min_stress"), ratio * 500.0, 1e-9);
+  }
+  // The solid fraction is linear in log S, so the interpolation meets the measured one exactly:
+  // S* = S0 10^((measured - simulated at S0) / 0.05).
+  const double at_design = metric(r, kDensity)->simulated;
+  const double expected = kStress * std::pow(10.0, (measured.at(kDensity) - at_design) / 0.05);
+  EXPECT_NEAR(c->proposed.at("tensile.consolidation_stress"), expected, 1e-6 * expected);
+  EXPECT_LT(expected, 0.5 * kStress);
+  const auto verify = of_group(d.step.requests, "consolidation/verify");
+  ASSERT_EQ(verify.size(), 1u);
+  EXPECT_NEAR(verify[0].settings.at("tensile").at("consolidation_stress"), expected,
+              1e-6 * expected);
+  EXPECT_NEAR(c->simulated.at(kDensity), measured.at(kDensity), 1e-9);
+
+  // The held-out error: the baseline's compact is too strong several times over; the
+  // consolidated one misses by B's weak effect only.
+  const double b_cal = coded(1, r.baseline_proposed.at(kB));
+  const double base_error = r.baseline_holdout_rms;
+  EXPECT_GT(base_error, 1.0);
+  const double truth_b = -0.3;
+  EXPECT_NEAR(c->holdout_rms, std::abs((1.0 + 0.05 * b_cal) / (1.0 + 0.05 * truth_b) - 1.0), 1e-9);
+  EXPECT_NEAR(c->holdout_gain, 1.0 - c->holdout_rms / base_error, 1e-12);
+  EXPECT_GT(c->holdout_gain, 0.9);
+  EXPECT_TRUE(c->explains_holdout);
+  EXPECT_EQ(r.holdout_cause, "consolidation") << r.conclusion;
+  EXPECT_NE(r.conclusion.find("held-out misfit"), std::string::npos) << r.conclusion;
+}
+
+TEST(Diagnosis, AConsolidationThatDoesNotMoveTheHeldOutMisfitNamesNothing) {
+  const auto truth_point = natural_point(0.2, -0.3, 0.1);
+  // The truth's strength is three times the model's at every solid fraction (a cause the
+  // consolidation does not touch), and its solid fraction is slightly below the box's reach:
+  // the consolidation meets it close to the design's stress and the strength stays three times
+  // too weak.
+  const auto weak = [](const RunRequest& r) { return consolidated_truth(r, 0.0, 1.0); };
+  {
+    auto measured = consolidated_truth(RunRequest{"truth", 1, {}, truth_point}, 0.005, 3.0);
+    const Report r = drive_requests(consolidation_problem(weak, measured), weak).step.report;
+    ASSERT_EQ(r.state, "done") << r.conclusion;
+    const CandidateOutcome* c = candidate(r, "consolidation");
+    ASSERT_NE(c, nullptr);
+    EXPECT_EQ(c->state, "verified") << c->evidence;
+    EXPECT_FALSE(c->explains_holdout);
+    EXPECT_TRUE(r.holdout_cause.empty()) << r.conclusion;
+    EXPECT_NE(r.conclusion.find("none is named"), std::string::npos) << r.conclusion;
+  }
+  // A measured solid fraction below what the loosest consolidation reaches: no stress is chosen,
+  // nothing is verified, nothing named.
+  {
+    auto measured = consolidated_truth(RunRequest{"truth", 1, {}, truth_point}, 0.2);
+    const Driven d = drive_requests(consolidation_problem(weak, measured), weak);
+    const Report& r = d.step.report;
+    ASSERT_EQ(r.state, "done") << r.conclusion;
+    const CandidateOutcome* c = candidate(r, "consolidation");
+    EXPECT_EQ(c->state, "failed");
+    EXPECT_NE(c->evidence.find("no stress from 1000 to 10000 Pa"), std::string::npos)
+        << c->evidence;
+    EXPECT_TRUE(of_group(d.step.requests, "consolidation/verify").empty());
+    EXPECT_TRUE(r.holdout_cause.empty());
+  }
+}
+
+TEST(Diagnosis, ConsolidationIsACandidateOnlyWhereTheServerStatesAConditioning) {
+  const auto truth_point = natural_point(0.2, -0.3, 0.1);
+  const auto measured = consolidated_truth(RunRequest{"truth", 1, {}, truth_point}, 0.04);
+  const auto model = [](const RunRequest& r) { return consolidated_truth(r); };
+  Problem p = consolidation_problem(model, measured);
+  p.options.candidates = {"consolidation"};
+  EXPECT_NO_THROW(diagnose::advance(p, {}));
+  p.options.consolidation_min = 1.0;
+  EXPECT_THROW(diagnose::advance(p, {}), InputError);
+  p.options.consolidation_min = 0.1;
+  p.conditioning.reset();
+  try {
+    diagnose::advance(p, {});
+    ADD_FAILURE() << "consolidation was a candidate without a conditioning";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), "diagnose.candidates");
+  }
 }
 
 }  // namespace

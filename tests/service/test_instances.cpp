@@ -277,6 +277,99 @@ measurements:
   if (!HasFailure()) fs::remove_all(dir);
 }
 
+/// A compression, a tensile test (its strength held out unless `strength_held_out` is false) and
+/// a shear cell; `measured` lists the compression's measured metrics.
+std::string consolidation_spec(const std::string& measured, bool strength_held_out = true) {
+  std::string spec = R"(name: consolidation
+material:
+  particle_law:
+    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, kc_ratio: 0.5, phi_f: 0.05, restitution: 0.3}
+    cohesion: {model: van_der_waals, hamaker: 1.0e-18, d_max: 1.0e-5}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 1.0e-3}}
+  density: 1500
+tests:
+  - {test: confined_compression, settings: {particles: 100, max_stress: 6000, cycles: 1}}
+  - {test: tensile, settings: {particles: 100, consolidation_stress: 6000, cycles: 1}}
+  - {test: shear_cell}
+factors:
+  - {path: particle_law.tangential.mu_s, low: 0.2, high: 0.4}
+design: {type: full_factorial}
+measurements:
+)";
+  for (const auto& metric : {"compressibility", "final_solid_fraction"})
+    if (measured.find(metric) != std::string::npos)
+      spec += "  - {test: confined_compression, metric: " + std::string(metric) + ", value: 0.4}\n";
+  spec += "  - {test: shear_cell, metric: pre_shear_stress, value: 1.0}\n";
+  spec += std::string("  - {test: tensile, metric: tensile_strength, value: 1.0") +
+          (strength_held_out ? ", holdout: true}\n" : "}\n");
+  return spec;
+}
+
+TEST(TestInstances, TheConsolidationCandidateScalesBothTestsConsolidationWhereItApplies) {
+  std::vector<server::NewJob> design;
+  const auto plan = server::plan_campaign(
+      cli::parse_campaign_spec(consolidation_spec("compressibility final_solid_fraction"), "c.yaml")
+          .spec,
+      design);
+  const auto problem = server::make_problem(plan, {}, 1);
+  ASSERT_TRUE(problem.conditioning);
+  const auto& c = *problem.conditioning;
+  EXPECT_EQ(c.held_out, "tensile");
+  EXPECT_EQ(c.stress, "consolidation_stress");
+  EXPECT_EQ(c.density, "confined_compression.final_solid_fraction");
+  // The spec's values, and the catalogue's default where the spec sets none (min_stress 500 Pa).
+  using Scaled = std::map<std::string, std::map<std::string, double>>;
+  EXPECT_EQ(c.scaled, (Scaled{{"confined_compression", {{"max_stress", 6000}, {"min_stress", 500}}},
+                              {"tensile", {{"consolidation_stress", 6000}, {"min_stress", 500}}}}));
+  // The solid fraction may be held out with the strength (a measurement of the held-out compact).
+  {
+    std::vector<server::NewJob> jobs;
+    std::string spec = consolidation_spec("compressibility final_solid_fraction");
+    spec =
+        spec.replace(spec.find("value: 0.4}\n  - {test: shear"), 11, "value: 0.4, holdout: true}");
+    const auto held = server::plan_campaign(cli::parse_campaign_spec(spec, "h.yaml").spec, jobs);
+    const auto conditioning = server::make_problem(held, {}, 1).conditioning;
+    ASSERT_TRUE(conditioning) << spec;
+    EXPECT_EQ(conditioning->density, "confined_compression.final_solid_fraction");
+    EXPECT_EQ(conditioning->scaled, c.scaled);
+  }
+  // Not where the solid fraction is not measured, nor where nothing is held out.
+  for (const auto& [measured, held] : std::vector<std::pair<std::string, bool>>{
+           {"compressibility", true}, {"compressibility final_solid_fraction", false}}) {
+    std::vector<server::NewJob> jobs;
+    const auto other = server::plan_campaign(
+        cli::parse_campaign_spec(consolidation_spec(measured, held), "o.yaml").spec, jobs);
+    EXPECT_FALSE(server::make_problem(other, {}, 1).conditioning) << measured << held;
+  }
+
+  // A run with settings of its own carries them in its job and its key: the tensile job of a row
+  // still waits for the compression's, which conditions the bed it starts from.
+  auto runs = server::runs_at(plan, {{"particle_law.tangential.mu_s", 0.2}}, false, 1,
+                              job_kind::diagnosis("consolidation"), 0);
+  std::erase_if(runs,
+                [&](const auto& r) { return plan.instances[r.instance].test == "shear_cell"; });
+  ASSERT_EQ(runs.size(), 2u);
+  for (auto& r : runs)
+    for (const auto& [name, value] : c.scaled.at(plan.instances[r.instance].name))
+      r.settings[name] = 0.25 * value;
+  const auto jobs = server::jobs_of(plan, runs);
+  ASSERT_EQ(jobs.size(), 2u);
+  for (const auto& j : jobs) {
+    v1::JobSpec job;
+    server::from_json(j.payload, job);
+    const bool tensile = job.test() == "tensile";
+    EXPECT_EQ(job.settings().at(tensile ? "consolidation_stress" : "max_stress"), 1500.0);
+    EXPECT_EQ(job.settings().at("min_stress"), 125.0);
+    EXPECT_EQ(job.settings().at("particles"), 100.0);
+    EXPECT_EQ(j.waits_for, tensile ? "confined_compression" : "");
+    for (const auto& d : design) EXPECT_NE(d.run_key.key, j.run_key.key);
+  }
+  // Settings that break a test's rule are refused before a job is made.
+  runs[0].settings["min_stress"] = 1e6;
+  EXPECT_THROW(server::admit_runs(plan, runs), InputError);
+}
+
 /// A confined compression of a grown bed beside a shear cell, which pours.
 std::string grown_compression_spec(const std::string& compression_preparation) {
   return "name: grown-compression\n" + kSpheres + R"(tests:
