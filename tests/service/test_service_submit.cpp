@@ -82,6 +82,8 @@ TEST_F(Service, InvalidSpecsGetInvalidArgumentNamingTheField) {
        "spec.diagnose.aspect_ratio_max"},
       {tiny_spec(30, 0, "", "diagnose: {rolling_max: -0.3}\n"), "spec.diagnose.rolling_max"},
       {tiny_spec(30, 0, "", "diagnose: {sigma_g_max: 1.0}\n"), "spec.diagnose.sigma_g_max"},
+      {tiny_spec(30, 0, "", "diagnose: {consolidation_min: 0.95}\n"),
+       "spec.diagnose.consolidation_min"},
       {tiny_spec(30, 0, "", "diagnose: {fixed_span: -3}\n"), "spec.diagnose.fixed_span"},
       {tiny_spec(30, 0, "", "diagnose: {margin: 7}\n"), "spec.diagnose.margin"},
       {tiny_spec(30, 0, "", "diagnose: {rows: some}\n"), "spec.diagnose.rows"},
