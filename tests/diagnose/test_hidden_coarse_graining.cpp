@@ -28,11 +28,13 @@
 #include <string>
 
 #include "core/common/rng.hpp"
-#include "tests/common/command.hpp"
+#include "tests/diagnose/hidden_truth.hpp"
 
 namespace {
 
 using namespace demcal;
+using test::num;
+using test::run_json;
 
 std::uint64_t g_seed = 1;
 
@@ -63,13 +65,6 @@ Truth draw_truth(std::uint64_t seed) {
   return t;
 }
 
-std::string num(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
-
 /// The material: the wall law is the particle law as written (with its cohesion).
 std::string material_yaml(double radius, double hamaker, double mu_s, double restitution,
                           bool states_real_radius) {
@@ -83,12 +78,6 @@ std::string material_yaml(double radius, double hamaker, double mu_s, double res
     << "  density: 2500\n";
   if (states_real_radius) y << "  real_median_radius: " << num(kRealMedianRadius) << "\n";
   return y.str();
-}
-
-nlohmann::json run_json(const std::string& cmd) {
-  const test::CommandResult r = test::run_command(cmd);
-  EXPECT_EQ(r.exit_code, 0) << cmd;
-  return nlohmann::json::parse(r.out);
 }
 
 /// The measured data: the truth simulated in both tests (its own lab seed).
@@ -134,16 +123,9 @@ std::string campaign_yaml(const std::map<std::string, double>& measured) {
 
 TEST(HiddenEffects, CoarseGrainingAtTheSameBondNumberIsNamed) {
   const Truth truth = draw_truth(g_seed);
-  const auto dir =
-      std::filesystem::temp_directory_path() /
-      ("demcal-hidden-coarse-" + std::to_string(g_seed) + "-" + std::to_string(getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto dir = test::fresh_directory("coarse", g_seed);
   std::ofstream(dir / "campaign.yaml") << campaign_yaml(measure(truth, dir));
-  const auto report =
-      run_json(std::string(DEMCAL_CLI_BIN) + " diagnose " + (dir / "campaign.yaml").string() +
-               " --format json --workers 2 --threads 1 --workdir " + (dir / "work").string() +
-               " 2>" + (dir / "diagnose.log").string());
+  const auto report = test::diagnose_json(dir);
   std::cout << "seed " << g_seed << ": hidden radius " << truth.radius << " m (A_H "
             << truth.hamaker() << " J, mu_s " << truth.mu_s << ", restitution " << truth.restitution
             << ")\n"
@@ -151,9 +133,7 @@ TEST(HiddenEffects, CoarseGrainingAtTheSameBondNumberIsNamed) {
 
   ASSERT_EQ(report["state"], "done");
   EXPECT_EQ(report["named_cause"], "coarse_graining") << report["conclusion"];
-  nlohmann::json best;
-  for (const auto& c : report["candidates"])
-    if (c["id"] == "coarse_graining") best = c;
+  const auto best = test::candidate(report, "coarse_graining");
   ASSERT_FALSE(best.is_null()) << "coarse_graining was not tested";
   EXPECT_LT(best["verified_rms"].get<double>(),
             (1.0 - kMargin) * report["baseline"]["verified_rms"].get<double>());
@@ -167,7 +147,6 @@ TEST(HiddenEffects, CoarseGrainingAtTheSameBondNumberIsNamed) {
 
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
-  if (const char* s = std::getenv("DEMCAL_HIDDEN_SEED")) g_seed = std::stoull(s);
-  if (argc > 1) g_seed = std::stoull(argv[1]);
+  g_seed = test::hidden_seed(argc, argv);
   return RUN_ALL_TESTS();
 }

@@ -31,11 +31,13 @@
 #include <string>
 
 #include "core/common/rng.hpp"
-#include "tests/common/command.hpp"
+#include "tests/diagnose/hidden_truth.hpp"
 
 namespace {
 
 using namespace demcal;
+using test::num;
+using test::run_json;
 
 std::uint64_t g_seed = 1;
 
@@ -59,13 +61,6 @@ Truth draw_truth(std::uint64_t seed) {
   return t;
 }
 
-std::string num(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
-
 /// A test's settings with its bed consolidated at `stress`.
 std::string settings(const std::string& test, double stress) {
   return "{particles: 100, cycles: 1, wall_stiffness_factor: 1, " +
@@ -81,12 +76,6 @@ std::string material_yaml(double mu_s, double youngs_modulus) {
          "    cohesion: {model: van_der_waals, hamaker: 1.0e-18, d_max: 1.0e-5}\n"
          "    tangential: {model: history, mu_s: " +
          num(mu_s) + "}\n  sizes: {monodisperse: {radius: 1.0e-3}}\n  density: 1500\n";
-}
-
-nlohmann::json run_json(const std::string& cmd) {
-  const test::CommandResult r = test::run_command(cmd);
-  EXPECT_EQ(r.exit_code, 0) << cmd;
-  return nlohmann::json::parse(r.out);
 }
 
 /// The truth's metrics as a lab measures them: means of kSamples lab runs, each on its own seed.
@@ -152,26 +141,17 @@ std::string campaign_yaml(const std::map<std::string, double>& measured) {
 
 TEST(HiddenEffects, TheHeldOutCompactsConsolidationIsNamed) {
   const Truth truth = draw_truth(g_seed);
-  const auto dir =
-      std::filesystem::temp_directory_path() /
-      ("demcal-hidden-consolidation-" + std::to_string(g_seed) + "-" + std::to_string(getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto dir = test::fresh_directory("consolidation", g_seed);
   const auto measured = measure(truth, dir);
   std::ofstream(dir / "campaign.yaml") << campaign_yaml(measured);
-  const auto report =
-      run_json(std::string(DEMCAL_CLI_BIN) + " diagnose " + (dir / "campaign.yaml").string() +
-               " --format json --workers 2 --threads 1 --workdir " + (dir / "work").string() +
-               " 2>" + (dir / "diagnose.log").string());
+  const auto report = test::diagnose_json(dir);
   std::cout << "seed " << g_seed << ": hidden consolidation " << truth.stress << " Pa (mu_s "
             << truth.mu_s << ", Y " << truth.youngs_modulus << ")\n"
             << report.dump(2) << "\n";
 
   ASSERT_EQ(report["state"], "done");
   EXPECT_EQ(report["holdout_cause"], "consolidation") << report["conclusion"];
-  nlohmann::json c;
-  for (const auto& x : report["candidates"])
-    if (x["id"] == "consolidation") c = x;
+  const auto c = test::candidate(report, "consolidation");
   ASSERT_FALSE(c.is_null()) << "consolidation was not tested";
   ASSERT_EQ(c["state"], "verified") << c["evidence"];
   EXPECT_LT(c["holdout_rms"].get<double>(),
@@ -187,7 +167,6 @@ TEST(HiddenEffects, TheHeldOutCompactsConsolidationIsNamed) {
 
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
-  if (const char* s = std::getenv("DEMCAL_HIDDEN_SEED")) g_seed = std::stoull(s);
-  if (argc > 1) g_seed = std::stoull(argv[1]);
+  g_seed = test::hidden_seed(argc, argv);
   return RUN_ALL_TESTS();
 }

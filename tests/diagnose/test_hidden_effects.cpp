@@ -38,11 +38,13 @@
 #include <string>
 
 #include "core/common/rng.hpp"
-#include "tests/common/command.hpp"
+#include "tests/diagnose/hidden_truth.hpp"
 
 namespace {
 
 using namespace demcal;
+using test::num;
+using test::run_json;
 
 std::uint64_t g_seed = 1;
 std::string g_cause;  ///< a cause asked for by name; empty: drawn from the seed
@@ -112,13 +114,6 @@ Truth draw_truth(std::uint64_t seed, const std::string& cause) {
   return t;
 }
 
-std::string num(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
-
 /// The material as YAML; the truth's adds what the campaign's model does not know.
 std::string material_yaml(const Truth& t, bool truth) {
   std::ostringstream y;
@@ -138,13 +133,6 @@ std::string material_yaml(const Truth& t, bool truth) {
   if (truth && t.rods) y << "  shape: {kind: rod, aspect_ratio: " << num(t.aspect_ratio) << "}\n";
   if (truth && t.spread > 0.0) y << "  shape: {kind: cluster, spread: " << num(t.spread) << "}\n";
   return y.str();
-}
-
-/// Runs a demcal command and parses its standard output as JSON.
-nlohmann::json run_json(const std::string& cmd) {
-  const test::CommandResult r = test::run_command(cmd);
-  EXPECT_EQ(r.exit_code, 0) << cmd;
-  return nlohmann::json::parse(r.out);
 }
 
 /// The measured data: the truth simulated in the packing test (its own lab seed).
@@ -195,10 +183,7 @@ nlohmann::json diagnose(const std::filesystem::path& spec, const std::filesystem
 
 TEST(HiddenEffects, DiagnosisNamesTheHiddenCause) {
   const Truth truth = draw_truth(g_seed, g_cause);
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("demcal-hidden-" + std::to_string(g_seed) + "-" + std::to_string(getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto dir = test::fresh_directory("effects", g_seed);
   const auto measured = measure(truth, dir);
   std::ofstream(dir / "campaign.yaml") << campaign_yaml(truth, measured);
   const auto report = diagnose(dir / "campaign.yaml", dir / "work");
@@ -212,9 +197,7 @@ TEST(HiddenEffects, DiagnosisNamesTheHiddenCause) {
   ASSERT_EQ(report["state"], "done");
   EXPECT_EQ(report["named_cause"], truth.cause) << report["conclusion"];
   const double base = report["baseline"]["verified_rms"].get<double>();
-  nlohmann::json best;
-  for (const auto& c : report["candidates"])
-    if (c["id"] == report["named_cause"]) best = c;
+  const auto best = test::candidate(report, report["named_cause"]);
   ASSERT_FALSE(best.is_null()) << "no cause named";
   const double after = best["verified_rms"].get<double>();
   EXPECT_LT(after, (1.0 - kMargin) * base)
@@ -233,8 +216,7 @@ TEST(HiddenEffects, DiagnosisNamesTheHiddenCause) {
 
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
-  if (const char* s = std::getenv("DEMCAL_HIDDEN_SEED")) g_seed = std::stoull(s);
-  if (argc > 1) g_seed = std::stoull(argv[1]);
+  g_seed = test::hidden_seed(argc, argv);
   if (argc > 2) g_cause = argv[2];
   return RUN_ALL_TESTS();
 }

@@ -34,6 +34,16 @@ const std::string kSpheres = R"(material:
   density: 2500
 )";
 
+/// Cohesive Luding spheres of 1 mm, whose die beds a tensile test can pull apart.
+const std::string kCohesiveLuding = R"(material:
+  particle_law:
+    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, kc_ratio: 0.5, phi_f: 0.05, restitution: 0.3}
+    cohesion: {model: van_der_waals, hamaker: 1.0e-18, d_max: 1.0e-5}
+    tangential: {model: history, mu_s: 0.3}
+  sizes: {monodisperse: {radius: 1.0e-3}}
+  density: 1500
+)";
+
 /// Two small drums of 57 spheres (14 x 6 mm, D/d = 7): `drum_ptfe` with a slippery wall law of
 /// its own, `drum_coated` with the material's (the particle law, §4.2 of seed 001).
 std::string drums_spec() {
@@ -230,15 +240,7 @@ TEST(TestInstances, EmbeddedRunReportsEachInstanceAsItsOwnMetric) {
 /// the embedded default: every tensile job is leased after its row's compression and starts from
 /// that bed (its phases are the unload and the pull only).
 TEST(TestInstances, ATensileJobStartsFromTheBedItsRowsCompressionConditioned) {
-  const std::string spec = R"(name: tensile-after-compression
-material:
-  particle_law:
-    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, kc_ratio: 0.5, phi_f: 0.05, restitution: 0.3}
-    cohesion: {model: van_der_waals, hamaker: 1.0e-18, d_max: 1.0e-5}
-    tangential: {model: history, mu_s: 0.3}
-  sizes: {monodisperse: {radius: 1.0e-3}}
-  density: 1500
-tests:
+  const std::string spec = "name: tensile-after-compression\n" + kCohesiveLuding + R"(tests:
   - {test: tensile, seed: 1, settings: {particles: 100, wall_stiffness_factor: 1, wall_hamaker_factor: 10, wall_k2_factor: 1, consolidation_stress: 5000, pull_distance: 1, cycles: 1}}
   - {test: confined_compression, seed: 1, settings: {particles: 100, wall_stiffness_factor: 1, max_stress: 5000, cycles: 1}}
 factors:
@@ -280,15 +282,7 @@ measurements:
 /// A compression, a tensile test (its strength held out unless `strength_held_out` is false) and
 /// a shear cell; `measured` lists the compression's measured metrics.
 std::string consolidation_spec(const std::string& measured, bool strength_held_out = true) {
-  std::string spec = R"(name: consolidation
-material:
-  particle_law:
-    normal: {model: luding, youngs_modulus: 1.0e7, k2_ratio: 5, kc_ratio: 0.5, phi_f: 0.05, restitution: 0.3}
-    cohesion: {model: van_der_waals, hamaker: 1.0e-18, d_max: 1.0e-5}
-    tangential: {model: history, mu_s: 0.3}
-  sizes: {monodisperse: {radius: 1.0e-3}}
-  density: 1500
-tests:
+  std::string spec = "name: consolidation\n" + kCohesiveLuding + R"(tests:
   - {test: confined_compression, settings: {particles: 100, max_stress: 6000, cycles: 1}}
   - {test: tensile, settings: {particles: 100, consolidation_stress: 6000, cycles: 1}}
   - {test: shear_cell}
