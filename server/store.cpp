@@ -487,8 +487,9 @@ Counts Store::counts(std::int64_t campaign_id, const std::string& kind) {
   // `reused`: the job's result was taken from an earlier run (0 for the states without results).
   Statement s(*this,
               "SELECT state, COUNT(*), SUM(reused), "
-              "SUM(state IN ('done', 'failed') AND finished >= ? AND NOT reused) "
-              "FROM (SELECT j.state, j.finished, "
+              "SUM(state IN ('done', 'failed') AND finished >= ? AND NOT reused "
+              "    AND error NOT LIKE 'given up:%') "
+              "FROM (SELECT j.state, j.finished, j.error, "
               "      COALESCE(r.reused_from != 0 OR r.reused_journal != '', 0) AS reused "
               "      FROM jobs j LEFT JOIN results r ON r.job_id = j.id "
               "      WHERE j.campaign_id = ? AND (? = '' OR j.kind = ?)) "

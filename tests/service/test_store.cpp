@@ -797,6 +797,8 @@ TEST(Store, AJobGivenUpFailsWithItsReasonAndTheCampaignEndsWithoutIt) {
   const Counts c = s.counts(id);
   EXPECT_EQ(c.done, 1);
   EXPECT_EQ(c.failed, 2);
+  // A job given up did not end by simulating: the ETA's rate counts the one done only.
+  EXPECT_EQ(c.simulated_since_opening, 1);
   EXPECT_EQ(s.campaign(id)->state, "done");
 }
 
