@@ -160,7 +160,7 @@ void run(const DiagnoseOptions& o) {
       [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
         report(drive(stub, channel, id, o), o.format);
       },
-      o.journal, o.wait ? Reach::kRun : Reach::kLook);
+      o.journal, o.wait ? Reach::kRun : Reach::kLookAtCopy);
 }
 
 }  // namespace

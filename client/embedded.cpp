@@ -1,9 +1,12 @@
 #include "client/embedded.hpp"
 
+#include <fcntl.h>
 #include <google/protobuf/util/message_differencer.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <stdlib.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
@@ -11,7 +14,9 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
 
@@ -94,6 +99,55 @@ std::string held_by(const server::StoreLock::Holder& holder) {
   return "held by a running coordinator" + (holder.pid.empty() ? "" : " (pid " + holder.pid + ")");
 }
 
+/// Where a coordinator that holds the store of a work directory leaves its loopback address and
+/// token for the commands of its user.
+std::filesystem::path coordinator_file(const std::filesystem::path& workdir) {
+  return workdir / "coordinator.json";
+}
+
+/// Writes the coordinator file of `workdir`: its owner's alone (0600), as the store is, written to
+/// a temporary file and renamed. A failure to write is reported and otherwise ignored: the other
+/// commands then read a copy of the store or are refused, as without it.
+void leave_coordinator_file(const std::filesystem::path& workdir,
+                            const rpc::ChannelOptions& channel) {
+  const auto file = coordinator_file(workdir);
+  const std::string temporary = file.string() + ".tmp";
+  const std::string text = nlohmann::json{
+      {"pid", std::to_string(::getpid())},
+      {"address", channel.address},
+      {"token", channel.token}}.dump();
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  const bool written =
+      fd >= 0 && ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+  if (fd >= 0) ::close(fd);
+  if (!written || std::rename(temporary.c_str(), file.c_str()) != 0) {
+    std::cerr << "could not write " << file.string() << " (" << std::strerror(errno)
+              << "): other commands will read a copy of the store while this one runs\n";
+    std::filesystem::remove(temporary);
+  }
+}
+
+/// The coordinator holding the store of `workdir` as `holder`, where it left its address: its
+/// file is this user's, readable by no one else, and names the holder's pid. Anything else
+/// (no file, another owner or mode, another pid, a file that does not parse) reaches nothing.
+std::optional<rpc::ChannelOptions> live_coordinator(const std::filesystem::path& workdir,
+                                                    const server::StoreLock::Holder& holder) {
+  const auto file = coordinator_file(workdir);
+  struct stat st {};
+  if (::lstat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || st.st_uid != ::geteuid() ||
+      (st.st_mode & 077) != 0)
+    return std::nullopt;
+  std::ifstream in(file);
+  const auto j = nlohmann::json::parse(in, nullptr, false);
+  if (!j.is_object() || !j.contains("pid") || !j.contains("address") || !j.contains("token") ||
+      j["pid"] != holder.pid || !j["address"].is_string() || !j["token"].is_string())
+    return std::nullopt;
+  rpc::ChannelOptions channel;
+  channel.address = j["address"];
+  channel.token = j["token"];
+  return channel;
+}
+
 /// Why a look (a command that runs no job) reads a copy of a store taken now instead of the
 /// file, and, for a store a running coordinator holds, since when that one holds it.
 struct CopyToLookAt {
@@ -132,6 +186,52 @@ void require_a_store_to_change(const std::filesystem::path& store) {
                              " (run the spec there first, or name its --workdir)");
 }
 
+/// The spec as a campaign is resumed by: canonical, without the diagnosis's rounds, which
+/// `demcal diagnose` may change on a stored campaign (its runs kept).
+v1::CampaignSpec resumed_as(const v1::CampaignSpec& spec) {
+  v1::CampaignSpec out = rpc::canonical_spec(spec);
+  if (out.has_diagnose()) out.mutable_diagnose()->clear_rounds();
+  if (out.has_diagnose() && out.diagnose().ByteSizeLong() == 0) out.clear_diagnose();
+  return out;
+}
+
+/// Throws InputError unless campaign `id` was submitted with the spec of `file`, up to its
+/// diagnosis's rounds.
+void refuse_if_another_spec(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                            std::int64_t id, const SpecFile& file,
+                            const std::filesystem::path& workdir) {
+  v1::GetRequest req;
+  req.set_id(id);
+  v1::Campaign stored;
+  check(stub.Get(rpc::make_context(channel, 60).get(), req, &stored), "get");
+  if (google::protobuf::util::MessageDifferencer::Equals(resumed_as(stored.spec()),
+                                                         resumed_as(file.spec)))
+    return;
+  throw InputError("", "campaign " + std::to_string(id) + " '" + file.spec.name() + "' in " +
+                           workdir.string() + " was submitted with another spec than " + file.name +
+                           ": give another --workdir (or another name) to run it, "
+                           "or the spec it was submitted with to resume it");
+}
+
+/// The newest campaign not cancelled of the spec's name on a coordinator of work directory
+/// `workdir`; 0 when there is none. InputError as refuse_if_another_spec.
+std::int64_t campaign_of_spec(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel,
+                              const SpecFile& file, const std::filesystem::path& workdir) {
+  v1::ListReply list;
+  check(stub.List(rpc::make_context(channel, 30).get(), {}, &list), "list");
+  std::int64_t id = 0;
+  for (const auto& c : list.campaigns())
+    if (c.name() == file.spec.name() && c.state() != v1::CANCELLED) id = std::max(id, c.id());
+  if (id) refuse_if_another_spec(stub, channel, id, file, workdir);
+  return id;
+}
+
+/// InputError naming the spec and the work directory: no campaign of the spec there.
+[[noreturn]] void no_campaign(const SpecFile& file, const std::filesystem::path& workdir) {
+  throw InputError(
+      "", "no campaign '" + file.spec.name() + "' of " + file.name + " in " + workdir.string());
+}
+
 }  // namespace
 
 std::filesystem::path work_directory(const std::string& spec, const std::string& workdir) {
@@ -148,8 +248,19 @@ void with_campaign(const std::string& campaign, const std::string& workdir,
     std::optional<StoreCopy> copy;
     std::optional<double> held_since;
     const std::filesystem::path store = EmbeddedService::store_path(dir);
+    if (reach == Reach::kLook || reach == Reach::kChange)
+      if (const auto held = server::StoreLock::holder(store.string()))
+        if (const auto live = live_coordinator(dir, *held)) {
+          std::cerr << "the store " << store.string() << " is " << held_by(*held)
+                    << ": reaching it at " << live->address << "\n";
+          const auto stub = campaign_stub(*live);
+          const std::int64_t id = campaign_of_spec(*stub, *live, file, dir);
+          if (!id) no_campaign(file, dir);
+          act(*stub, *live, id);
+          return;
+        }
     if (reach == Reach::kChange) require_a_store_to_change(store);
-    if (reach == Reach::kLook)
+    if (reach == Reach::kLook || reach == Reach::kLookAtCopy)
       if (const auto look = copy_to_look_at(store)) {
         copy.emplace(store);
         std::cerr << "the store " << store.string() << " " << look->why
@@ -240,6 +351,8 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
   coordinator_ = std::make_unique<server::Coordinator>(co);
   channel_.address = "127.0.0.1:" + std::to_string(coordinator_->port());
   channel_.token = co.token;
+  holds_store_ = !held_since;
+  if (holds_store_) leave_coordinator_file(workdir, channel_);
   for (int i = 1; i <= local.workers; ++i) {
     worker::WorkerOptions wo;
     wo.channel = channel_;
@@ -270,6 +383,7 @@ void EmbeddedService::stop_on_signal(int sig) {
   while (running_ > 0 && std::chrono::steady_clock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   if (keeper_) keeper_->sync();
+  take_address_away();
 }
 
 EmbeddedService::~EmbeddedService() {
@@ -278,35 +392,14 @@ EmbeddedService::~EmbeddedService() {
   flags_.stop = true;
   for (auto& w : workers_) w.join();
   keeper_.reset();  // its last update, with every job the workers finished
+  take_address_away();
   coordinator_->shutdown();
 }
 
-namespace {
-
-/// The spec as a campaign is resumed by: canonical, without the diagnosis's rounds, which
-/// `demcal diagnose` may change on a stored campaign (its runs kept).
-v1::CampaignSpec resumed_as(const v1::CampaignSpec& spec) {
-  v1::CampaignSpec out = rpc::canonical_spec(spec);
-  if (out.has_diagnose()) out.mutable_diagnose()->clear_rounds();
-  if (out.has_diagnose() && out.diagnose().ByteSizeLong() == 0) out.clear_diagnose();
-  return out;
-}
-
-}  // namespace
-
-void EmbeddedService::refuse_if_another_spec(std::int64_t id, const SpecFile& file) {
-  v1::GetRequest req;
-  req.set_id(id);
-  v1::Campaign stored;
-  check(stub_->Get(rpc::make_context(channel_, 60).get(), req, &stored), "get");
-  if (google::protobuf::util::MessageDifferencer::Equals(resumed_as(stored.spec()),
-                                                         resumed_as(file.spec)))
-    return;
-  throw InputError("", "campaign " + std::to_string(id) + " '" + file.spec.name() + "' in " +
-                           workdir_.string() + " was submitted with another spec than " +
-                           file.name +
-                           ": give another --workdir (or another name) to run it, "
-                           "or the spec it was submitted with to resume it");
+void EmbeddedService::take_address_away() {
+  if (!holds_store_) return;
+  std::error_code ignored;
+  std::filesystem::remove(coordinator_file(workdir_), ignored);
 }
 
 std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostream& out,
@@ -328,20 +421,12 @@ std::int64_t resuming(std::int64_t id, const SpecFile& file, std::ostream& out) 
 }  // namespace
 
 std::int64_t EmbeddedService::resumable_campaign(const SpecFile& file) {
-  v1::ListReply list;
-  check(stub_->List(rpc::make_context(channel_, 30).get(), {}, &list), "list");
-  std::int64_t id = 0;
-  for (const auto& c : list.campaigns())
-    if (c.name() == file.spec.name() && c.state() != v1::CANCELLED) id = std::max(id, c.id());
-  if (id) refuse_if_another_spec(id, file);
-  return id;
+  return campaign_of_spec(*stub_, channel_, file, workdir_);
 }
 
 std::int64_t EmbeddedService::resume(const SpecFile& file, std::ostream& out) {
   const std::int64_t id = resumable_campaign(file);
-  if (!id)
-    throw InputError(
-        "", "no campaign '" + file.spec.name() + "' of " + file.name + " in " + workdir_.string());
+  if (!id) no_campaign(file, workdir_);
   return resuming(id, file, out);
 }
 

@@ -79,13 +79,13 @@ class EmbeddedService {
   void stop_on_signal(int sig);
 
  private:
-  /// Throws InputError unless campaign `id` was submitted with the spec of `file`, up to its
-  /// diagnosis's rounds.
-  void refuse_if_another_spec(std::int64_t id, const SpecFile& file);
+  /// Removes the address it left in its work directory (a holder's; a copy left none).
+  void take_address_away();
   /// submit_or_resume without a journal.
   std::int64_t submit_or_resume_campaign(const SpecFile& file, std::ostream& out);
   /// The newest campaign not cancelled of the spec's name in this work directory; 0 when there
-  /// is none. InputError as refuse_if_another_spec.
+  /// is none. InputError unless it was submitted with the spec of `file`, up to its diagnosis's
+  /// rounds.
   std::int64_t resumable_campaign(const SpecFile& file);
 
   std::filesystem::path workdir_;
@@ -98,6 +98,7 @@ class EmbeddedService {
   std::atomic<int> running_{0};  ///< workers that have not returned
   std::unique_ptr<v1::CampaignService::Stub> stub_;
   std::unique_ptr<JournalKeeper> keeper_;
+  bool holds_store_ = false;  ///< not a copy: it left its address in the work directory
 };
 
 /// demcal-work/<spec stem> unless a directory is given.
@@ -108,12 +109,19 @@ using CampaignAction = std::function<void(v1::CampaignService::Stub& stub,
                                           const rpc::ChannelOptions& channel, std::int64_t id)>;
 
 /// What a command does to a campaign's store on the embedded default.
+/// A coordinator that holds a store (a `demcal run` or `demcal diagnose` going on) leaves its
+/// loopback address and token in the work directory, its user's alone: a look or a change there
+/// is made through it.
 enum class Reach {
-  kRun,     ///< runs its jobs on local workers, watched until they end
-  kLook,    ///< runs nothing and reads the store as it stands: a copy taken now when a running
-            ///< coordinator holds it or its schema is older than this build's
-  kChange,  ///< runs nothing and changes the store itself: refused when a running coordinator
-            ///< holds it (a copy's change would be thrown away) or there is none yet
+  kRun,         ///< runs its jobs on local workers, watched until they end
+  kLook,        ///< runs nothing and reads the store as it stands: through the running
+                ///< coordinator that holds it, else from a copy taken now (one that left no
+                ///< address, or a store of a schema older than this build's)
+  kLookAtCopy,  ///< as kLook, but from a copy whenever a running coordinator holds the store:
+                ///< for a look that queues runs, which the copy throws away
+  kChange,      ///< runs nothing and changes the store: through the running coordinator that
+                ///< holds it; refused when one that left no address holds it (a copy's change
+                ///< would be thrown away) or there is none yet
 };
 
 /// Reaches the campaign a command names and runs `act` on it: a spec YAML file on the embedded

@@ -165,10 +165,11 @@ TEST_F(Service, TheEmbeddedDefaultInterruptedCountsNoAttemptAgainstItsJobs) {
   EXPECT_GE(given_back, 1);
 }
 
-// `demcal give-up SPEC` changes the embedded store itself: refused while the campaign's `demcal
-// run` holds it, and where there is no store; done once the run has stopped, after which the run
-// goes on to the campaign's end without the job given up.
-TEST_F(Service, GiveUpOnTheEmbeddedDefaultChangesTheStoreOnlyWhenNoCoordinatorHoldsIt) {
+// `demcal give-up SPEC` on the embedded default: through the campaign's `demcal run` while that
+// one holds the store (the address it left in the work directory), which goes on to the
+// campaign's end without the job; refused while a holder left no address it may use (a file
+// others could read), and where there is no store; on the store itself once no run holds it.
+TEST_F(Service, GiveUpOnTheEmbeddedDefaultReachesTheRunningCoordinatorOrChangesTheStore) {
   const std::string spec = path("gaveup.yaml");
   std::ofstream(spec) << wall_friction_spec("gaveup", "");
   const std::string db = path("work/campaign.db");
@@ -198,40 +199,55 @@ TEST_F(Service, GiveUpOnTheEmbeddedDefaultChangesTheStoreOnlyWhenNoCoordinatorHo
              [&](sqlite3_stmt* st) { n = sqlite3_column_int(st, 0); });
     return n;
   };
+  const fs::path address = path("work/coordinator.json");
   {
     Process run(run_argv, path("run1.log"));
-    ASSERT_TRUE(wait_until([&] { return job_in("leased") != 0; }, 60)) << run.log();
-    const auto [held, held_log] = give_up("held.log", path("work"), job_in("leased"));
-    EXPECT_NE(held, 0);
-    EXPECT_NE(held_log.find("held by a running coordinator"), std::string::npos) << held_log;
-    EXPECT_NE(held_log.find(db), std::string::npos) << held_log;
+    ASSERT_TRUE(wait_until([&] { return job_in("leased") != 0 && fs::exists(address); }, 60))
+        << run.log();
+    EXPECT_EQ(fs::status(address).permissions() & fs::perms::all,
+              fs::perms::owner_read | fs::perms::owner_write);
+    // An address others could read is not used: refused, naming the holder.
+    fs::permissions(address, fs::perms::group_read, fs::perm_options::add);
+    const auto [open, open_log] = give_up("open.log", path("work"), job_in("leased"));
+    EXPECT_NE(open, 0);
+    EXPECT_NE(open_log.find("held by a running coordinator"), std::string::npos) << open_log;
+    EXPECT_NE(open_log.find(db), std::string::npos) << open_log;
     run.signal(SIGINT);
     EXPECT_EQ(run.wait_exit(40), 128 + SIGINT) << run.log();
   }
-  EXPECT_EQ(given_up(), 0);  // the refused give-up changed nothing
-  const std::int64_t queued = job_in("queued");
-  ASSERT_NE(queued, 0);
-  const auto [given, given_log] = give_up("given.log", path("work"), queued);
-  ASSERT_EQ(given, 0) << given_log;
-  EXPECT_NE(given_log.find("given up: creeps"), std::string::npos) << given_log;
-  const auto [again, again_log] = give_up("again.log", path("work"), queued);
-  EXPECT_NE(again, 0);
-  EXPECT_NE(again_log.find("is failed"), std::string::npos) << again_log;
-  Process last(run_argv, path("run2.log"));
-  ASSERT_EQ(last.wait_exit(150), 0) << last.log();
+  EXPECT_FALSE(fs::exists(address));  // a stopped run takes its address away
+  EXPECT_EQ(given_up(), 0);           // the refused give-up changed nothing
+  std::int64_t leased = 0;
+  {
+    Process run(run_argv, path("run2.log"));
+    ASSERT_TRUE(wait_until([&] { return job_in("leased") != 0 && fs::exists(address); }, 60))
+        << run.log();
+    leased = job_in("leased");
+    const auto [live, live_log] = give_up("live.log", path("work"), leased);
+    ASSERT_EQ(live, 0) << live_log;
+    EXPECT_NE(live_log.find("reaching it at 127.0.0.1:"), std::string::npos) << live_log;
+    EXPECT_NE(live_log.find("given up: creeps"), std::string::npos) << live_log;
+    ASSERT_EQ(run.wait_exit(150), 0) << run.log();
+  }
+  EXPECT_FALSE(fs::exists(address));
   std::map<std::string, int> states;
   each_row(db, "SELECT state FROM jobs", [&](sqlite3_stmt* st) {
     ++states[reinterpret_cast<const char*>(sqlite3_column_text(st, 0))];
   });
   EXPECT_EQ(states["done"], 3);
   EXPECT_EQ(states["failed"], 1);
-  EXPECT_EQ(job_in("failed"), queued);
+  EXPECT_EQ(job_in("failed"), leased);
   EXPECT_EQ(given_up(), 1);
+  // With no run holding it, the store itself: the job has ended.
+  const auto [again, again_log] = give_up("again.log", path("work"), leased);
+  EXPECT_NE(again, 0);
+  EXPECT_NE(again_log.find("is failed"), std::string::npos) << again_log;
 }
 
-// `demcal status SPEC` of a campaign whose `demcal run` holds the store reads a copy of it, with
-// that run's lease (its job in flight shows as running) and rated from that run's start (its lock
-// file's date): once a job of the run has ended, it shows an ETA.
+// `demcal status SPEC` of a campaign whose `demcal run` holds the store asks that run's
+// coordinator. Where the run left no address, it reads a copy of the store, with that run's lease
+// (its job in flight shows as running) and rated from that run's start (its lock file's date):
+// once a job of the run has ended, it shows an ETA.
 TEST_F(Service, StatusOfACampaignRunningInAnotherProcessShowsAnEta) {
   const std::string spec = path("held.yaml");
   std::ofstream(spec) << wall_friction_spec("held", "");
@@ -243,8 +259,20 @@ TEST_F(Service, StatusOfACampaignRunningInAnotherProcessShowsAnEta) {
     return !polled_ids(db, std::string("SELECT id FROM jobs WHERE state = '") + state + "'")
                 .empty();
   };
+  ASSERT_TRUE(
+      wait_until([&] { return in("leased") && fs::exists(path("work/coordinator.json")); }, 90))
+      << run.log();
+  {
+    Process live({DEMCAL_CLI_BIN, "status", spec, "--workdir", path("work")}, path("live.log"));
+    ASSERT_EQ(live.wait_exit(60), 0) << live.log();
+    EXPECT_NE(live.log().find("reaching it at 127.0.0.1:"), std::string::npos) << live.log();
+    EXPECT_EQ(live.log().find("copy"), std::string::npos) << live.log();
+    EXPECT_NE(live.log().find("/4 done"), std::string::npos) << live.log();  // its progress
+  }
   // Frozen (SIGSTOP: the run holds its store, its progress stops while the copy is read) with a
   // job done, one running and one queued; a freeze between two leases is thawed and tried again.
+  // Its address is taken away, as a run of an earlier build leaves none.
+  fs::remove(path("work/coordinator.json"));
   bool frozen = false;
   for (int attempt = 0; attempt < 5 && !frozen; ++attempt) {
     ASSERT_TRUE(wait_until([&] { return in("done") && in("leased") && in("queued"); }, 90))
