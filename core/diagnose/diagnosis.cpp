@@ -785,11 +785,16 @@ CandidateOutcome assess_conditioning(const Problem& p, const Plan& plan, const F
   }
   c.proposed[plan.factors.front().path] = ratio * stress;
   c.state = "designed";
+  std::ostringstream e;
+  e << cond.held_out << " consolidated at " << number(ratio * stress) << " Pa, where the compact's "
+    << cond.density << " meets the measured " << number(target) << " (simulated "
+    << levels_seen.str() << ")";
   for (int k = 0; k < n; ++k)
     requests.push_back(
         conditioned_run(cond, plan.id + "/verify", k + 1, rep.baseline_proposed, ratio, k));
   const auto rows = replicate_rows(p, find_group(groups, plan.id + "/verify"), 1);
   if (rows.empty()) {
+    c.evidence = e.str() + "; verifying it";
     finished = false;
     return c;
   }
@@ -797,10 +802,7 @@ CandidateOutcome assess_conditioning(const Problem& p, const Plan& plan, const F
   c.rounds = c.best_round = 1;
   c.holdout_rms = rms_error(p, base.all, c.simulated, true);
   c.holdout_rms_se = replicate_rms_se(p, base.all, rows, true);
-  std::ostringstream e;
-  e << cond.held_out << " consolidated at " << number(ratio * stress) << " Pa, where the compact's "
-    << cond.density << " meets the measured " << number(target) << " (simulated "
-    << levels_seen.str() << "; verified " << number(c.simulated[cond.density]) << ")";
+  e << "; verified " << cond.density << " " << number(c.simulated[cond.density]);
   if (!std::isfinite(c.holdout_rms)) {
     c.state = "failed";
     c.evidence = e.str() + "; a verification run failed";

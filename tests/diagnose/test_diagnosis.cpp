@@ -1155,6 +1155,16 @@ TEST(Diagnosis, AHeldOutCompactConsolidatedToTheMeasuredDensityIsNamed) {
   EXPECT_NEAR(verify[0].settings.at("tensile").at("consolidation_stress"), expected,
               1e-6 * expected);
   EXPECT_NEAR(c->simulated.at(kDensity), measured.at(kDensity), 1e-9);
+  // Before its verification, the report already says where it conditions and why.
+  std::map<std::string, GroupResults> unverified;
+  for (const auto& q : d.step.requests)
+    if (q.group != "consolidation/verify") unverified[q.group][q.row] = consolidated_truth(q);
+  const Report waiting = diagnose::advance(p, unverified).report;
+  const CandidateOutcome* designed = candidate(waiting, "consolidation");
+  EXPECT_EQ(designed->state, "designed");
+  EXPECT_EQ(designed->proposed, c->proposed);
+  EXPECT_NE(designed->evidence.find("verifying it"), std::string::npos) << designed->evidence;
+  EXPECT_NE(designed->evidence.find("meets the measured"), std::string::npos) << designed->evidence;
 
   // The held-out error: the baseline's compact is too strong several times over; the
   // consolidated one misses by B's weak effect only.
