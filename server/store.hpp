@@ -151,9 +151,9 @@ struct Counts {
   std::int64_t queued = 0, leased = 0, done = 0, failed = 0, cancelled = 0;
   std::int64_t reused = 0;  ///< of done: results taken from an earlier run with the same run key
   /// The window a rate is measured over: the jobs simulated (done or failed, not taken from an
-  /// earlier run nor given up) since the store was opened (or since StoreLimits::rate_since), and the
-  /// wall-clock time of that opening. A campaign resumed after days away is rated on this run of
-  /// its coordinator only.
+  /// earlier run nor given up) since the store was opened (or since StoreLimits::rate_since), and
+  /// the wall-clock time of that opening. A campaign resumed after days away is rated on this run
+  /// of its coordinator only.
   std::int64_t simulated_since_opening = 0;
   double opening = 0.0;
   std::int64_t total() const { return queued + leased + done + failed + cancelled; }

@@ -816,6 +816,23 @@ CandidateOutcome assess_conditioning(const Problem& p, const Plan& plan, const F
   return c;
 }
 
+/// How a candidate's verified error compares with the baseline's: below (1 - margin) times it, and
+/// whether that cut is within noise_z standard errors of the difference (the two errors' standard
+/// errors combined as independent; unknown without replicates, when the margin alone decides).
+struct Cut {
+  bool by_margin = false, within_noise = false;
+  double noise = kPending;  ///< the standard error of the difference
+  bool explains() const { return by_margin && !within_noise; }
+};
+
+Cut cut_of(const Options& o, double base, double base_se, double error, double error_se) {
+  Cut c;
+  c.by_margin = std::isfinite(base) && error < (1.0 - o.margin) * base;
+  c.noise = std::hypot(base_se, error_se);
+  c.within_noise = c.by_margin && base - error <= o.noise_z * c.noise;
+  return c;
+}
+
 /// Step 3: candidates ranked by their verified error, each verified one with its evidence and
 /// whether it explains the misfit.
 void rank_candidates(const Problem& p, Report& rep) {
@@ -828,12 +845,10 @@ void rank_candidates(const Problem& p, Report& rep) {
   const double base_rms = rep.baseline_verified_rms;
   for (auto& c : rep.candidates) {
     if (c.state != "verified" || c.conditioning) continue;
-    const bool cut =
-        std::isfinite(base_rms) && c.verified_rms < (1.0 - p.options.margin) * base_rms;
-    // Unknown without replicates: then the margin alone decides.
-    const double noise = std::hypot(rep.baseline_verified_rms_se, c.verified_rms_se);
-    c.within_noise = cut && base_rms - c.verified_rms <= p.options.noise_z * noise;
-    c.explains = cut && !c.within_noise;
+    const Cut cut = cut_of(p.options, base_rms, rep.baseline_verified_rms_se, c.verified_rms,
+                           c.verified_rms_se);
+    c.within_noise = cut.within_noise;
+    c.explains = cut.explains();
     std::ostringstream e;
     e << "verified RMS error " << with_se(c.verified_rms, c.verified_rms_se) << " against "
       << with_se(base_rms, rep.baseline_verified_rms_se) << " for the baseline (predicted "
@@ -853,7 +868,7 @@ void rank_candidates(const Problem& p, Report& rep) {
     e << (c.reaches_all ? "; its box reaches every target" : "; some target stays out of reach");
     if (c.within_noise)
       e << "; its cut is within " << number(p.options.noise_z)
-        << " standard errors of the difference (" << percent(noise) << "): the seeds' noise";
+        << " standard errors of the difference (" << percent(cut.noise) << "): the seeds' noise";
     c.evidence = e.str();
   }
 }
@@ -939,10 +954,10 @@ void name_holdout_cause(const Problem& p, bool all_verified, Report& rep) {
   for (auto& c : rep.candidates) {
     if (c.state != "verified" || !std::isfinite(c.holdout_rms)) continue;
     c.holdout_gain = 1.0 - c.holdout_rms / base;
-    const double noise = std::hypot(rep.baseline_holdout_rms_se, c.holdout_rms_se);
-    const bool cut = c.holdout_rms < (1.0 - p.options.margin) * base &&
-                     !(base - c.holdout_rms <= p.options.noise_z * noise);
-    c.explains_holdout = cut && (c.conditioning || c.verified_rms <= rep.baseline_verified_rms);
+    const Cut cut =
+        cut_of(p.options, base, rep.baseline_holdout_rms_se, c.holdout_rms, c.holdout_rms_se);
+    c.explains_holdout =
+        cut.explains() && (c.conditioning || c.verified_rms <= rep.baseline_verified_rms);
     if (c.explains_holdout && (!named || c.holdout_rms < named->holdout_rms)) named = &c;
   }
   if (!all_verified) return;
