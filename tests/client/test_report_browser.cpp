@@ -1,9 +1,7 @@
 // The HTML report and the live page in a real browser. A coordinator with its live page
 // (`demcal-server --http`) and two workers run examples/packing_demo_campaign.yaml (300
 // particles, ten runs) and its sequential calibration; then Debian's headless Chromium opens
-// `demcal report`'s report.html and the live page. Chromium's --dump-dom gives the DOM after
-// the scripts ran (Vega renders SVG, so every mark is an element we can count) and its log
-// carries every console message; no driver beyond the browser itself is needed.
+// `demcal report`'s report.html and the live page (tests/common/chromium.hpp).
 #include <gtest/gtest.h>
 #include <httplib.h>
 
@@ -21,12 +19,16 @@
 #include <string>
 #include <vector>
 
+#include "tests/common/chromium.hpp"
 #include "tests/common/command.hpp"
 #include "tests/service/process.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+using demcal::test::chromium_flags;
+using demcal::test::open_in_chromium;
+using demcal::test::Page;
 using demcal::test::Process;
 using nlohmann::json;
 
@@ -51,31 +53,6 @@ int read_port(const fs::path& file) {
   demcal::test::wait_until([&] { return fs::exists(file); }, 30);
   std::ifstream(file) >> port;
   return port;
-}
-
-/// The page after its scripts ran, and every console message Chromium logged.
-struct Page {
-  std::string dom;
-  std::vector<std::string> console;
-};
-
-std::string chromium_flags(const fs::path& dir) {
-  // Root in a container: no sandbox. Virtual time lets the page's timers (the live page's
-  // poll) and Vega's asynchronous rendering finish before the DOM is taken. A profile of its
-  // own: no lock shared with a browser the user runs.
-  return "chromium --headless --no-sandbox --disable-gpu --hide-scrollbars "
-         "--enable-logging=stderr --v=0 --virtual-time-budget=15000 --user-data-dir=" +
-         (dir / "chromium-profile").string() + " ";
-}
-
-Page open_in_chromium(const std::string& url, const fs::path& dir, const std::string& name) {
-  const fs::path err = dir / (name + ".chromium.log");
-  const Output o = run(chromium_flags(dir) + "--dump-dom '" + url + "' 2>" + err.string(), false);
-  Page page{o.out, {}};
-  std::istringstream log(read_text(err));
-  for (std::string line; std::getline(log, line);)
-    if (line.find(":CONSOLE") != std::string::npos) page.console.push_back(line);
-  return page;
 }
 
 void screenshot(const std::string& url, const fs::path& png) {

@@ -11,7 +11,9 @@
 // The whole pipeline runs as a user runs it (`demcal lab run` for the truth, `demcal diagnose
 // spec.yaml` with the embedded coordinator and two workers) and must name consolidation as the
 // cause of the held-out misfit, cut the held-out error by the margin, and condition the compact
-// below the design's stress to the measured solid fraction (within 0.02). At 100 particles a
+// below the design's stress to the measured solid fraction (within 0.02); the HTML report
+// (`demcal report`, opened in headless Chromium) names that cause and its gain as the CLI's JSON
+// does, and says "held out" under what the candidate explains. At 100 particles a
 // compact's solid fraction scatters by up to 0.05 between seeds, as much as a decade of stress
 // moves it: a measured value is the mean of three samples, the diagnosis verifies on two lab seeds
 // and conditions down to 0.05 of the design's stress. It does not recover S itself at this size:
@@ -27,10 +29,13 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/common/rng.hpp"
+#include "tests/common/chromium.hpp"
 #include "tests/diagnose/hidden_truth.hpp"
 
 namespace {
@@ -139,6 +144,46 @@ std::string campaign_yaml(const std::map<std::string, double>& measured) {
   return y.str();
 }
 
+/// The cells of the report's candidate table row of candidate `id` (empty when it has none).
+std::vector<std::string> candidate_row(const std::string& dom, const std::string& id) {
+  const std::size_t table = dom.find("<table class=\"data diagnosis-candidates\">");
+  if (table == std::string::npos) return {};
+  const std::size_t row = dom.find("<tr><td>" + id + "</td>", table);
+  if (row == std::string::npos) return {};
+  const std::string tr = dom.substr(row, dom.find("</tr>", row) - row);
+  std::vector<std::string> cells;
+  const std::regex td("<td>([^<]*)</td>");
+  for (auto it = std::sregex_iterator(tr.begin(), tr.end(), td); it != std::sregex_iterator(); ++it)
+    cells.push_back((*it)[1].str());
+  return cells;
+}
+
+/// `demcal report` of the diagnosed campaign, opened in Chromium: the held-out cause, its gain
+/// and what the candidate explains, as the diagnosis's JSON has them.
+void expect_report_names_the_held_out_cause(const std::filesystem::path& dir,
+                                            const nlohmann::json& report) {
+  const auto out = dir / "report";
+  const auto r = test::run_command(std::string(DEMCAL_CLI_BIN) + " report " +
+                                   (dir / "campaign.yaml").string() + " --workdir " +
+                                   (dir / "work").string() + " -o " + out.string() + " 2>&1");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const test::Page page = test::open_in_chromium(
+      "file://" + std::filesystem::absolute(out / "report.html").string(), dir, "report");
+  EXPECT_TRUE(page.console.empty()) << page.console.front();
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      page.dom, m,
+      std::regex("data-holdout-cause=\"([^\"]*)\" data-holdout-gain=\"([^\"]*)\">([^<]*)<")))
+      << "the report names no cause of the held-out misfit";
+  EXPECT_EQ(m[1].str(), "consolidation");
+  const double gain = test::candidate(report, "consolidation")["holdout_gain"].get<double>();
+  EXPECT_NEAR(std::stod(m[2].str()), gain, 1e-12);
+  EXPECT_NE(m[3].str().find("Named cause of the held-out misfit: "), std::string::npos) << m[3];
+  const auto cells = candidate_row(page.dom, "consolidation");
+  ASSERT_EQ(cells.size(), 10u) << "the candidate table has no consolidation row";
+  EXPECT_EQ(cells[7], "held out");  // the explains column
+}
+
 TEST(HiddenEffects, TheHeldOutCompactsConsolidationIsNamed) {
   const Truth truth = draw_truth(g_seed);
   const auto dir = test::fresh_directory("consolidation", g_seed);
@@ -160,6 +205,7 @@ TEST(HiddenEffects, TheHeldOutCompactsConsolidationIsNamed) {
   EXPECT_NEAR(c["simulated"]["confined_compression.final_solid_fraction"].get<double>(),
               measured.at("confined_compression.final_solid_fraction"), kDensityTolerance);
   EXPECT_LT(c["proposed"]["tensile.consolidation_stress"].get<double>(), kDesignStress);
+  expect_report_names_the_held_out_cause(dir, report);
   if (!HasFailure()) std::filesystem::remove_all(dir);
 }
 
