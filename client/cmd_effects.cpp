@@ -1,4 +1,5 @@
-// `demcal effects ID [--format table|csv|json]`, `demcal calibrate ID [--verify [--wait]]`,
+// `demcal effects ID|SPEC [--format table|csv|json]`, `demcal calibrate ID|SPEC [--verify
+// [--wait]]`,
 // `demcal export ID|SPEC [--format csv|json|journal|liggghts|yaml] [-o FILE]
 // [--lab-specs DIR | --job N]`:
 // analysis on the coordinator, on demand. The journal format writes the finished jobs as a
@@ -267,7 +268,10 @@ void write_export(v1::CampaignService::Stub& stub, const rpc::ChannelOptions& ch
 void add_analysis_commands(CLI::App& app) {
   struct Options {
     rpc::ChannelOptions channel;
-    std::int64_t id = 0;
+    std::string campaign;  ///< an id, or a spec YAML on the embedded default
+    std::string workdir;
+    LocalWorkers local;
+    bool verbose = false;
     std::string format = "table";
     std::string model = "2fi";
     std::string calibrate_model;  ///< empty: the spec's calibration.model
@@ -275,53 +279,72 @@ void add_analysis_commands(CLI::App& app) {
     bool verify = false, wait = false;
   };
   auto o = std::make_shared<Options>();
+  const auto add_campaign = [](CLI::App& cmd, Options& opt) {
+    add_connection_options(cmd, opt.channel);
+    cmd.add_option("campaign", opt.campaign, "campaign id, or a spec YAML (embedded default)")
+        ->required();
+    cmd.add_option("--workdir", opt.workdir, "embedded: directory of the SQLite file");
+    cmd.add_flag("-v,--verbose", opt.verbose, "embedded: coordinator and worker logs");
+  };
 
   auto* effects =
       app.add_subcommand("effects", "Effects per metric with alias chains and Lenth significance");
-  add_connection_options(*effects, o->channel);
-  effects->add_option("id", o->id, "campaign id")->required();
+  add_campaign(*effects, *o);
   effects->add_option("--format", o->format, "table, csv or json")
       ->check(CLI::IsMember({"table", "csv", "json"}));
   effects->add_option("--model", o->model, "main, 2fi or quadratic")
       ->check(CLI::IsMember({"main", "2fi", "quadratic"}));
   effects->add_option("--alpha", o->alpha, "significance level");
   effects->callback([o] {
-    v1::EffectsRequest req;
-    req.set_id(o->id);
-    req.set_model(o->model);
-    req.set_alpha(o->alpha);
-    v1::EffectsReply reply;
-    check(campaign_stub(o->channel)
-              ->GetEffects(rpc::make_context(o->channel, 120).get(), req, &reply),
-          "effects");
-    print_effects(std::cout, reply, o->format);
+    // A spec's campaign is read as it stands: through the coordinator running it, else a copy.
+    with_campaign(
+        o->campaign, o->workdir, LocalWorkers{}, o->verbose, o->channel,
+        [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
+          v1::EffectsRequest req;
+          req.set_id(id);
+          req.set_model(o->model);
+          req.set_alpha(o->alpha);
+          v1::EffectsReply reply;
+          check(stub.GetEffects(rpc::make_context(channel, 120).get(), req, &reply), "effects");
+          print_effects(std::cout, reply, o->format);
+        },
+        {}, Reach::kLook);
   });
 
   auto* calibrate = app.add_subcommand(
       "calibrate", "Propose a parameter set from the fitted models and the measurements");
-  add_connection_options(*calibrate, o->channel);
-  calibrate->add_option("id", o->id, "campaign id")->required();
+  add_campaign(*calibrate, *o);
   calibrate->add_flag("--verify", o->verify,
                       "advance the sequential calibration: queue the next round or stage");
   calibrate->add_flag("--wait", o->wait,
-                      "with --verify: run the loop to its end (within tolerance or budget)");
+                      "with --verify: run the loop to its end (within tolerance or budget); "
+                      "embedded: on local workers, after the campaign's queued jobs");
   calibrate->add_option("--model", o->calibrate_model, "main or 2fi (default: the spec's)")
       ->check(CLI::IsMember({"main", "2fi"}));
   calibrate->add_option("--format", o->format, "table or json")
       ->check(CLI::IsMember({"table", "json"}));
+  add_local_worker_options(*calibrate, o->local);
   calibrate->callback([o] {
-    auto stub = campaign_stub(o->channel);
-    v1::CalibrateRequest req;
-    req.set_id(o->id);
-    req.set_verify(o->verify);
-    req.set_model(o->calibrate_model);
-    v1::CalibrateReply reply;
-    if (o->verify && o->wait) {
-      reply = drive_calibration(*stub, o->channel, req, std::cerr);
-    } else {
-      check(stub->Calibrate(rpc::make_context(o->channel, 300).get(), req, &reply), "calibrate");
-    }
-    print_calibration(std::cout, reply, o->format);
+    if (o->wait && !o->verify) throw InputError("--wait", "only with --verify");
+    // A proposal is a look; a round queued is a change to the store, made through the
+    // coordinator running the spec's campaign if there is one; running the loop to its end
+    // needs workers.
+    const Reach reach = !o->verify ? Reach::kLook : o->wait ? Reach::kRun : Reach::kChange;
+    with_campaign(
+        o->campaign, o->workdir, o->local, o->verbose, o->channel,
+        [&](v1::CampaignService::Stub& stub, const rpc::ChannelOptions& channel, std::int64_t id) {
+          v1::CalibrateRequest req;
+          req.set_id(id);
+          req.set_verify(o->verify);
+          req.set_model(o->calibrate_model);
+          v1::CalibrateReply reply;
+          if (o->wait)
+            reply = drive_calibration(stub, channel, req, std::cerr);
+          else
+            check(stub.Calibrate(rpc::make_context(channel, 300).get(), req, &reply), "calibrate");
+          print_calibration(std::cout, reply, o->format);
+        },
+        {}, reach);
   });
 
   auto e = std::make_shared<ExportOptions>();

@@ -674,6 +674,50 @@ TEST(Cli, ExportYamlWritesTheCalibratedMaterialAndALabRunSpecPerTest) {
 /// stored. The grown job, queued again, has its spec written without the campaign being run: it
 /// stays queued. A job the campaign does not have, the option outside the yaml format and beside
 /// --lab-specs are refused, naming --job.
+/// `demcal effects SPEC` and `demcal calibrate SPEC` on the embedded default read the spec's
+/// campaign as `demcal run` left it: the effect tables and the calibration the run printed;
+/// `calibrate SPEC --verify [--wait]` advances its loop. `--wait` without `--verify` is refused
+/// at its flag.
+TEST(Cli, EffectsAndCalibrateOfASpecReadItsCampaignOnTheEmbeddedDefault) {
+  const fs::path dir = scratch_dir("effects_spec");
+  std::ofstream(dir / "tiny.yaml") << kTinyPackingCampaign;
+  const std::string spec = (dir / "tiny.yaml").string();
+  const std::string work = " --workdir " + (dir / "work").string();
+  const std::string cli = std::string(DEMCAL_BINARY_DIR) + "/client/demcal ";
+  const auto run = demcal::test::run_command(cli + "run " + spec + work +
+                                             " --threads 1 --format json 2>/dev/null");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const auto doc = nlohmann::json::parse(run.out);
+
+  const auto effects =
+      demcal::test::run_command(cli + "effects " + spec + work + " --format json 2>/dev/null");
+  ASSERT_EQ(effects.exit_code, 0) << effects.out;
+  ASSERT_FALSE(doc["effects"]["metrics"].empty());
+  EXPECT_EQ(nlohmann::json::parse(effects.out), doc["effects"]);
+
+  const auto calibration =
+      demcal::test::run_command(cli + "calibrate " + spec + work + " --format json 2>/dev/null");
+  ASSERT_EQ(calibration.exit_code, 0) << calibration.out;
+  const auto read = nlohmann::json::parse(calibration.out);
+  ASSERT_FALSE(doc["calibration"]["proposed"].empty());
+  EXPECT_EQ(read["proposed"], doc["calibration"]["proposed"]);
+  EXPECT_EQ(read["rounds"], doc["calibration"]["rounds"]);
+  // The loop ended with the run (its one round verified): advancing it queues nothing, on the
+  // store as it stands or with local workers.
+  for (const std::string verify : {" --verify", " --verify --wait --threads 1"}) {
+    const auto advanced = demcal::test::run_command(cli + "calibrate " + spec + work + verify +
+                                                    " --format json 2>/dev/null");
+    ASSERT_EQ(advanced.exit_code, 0) << verify << ": " << advanced.out;
+    EXPECT_EQ(nlohmann::json::parse(advanced.out)["rounds"], doc["calibration"]["rounds"])
+        << verify;
+  }
+
+  const Result wait = demcal("calibrate " + spec + work + " --wait");
+  EXPECT_NE(wait.exit_code, 0);
+  EXPECT_NE(wait.out.find("--wait: only with --verify"), std::string::npos) << wait.out;
+  fs::remove_all(dir);
+}
+
 TEST(Cli, ExportJobWritesTheLabRunSpecThatSimulatesAJobAgain) {
   const fs::path dir = scratch_dir("job");
   std::ofstream(dir / "tiny.yaml") << kTinyPackingCampaign;
