@@ -116,9 +116,7 @@ void add_campaign_commands(CLI::App& app) {
 
   auto* status = app.add_subcommand("status", "A campaign's state and progress (--jobs: each job)");
   add_connection_options(*status, o->channel);
-  status->add_option("campaign", o->campaign, "campaign id, or a spec YAML (embedded default)")
-      ->required();
-  status->add_option("--workdir", o->workdir, "embedded: directory of the SQLite file");
+  add_campaign_options(*status, o->campaign, o->workdir);
   status->add_flag("--jobs", o->jobs, "list every job with its state, attempt and metrics");
   status
       ->add_option("--format", o->format,
@@ -158,9 +156,7 @@ void add_campaign_commands(CLI::App& app) {
   auto* give_up = app.add_subcommand(
       "give-up", "Give up one queued or running job: it fails, the campaign goes on without it");
   add_connection_options(*give_up, o->channel);
-  give_up->add_option("campaign", o->campaign, "campaign id, or a spec YAML (embedded default)")
-      ->required();
-  give_up->add_option("--workdir", o->workdir, "embedded: directory of the SQLite file");
+  add_campaign_options(*give_up, o->campaign, o->workdir);
   give_up->add_option("--job", o->job, "the job's id (demcal status --jobs)")
       ->required()
       ->check(CLI::PositiveNumber);

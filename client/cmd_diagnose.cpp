@@ -172,9 +172,7 @@ void add_diagnose_command(CLI::App& app) {
                          "What the calibrated model gets wrong, the candidate causes tested by "
                          "simulation, the named cause and the gain");
   add_connection_options(*cmd, o->channel);
-  cmd->add_option("campaign", o->campaign, "campaign id, or a spec YAML (embedded default)")
-      ->required();
-  cmd->add_option("--workdir", o->workdir, "embedded: directory of the SQLite file");
+  add_campaign_options(*cmd, o->campaign, o->workdir);
   add_local_worker_options(*cmd, o->local);
   cmd->add_flag("!--no-wait", o->wait, "report the current state and queue the next runs only");
   cmd->add_option("--seed", o->seed, "calibration multi-start seed")->capture_default_str();

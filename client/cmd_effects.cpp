@@ -281,9 +281,7 @@ void add_analysis_commands(CLI::App& app) {
   auto o = std::make_shared<Options>();
   const auto add_campaign = [](CLI::App& cmd, Options& opt) {
     add_connection_options(cmd, opt.channel);
-    cmd.add_option("campaign", opt.campaign, "campaign id, or a spec YAML (embedded default)")
-        ->required();
-    cmd.add_option("--workdir", opt.workdir, "embedded: directory of the SQLite file");
+    add_campaign_options(cmd, opt.campaign, opt.workdir);
     cmd.add_flag("-v,--verbose", opt.verbose, "embedded: coordinator and worker logs");
   };
 
@@ -354,8 +352,7 @@ void add_analysis_commands(CLI::App& app) {
       "(journal), or its calibrated material as a LIGGGHTS input fragment (liggghts) or a spec's "
       "material block (yaml)");
   add_connection_options(*exp, e->channel);
-  exp->add_option("campaign", e->campaign, "campaign id, or a spec YAML (embedded default)")
-      ->required();
+  add_campaign_options(*exp, e->campaign, e->workdir);
   exp->add_option("--format", e->format, "csv, json, journal, liggghts or yaml")
       ->check(CLI::IsMember({"csv", "json", "journal", "liggghts", "yaml"}));
   exp->add_option("-o,--output", e->out,
@@ -371,7 +368,6 @@ void add_analysis_commands(CLI::App& app) {
                   "test, settings, seed and parameters; in a comment its stored metrics, its "
                   "error if it failed, or its state if it has not finished")
       ->check(CLI::Range(std::int64_t{1}, std::numeric_limits<std::int64_t>::max()));
-  exp->add_option("--workdir", e->workdir, "embedded: directory of the SQLite file");
   add_local_worker_options(*exp, e->local);
   exp->add_flag("-v,--verbose", e->verbose, "embedded: coordinator and worker logs");
   exp->callback([e] {

@@ -54,11 +54,9 @@ void add_report_command(CLI::App& app) {
                          "Write a self-contained report.html: design, effect plots, envelopes, "
                          "calibration, diagnosis");
   add_connection_options(*cmd, o->channel);
-  cmd->add_option("campaign", o->campaign, "campaign id, or a spec YAML (embedded default)")
-      ->required();
+  add_campaign_options(*cmd, o->campaign, o->workdir);
   cmd->add_option("-o,--output", o->out_dir, "directory for report.html")->capture_default_str();
   cmd->add_flag("--data", o->data, "also write the report's data as report.json");
-  cmd->add_option("--workdir", o->workdir, "embedded: directory of the SQLite file");
   add_local_worker_options(*cmd, o->local);
   cmd->add_flag("-v,--verbose", o->verbose, "embedded: coordinator and worker logs");
   cmd->callback([o] { run(*o); });

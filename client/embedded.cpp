@@ -293,6 +293,12 @@ void with_campaign(const std::string& campaign, const std::string& workdir,
   act(*campaign_stub(channel), channel, id);
 }
 
+void add_campaign_options(CLI::App& cmd, std::string& campaign, std::string& workdir) {
+  cmd.add_option("campaign", campaign, "campaign id, or a spec YAML (embedded default)")
+      ->required();
+  cmd.add_option("--workdir", workdir, "embedded: directory of the SQLite file");
+}
+
 void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
   cmd.add_option("--workers", local.workers, "embedded: local workers (jobs run side by side)")
       ->check(CLI::Range(1, 64))

@@ -33,6 +33,10 @@ struct LocalWorkers {
 /// `--workers`, `--threads` and `--yield-after` of a command that runs the embedded default.
 void add_local_worker_options(CLI::App& cmd, LocalWorkers& local);
 
+/// The campaign a command names (required: an id, or a spec YAML on the embedded default) and
+/// `--workdir`, the spec's work directory (with_campaign).
+void add_campaign_options(CLI::App& cmd, std::string& campaign, std::string& workdir);
+
 class EmbeddedService {
  public:
   /// `held_since`: the store in `workdir` is a copy of one that a running coordinator has held

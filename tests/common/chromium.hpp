@@ -4,7 +4,6 @@
 // log carries every console message; no driver beyond the browser itself is needed.
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
