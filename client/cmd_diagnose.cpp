@@ -82,13 +82,6 @@ void print_metrics(std::ostream& out, const v1::DiagnosisReport& r) {
       << (b.has_holdout_rms_se() ? " +- " + pct(true, b.holdout_rms_se()) : "") << "\n";
 }
 
-/// What a candidate explains: the calibrated misfit, the held-out one, both or neither.
-std::string explains(const v1::DiagnosisCandidate& c) {
-  if (c.explains() && c.explains_holdout()) return "both";
-  if (c.explains()) return "yes";
-  return c.explains_holdout() ? "held out" : "no";
-}
-
 void print_candidates(std::ostream& out, const v1::DiagnosisReport& r) {
   out << "\ncandidate causes, each tested by simulation (best first)\n";
   out << std::left << std::setw(14) << "candidate" << std::right << std::setw(6) << "runs"
@@ -103,7 +96,8 @@ void print_candidates(std::ostream& out, const v1::DiagnosisReport& r) {
         << pct(c.has_verified_rms(), c.verified_rms()) << std::setw(8)
         << (std::to_string(c.best_round()) + "/" + std::to_string(c.rounds())) << std::setw(10)
         << pct(c.has_holdout_rms(), c.holdout_rms()) << std::setw(8)
-        << pct(c.has_holdout_gain(), c.holdout_gain()) << std::setw(10) << explains(c) << "\n";
+        << pct(c.has_holdout_gain(), c.holdout_gain()) << std::setw(10) << c.explains_label()
+        << "\n";
     out << "    " << c.cause() << " [" << c.state() << "]";
     if (!c.evidence().empty()) out << ": " << c.evidence();
     out << "\n";

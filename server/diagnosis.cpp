@@ -217,6 +217,7 @@ v1::DiagnosisCandidate candidate_message(const diagnose::CandidateOutcome& c) {
   if (std::isfinite(c.holdout_rms_se)) out.set_holdout_rms_se(c.holdout_rms_se);
   if (std::isfinite(c.holdout_gain)) out.set_holdout_gain(c.holdout_gain);
   out.set_explains_holdout(c.explains_holdout);
+  out.set_explains_label(diagnose::explains_label(c));
   out.set_evidence(c.evidence);
   return out;
 }

@@ -976,6 +976,12 @@ void name_holdout_cause(const Problem& p, bool all_verified, Report& rep) {
 
 }  // namespace
 
+std::string explains_label(const CandidateOutcome& c) {
+  if (c.explains && c.explains_holdout) return "both";
+  if (c.explains) return "yes";
+  return c.explains_holdout ? "held out" : "no";
+}
+
 Step advance(const Problem& p, const std::map<std::string, GroupResults>& groups) {
   Step step;
   Report& rep = step.report;

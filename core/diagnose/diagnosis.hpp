@@ -236,6 +236,10 @@ struct CandidateOutcome {
   std::string evidence;
 };
 
+/// What a candidate explains, in the words every view shows: "both" (the calibrated and the
+/// held-out misfit), "yes" (the calibrated), "held out", or "no".
+std::string explains_label(const CandidateOutcome& c);
+
 struct Report {
   std::string state;  ///< waiting | running | done
   std::vector<MetricRow> metrics;

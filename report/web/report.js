@@ -499,11 +499,8 @@
       s.appendChild(el('p', { class: 'named', 'data-holdout-cause': heldOut.id, 'data-holdout-gain': heldOut.holdout_gain },
         'Named cause of the held-out misfit: ' + heldOut.cause + '; held out ' + withSe(heldOut.holdout_rms, heldOut.holdout_rms_se) + ' against the baseline\'s ' + withSe(b.holdout_rms, b.holdout_rms_se) + ', a gain of ' + pct(heldOut.holdout_gain)));
     }
-    // What a candidate explains, as `demcal diagnose` prints it: the calibrated misfit, the
-    // held-out one, both or neither.
-    const explains = (c) => (c.explains && c.explains_holdout ? 'both' : c.explains ? 'yes' : c.explains_holdout ? 'held out' : 'no');
     s.appendChild(table(['candidate', 'runs', 'predicted', 'verified', 'round (best/done)', 'held out', 'gain', 'explains', 'cause', 'state'], cands.map((c) => [
-      c.id, c.runs, pct(c.predicted_rms), withSe(c.verified_rms, c.verified_rms_se), (c.best_round || 0) + '/' + (c.rounds || 0), withSe(c.holdout_rms, c.holdout_rms_se), pct(c.holdout_gain), explains(c), c.cause, c.state,
+      c.id, c.runs, pct(c.predicted_rms), withSe(c.verified_rms, c.verified_rms_se), (c.best_round || 0) + '/' + (c.rounds || 0), withSe(c.holdout_rms, c.holdout_rms_se), pct(c.holdout_gain), c.explains_label, c.cause, c.state,
     ]), 'data diagnosis-candidates'));
     const bars = [{ model: 'baseline', verified_rms: b.verified_rms }].concat(cands.map((c) => ({ model: c.id, verified_rms: c.verified_rms })))
       .filter((x) => typeof x.verified_rms === 'number');

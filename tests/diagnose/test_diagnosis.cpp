@@ -1176,6 +1176,7 @@ TEST(Diagnosis, AHeldOutCompactConsolidatedToTheMeasuredDensityIsNamed) {
   EXPECT_NEAR(c->holdout_gain, 1.0 - c->holdout_rms / base_error, 1e-12);
   EXPECT_GT(c->holdout_gain, 0.9);
   EXPECT_TRUE(c->explains_holdout);
+  EXPECT_EQ(explains_label(*c), c->explains ? "both" : "held out");
   EXPECT_EQ(r.holdout_cause, "consolidation") << r.conclusion;
   EXPECT_NE(r.conclusion.find("held-out misfit"), std::string::npos) << r.conclusion;
 }
@@ -1195,6 +1196,7 @@ TEST(Diagnosis, AConsolidationThatDoesNotMoveTheHeldOutMisfitNamesNothing) {
     ASSERT_NE(c, nullptr);
     EXPECT_EQ(c->state, "verified") << c->evidence;
     EXPECT_FALSE(c->explains_holdout);
+    EXPECT_EQ(explains_label(*c), c->explains ? "yes" : "no");
     EXPECT_TRUE(r.holdout_cause.empty()) << r.conclusion;
     EXPECT_NE(r.conclusion.find("none is named"), std::string::npos) << r.conclusion;
   }
@@ -1231,6 +1233,17 @@ TEST(Diagnosis, ConsolidationIsACandidateOnlyWhereTheServerStatesAConditioning) 
   } catch (const InputError& e) {
     EXPECT_EQ(e.where(), "diagnose.candidates");
   }
+}
+
+TEST(Diagnosis, TheExplainsLabelNamesWhichMisfitACandidateExplains) {
+  CandidateOutcome c;
+  EXPECT_EQ(explains_label(c), "no");
+  c.explains = true;
+  EXPECT_EQ(explains_label(c), "yes");
+  c.explains_holdout = true;
+  EXPECT_EQ(explains_label(c), "both");
+  c.explains = false;
+  EXPECT_EQ(explains_label(c), "held out");
 }
 
 }  // namespace
