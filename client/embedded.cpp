@@ -325,7 +325,7 @@ void add_local_worker_options(CLI::App& cmd, LocalWorkers& local) {
 
 EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const LocalWorkers& local,
                                  bool verbose, std::optional<double> held_since)
-    : workdir_(workdir) {
+    : workdir_(workdir), local_(local) {
   watch_stop_signals();
   // The work directory holds the campaign's database: a new one is its owner's alone (0700).
   if (std::filesystem::create_directories(workdir))
@@ -359,22 +359,26 @@ EmbeddedService::EmbeddedService(const std::filesystem::path& workdir, const Loc
   channel_.token = co.token;
   holds_store_ = !held_since;
   if (holds_store_) leave_coordinator_file(workdir, channel_);
-  for (int i = 1; i <= local.workers; ++i) {
+  stub_ = campaign_stub(channel_);
+  signalled_service = this;
+}
+
+void EmbeddedService::start_local_workers() {
+  if (!workers_.empty()) return;
+  for (int i = 1; i <= local_.workers; ++i) {
     worker::WorkerOptions wo;
     wo.channel = channel_;
-    wo.threads = local.threads;
-    wo.id = local.workers == 1 ? "embedded" : "embedded-" + std::to_string(i);
+    wo.threads = local_.threads;
+    wo.id = local_.workers == 1 ? "embedded" : "embedded-" + std::to_string(i);
     // The local workers share the stages runs can start from (docs/lab-tests.md, "Work done
     // once"), kept beside the campaign's database.
-    wo.stage_cache_dir = (workdir / "stages").string();
+    wo.stage_cache_dir = (workdir_ / "stages").string();
     ++running_;
     workers_.emplace_back([this, wo] {
       worker::run_worker(wo, flags_);
       --running_;
     });
   }
-  stub_ = campaign_stub(channel_);
-  signalled_service = this;
 }
 
 void EmbeddedService::stop_on_signal(int sig) {
@@ -413,6 +417,7 @@ std::int64_t EmbeddedService::submit_or_resume(const SpecFile& file, std::ostrea
   if (journal) import_journal(*stub_, channel_, *journal, file.spec, out);
   const std::int64_t id = submit_or_resume_campaign(file, out);
   if (journal) keeper_ = std::make_unique<JournalKeeper>(*journal, *stub_, channel_, id);
+  start_local_workers();
   return id;
 }
 
@@ -433,6 +438,7 @@ std::int64_t EmbeddedService::resumable_campaign(const SpecFile& file) {
 std::int64_t EmbeddedService::resume(const SpecFile& file, std::ostream& out) {
   const std::int64_t id = resumable_campaign(file);
   if (!id) no_campaign(file, workdir_);
+  start_local_workers();
   return resuming(id, file, out);
 }
 

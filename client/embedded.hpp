@@ -85,6 +85,10 @@ class EmbeddedService {
  private:
   /// Removes the address it left in its work directory (a holder's; a copy left none).
   void take_address_away();
+  /// Starts the local workers (once). Not before the campaign is reached: a worker leases at
+  /// once, and a job leased before the journal's runs are offered would simulate a run the
+  /// journal holds.
+  void start_local_workers();
   /// submit_or_resume without a journal.
   std::int64_t submit_or_resume_campaign(const SpecFile& file, std::ostream& out);
   /// The newest campaign not cancelled of the spec's name in this work directory; 0 when there
@@ -97,6 +101,7 @@ class EmbeddedService {
   std::unique_ptr<server::Coordinator> coordinator_;
   std::unique_ptr<server::HttpPage> http_;
   rpc::ChannelOptions channel_;
+  LocalWorkers local_;
   worker::StopFlags flags_;
   std::vector<std::thread> workers_;
   std::atomic<int> running_{0};  ///< workers that have not returned

@@ -1,7 +1,8 @@
 // Campaign journals and runs reused by run key (docs/journal.md), with real processes: a second
 // campaign in one store takes the first's results instead of leasing its jobs; `demcal run
 // --journal` interrupted and resumed in a fresh work directory gives the uninterrupted run's
-// effects to the bit with no run simulated twice; a journal of another spec gives exactly the runs
+// effects to the bit with no run simulated twice, and a store snapshot behind its journal takes the
+// journal's runs before it leases a job; a journal of another spec gives exactly the runs
 // whose keys match; runs of another version of their test's protocol, or of a material the build
 // refuses, are not taken; lines cut short are dropped and malformed lines refused with their file
 // and line.
@@ -311,6 +312,39 @@ TEST_F(Journal, AnInterruptedCampaignGoesOnElsewhereFromItsJournalToTheSameEffec
   // An uninterrupted run gives the same effect tables, to the bit.
   ASSERT_EQ(run(spec, "whole", "", err), 0) << err;
   EXPECT_EQ(output("second").at("effects"), output("whole").at("effects"));
+}
+
+TEST_F(Journal, AStoreSnapshotBehindItsJournalTakesTheJournalsRunsBeforeItsWorkerLeasesOne) {
+  const std::string spec = path("behind.yaml");
+  std::ofstream(spec) << wall_friction_spec("behind", "");
+  const std::string journal = path("behind.jsonl");
+  {
+    Process first(run_argv(spec, "first", journal), path("first.json"), path("first.err"));
+    ASSERT_TRUE(wait_until([&] { return results_stored("first") >= 1; }, 90));
+    first.signal(SIGINT);
+    EXPECT_EQ(first.wait_exit(40), 128 + SIGINT);
+  }
+  const int finished = results_stored("first");
+  ASSERT_LT(finished, 4);
+  // The stopped store is kept as a snapshot; the campaign then goes on to its end in its own
+  // work directory, so the journal holds runs the snapshot has queued.
+  fs::create_directories(path("snapshot"));
+  for (const auto& entry : fs::directory_iterator(path("first")))
+    if (entry.path().filename().string().starts_with("campaign.db"))
+      fs::copy_file(entry.path(), fs::path(path("snapshot")) / entry.path().filename());
+  std::string err;
+  ASSERT_EQ(run(spec, "first", journal, err), 0) << err;
+  ASSERT_EQ(journal_keys(journal).size(), 4u);
+  // Going on from the snapshot with the journal simulates nothing: its local worker starts
+  // once the journal's runs are offered, so each queued job takes its run's result.
+  ASSERT_EQ(run(spec, "snapshot", journal, err), 0) << err;
+  const auto [simulated, reused] = simulated_and_reused("snapshot");
+  EXPECT_EQ(simulated, finished);
+  EXPECT_EQ(reused, 4 - finished);
+  std::map<std::string, std::string> metrics_of_key;
+  for (const auto& job : stored_jobs("first")) metrics_of_key[job.run_key] = job.metrics;
+  for (const auto& job : stored_jobs("snapshot"))
+    EXPECT_EQ(job.metrics, metrics_of_key.at(job.run_key)) << job.run_key;
 }
 
 TEST_F(Journal, ADiagnosisKeepsItsRunsInTheJournalAndGoesOnFromItElsewhere) {
