@@ -24,6 +24,15 @@ std::string head_on(const std::string& normal, double v0, double dt, double end_
          num(-v0) + ", 0, 0]}\n" + "time_step: " + num(dt) + "\nend_time: " + num(end_time) + "\n";
 }
 
+/// A contact of two spheres of radius kR, one fixed, whose overlap is driven through `waypoints`
+/// (a YAML list, m) at `speed` (m/s), one step of 1 us at a time.
+std::string driven_path(const std::string& normal, const std::string& waypoints, double speed) {
+  return "contact_law:\n  normal: " + normal + "\n  tangential: {model: history, mu_s: 0.5}\n" +
+         "bodies:\n  - {radius: 0.001, density: 2500, position: [0, 0, 0], fixed: true}\n" +
+         "  - {radius: 0.001, density: 2500, position: [0.002, 0, 0]}\ntime_step: 1.0e-6\n" +
+         "mode: path\npath: {waypoints: " + waypoints + ", speed: " + num(speed) + "}\n";
+}
+
 // Linear spring-dashpot damped throughout the contact: e = exp(-pi xi / sqrt(1 - xi^2)) and
 // t_c = pi / sqrt(kn/m* (1 - xi^2)) (seed 001 eq. 3-4).
 TEST(LinearSpringDashpot, RestitutionAndContactTimeMatchTheory) {
@@ -132,17 +141,10 @@ TEST(Luding, DrivenOverlapPathFollowsTheEquationsAtEveryStep) {
 
 // Eq. 3: k1 = 4/3 Y sqrt(r^2 delta') with r = r_eff = 2 R* (equal spheres: the radius).
 TEST(Luding, LoadingStiffnessFromYoungsModulus) {
-  const std::string yaml = R"(
-contact_law:
-  normal: {model: luding, youngs_modulus: 1.0e7, delta_prime: 0.01, k2_ratio: 5.0, phi_f: 0.05, restitution: 1.0}
-  tangential: {model: history, mu_s: 0.5}
-bodies:
-  - {radius: 0.001, density: 2500, position: [0, 0, 0], fixed: true}
-  - {radius: 0.001, density: 2500, position: [0.002, 0, 0]}
-time_step: 1.0e-6
-mode: path
-path: {waypoints: [1.0e-6], speed: 0.01}
-)";
+  const std::string yaml = driven_path(
+      "{model: luding, youngs_modulus: 1.0e7, delta_prime: 0.01, k2_ratio: 5.0, phi_f: 0.05, "
+      "restitution: 1.0}",
+      "[1.0e-6]", 0.01);
   std::vector<lab::SingleContactSample> samples;
   test::run_contact(yaml, &samples);
   const double k1 = 4.0 / 3.0 * 1e7 * std::sqrt(1e-3 * 1e-3 * 0.01);
@@ -156,18 +158,9 @@ path: {waypoints: [1.0e-6], speed: 0.01}
 // leaves from and returns to the same overlap with the same delta_max.
 TEST(Luding, ClosedCyclesThroughTheAdhesiveBranchDissipate) {
   const auto cycle_work = [](const std::string& waypoints) {
-    const std::string yaml = R"(
-contact_law:
-  normal: {model: luding, k1: 1.0e4, k2_ratio: 2.0, kc_ratio: 5.0, phi_f: 0.2, restitution: 1.0}
-  tangential: {model: history, mu_s: 0.5}
-bodies:
-  - {radius: 0.001, density: 2500, position: [0, 0, 0], fixed: true}
-  - {radius: 0.001, density: 2500, position: [0.002, 0, 0]}
-time_step: 1.0e-6
-mode: path
-path: {waypoints: )" + waypoints +
-                             R"(, speed: 0.05}
-)";
+    const std::string yaml = driven_path(
+        "{model: luding, k1: 1.0e4, k2_ratio: 2.0, kc_ratio: 5.0, phi_f: 0.2, restitution: 1.0}",
+        waypoints, 0.05);
     std::vector<lab::SingleContactSample> samples;
     test::run_contact(yaml, &samples);
     // The work done on the contact from the path's first arrival at 5e-4 m to its end there.

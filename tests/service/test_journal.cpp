@@ -108,6 +108,15 @@ class Journal : public Service {
     ASSERT_EQ(file_lines(path("a.jsonl")).size(), 5u);
   }
 
+  /// `demcal run` (run_argv) stopped with SIGINT (Ctrl-C) once `results` runs are stored in WORK.
+  void run_until_interrupted(const std::string& spec, const std::string& work,
+                             const std::string& journal, int results) {
+    Process p(run_argv(spec, work, journal), path(work + ".json"), path(work + ".err"));
+    ASSERT_TRUE(wait_until([&] { return results_stored(work) >= results; }, 90));
+    p.signal(SIGINT);
+    EXPECT_EQ(p.wait_exit(40), 128 + SIGINT);
+  }
+
   nlohmann::json output(const std::string& work) {
     return nlohmann::json::parse(std::ifstream(path(work + ".json")));
   }
@@ -283,13 +292,8 @@ TEST_F(Journal, AnInterruptedCampaignGoesOnElsewhereFromItsJournalToTheSameEffec
   const std::string spec = path("moved.yaml");
   std::ofstream(spec) << wall_friction_spec("moved", "");
   const std::string journal = path("moved.jsonl");
-  {
-    // Stopped (Ctrl-C) once two of its four runs are finished, a few seconds each.
-    Process first(run_argv(spec, "first", journal), path("first.json"), path("first.err"));
-    ASSERT_TRUE(wait_until([&] { return results_stored("first") >= 2; }, 90));
-    first.signal(SIGINT);
-    EXPECT_EQ(first.wait_exit(40), 128 + SIGINT);
-  }
+  // Stopped (Ctrl-C) once two of its four runs are finished, a few seconds each.
+  run_until_interrupted(spec, "first", journal, 2);
   // The journal holds its header and every run the interrupted campaign finished.
   const int finished = results_stored("first");
   ASSERT_LT(finished, 4);
@@ -318,12 +322,7 @@ TEST_F(Journal, AStoreSnapshotBehindItsJournalTakesTheJournalsRunsBeforeItsWorke
   const std::string spec = path("behind.yaml");
   std::ofstream(spec) << wall_friction_spec("behind", "");
   const std::string journal = path("behind.jsonl");
-  {
-    Process first(run_argv(spec, "first", journal), path("first.json"), path("first.err"));
-    ASSERT_TRUE(wait_until([&] { return results_stored("first") >= 1; }, 90));
-    first.signal(SIGINT);
-    EXPECT_EQ(first.wait_exit(40), 128 + SIGINT);
-  }
+  run_until_interrupted(spec, "first", journal, 1);
   const int finished = results_stored("first");
   ASSERT_LT(finished, 4);
   // The stopped store is kept as a snapshot; the campaign then goes on to its end in its own
