@@ -22,6 +22,7 @@
 
 #include "core/common/error.hpp"
 #include "rpc/material_convert.hpp"
+#include "rpc/stop_signals.hpp"
 #include "server/limits.hpp"
 #include "server/store.hpp"
 #include "server/store_lock.hpp"
@@ -36,14 +37,6 @@ std::string random_token() {
   return t;
 }
 
-sigset_t stop_signals() {
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  return set;
-}
-
 /// The service whose workers a stop signal ends (one at a time per process).
 std::atomic<EmbeddedService*> signalled_service{nullptr};
 
@@ -51,8 +44,7 @@ std::atomic<EmbeddedService*> signalled_service{nullptr};
 /// in the calling thread before any other starts, so every later thread inherits the block.
 void watch_stop_signals() {
   static const bool started = [] {
-    const sigset_t set = stop_signals();
-    pthread_sigmask(SIG_BLOCK, &set, nullptr);
+    const sigset_t set = rpc::block_stop_signals();
     std::thread([set] {
       int sig = 0;
       sigwait(&set, &sig);

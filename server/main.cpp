@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "rpc/channel.hpp"
+#include "rpc/stop_signals.hpp"
 #include "server/coordinator.hpp"
 #include "server/http_page.hpp"
 
@@ -92,11 +93,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   // Signals are taken synchronously by this thread; every other thread inherits the mask.
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  const sigset_t set = demcal::rpc::block_stop_signals();
   try {
     demcal::server::Coordinator coordinator(o);
     write_port_file(port_file, coordinator.port());

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "core/sim/threads.hpp"
+#include "rpc/stop_signals.hpp"
 #include "worker/worker.hpp"
 
 int main(int argc, char** argv) {
@@ -52,11 +53,8 @@ int main(int argc, char** argv) {
       spdlog::critical("{}", e.what());
       return 2;
     }
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  // Signals are taken synchronously by one thread; every other thread inherits the mask.
+  const sigset_t set = demcal::rpc::block_stop_signals();
   demcal::worker::StopFlags flags;
   std::thread signals([&] {
     for (int n = 0; n < 2; ++n) {
