@@ -293,7 +293,7 @@ TEST_F(Journal, AnInterruptedCampaignGoesOnElsewhereFromItsJournalToTheSameEffec
   std::ofstream(spec) << wall_friction_spec("moved", "");
   const std::string journal = path("moved.jsonl");
   // Stopped (Ctrl-C) once two of its four runs are finished, a few seconds each.
-  run_until_interrupted(spec, "first", journal, 2);
+  ASSERT_NO_FATAL_FAILURE(run_until_interrupted(spec, "first", journal, 2));
   // The journal holds its header and every run the interrupted campaign finished.
   const int finished = results_stored("first");
   ASSERT_LT(finished, 4);
@@ -322,7 +322,7 @@ TEST_F(Journal, AStoreSnapshotBehindItsJournalTakesTheJournalsRunsBeforeItsWorke
   const std::string spec = path("behind.yaml");
   std::ofstream(spec) << wall_friction_spec("behind", "");
   const std::string journal = path("behind.jsonl");
-  run_until_interrupted(spec, "first", journal, 1);
+  ASSERT_NO_FATAL_FAILURE(run_until_interrupted(spec, "first", journal, 1));
   const int finished = results_stored("first");
   ASSERT_LT(finished, 4);
   // The stopped store is kept as a snapshot; the campaign then goes on to its end in its own
