@@ -596,6 +596,39 @@ void keep_if_best(const VerifiedPoint& point, int round, CandidateOutcome& c) {
   c.reaches_all = point.reaches_all;
 }
 
+/// What a candidate with nothing verified yet shows: the point it verifies and the surrogate's
+/// error there.
+void show_proposal(const VerifiedPoint& point, CandidateOutcome& c) {
+  c.proposed = point.proposed;
+  c.rescaled = point.rescaled;
+  c.predicted_rms = point.predicted_rms;
+  c.reaches_all = point.reaches_all;
+}
+
+/// A candidate whose first verification lost a run (a failed or given-up job): nothing is
+/// verified, and the evidence keeps what is known, the prediction, the measured metrics its
+/// finished runs gave and those no run gave.
+void fail_unverified(const Problem& p, const VerifiedPoint& point, CandidateOutcome& c) {
+  show_proposal(point, c);
+  c.simulated = point.simulated;
+  c.state = "failed";
+  std::ostringstream missing, finished;
+  for (const auto& m : p.measurements) {
+    auto it = point.simulated.find(m.response);
+    if (it == point.simulated.end() || !std::isfinite(it->second)) {
+      missing << (missing.tellp() > 0 ? ", " : "") << m.response;
+      continue;
+    }
+    finished << (finished.tellp() > 0 ? ", " : "") << m.response << " " << number(it->second)
+             << " (" << percent((it->second - m.value) / std::abs(m.value)) << ")";
+  }
+  std::ostringstream e;
+  e << "a verification run failed, so nothing is verified (predicted RMS error "
+    << percent(point.predicted_rms) << "); not simulated: " << missing.str();
+  if (finished.tellp() > 0) e << "; its finished runs gave " << finished.str();
+  c.evidence = e.str();
+}
+
 /// Calibrates a candidate on its data, verifies, adds the verified run, refits, and again: at
 /// most `rounds` rounds, fewer once a verified error is below `converged`. Appends the
 /// verification runs it needs; false when one has not finished.
@@ -617,10 +650,7 @@ bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
     point.simulated = replicate_mean(replicates);
     if (point.simulated.empty()) {
       if (c.best_round == 0) {  // nothing verified yet: show what is being verified
-        c.proposed = point.proposed;
-        c.rescaled = point.rescaled;
-        c.predicted_rms = point.predicted_rms;
-        c.reaches_all = point.reaches_all;
+        show_proposal(point, c);
         c.state = "designed";
       }
       return false;
@@ -631,7 +661,7 @@ bool verify_rounds(const Problem& p, const Plan& plan, const Fitted& base,
     point.holdout_rms_se = replicate_rms_se(p, base.all, replicates, true);
     c.rounds = round;
     if (!std::isfinite(point.verified_rms)) {  // a failed run ends the rounds
-      if (c.best_round == 0) c.state = "failed";
+      if (c.best_round == 0) fail_unverified(p, point, c);
       return true;
     }
     keep_if_best(point, round, c);

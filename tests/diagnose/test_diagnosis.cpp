@@ -1005,6 +1005,40 @@ TEST(Diagnosis, ReplicatedVerificationsAverageTheirSeeds) {
   }
 }
 
+TEST(Diagnosis, AVerificationThatLostARunKeepsItsPredictionAndNamesWhatIsMissing) {
+  // The second seed of the rolling candidate's verification loses its coordination number (a
+  // failed or given-up job leaves its test's metrics missing): nothing is verified, nothing is
+  // named, and the report keeps the proposed mu_r, the prediction there and what was simulated.
+  const auto ms = hidden_rolling_targets();
+  const Disturbance lose = [](const RunRequest& r, Responses& y) {
+    if (r.group == "rolling/verify" && r.replicate == 1) y[kCn] = std::nan("");
+  };
+  Problem p = make_problem(rolling_truth, {kSf, kCn}, ms);
+  p.options.candidates = {"rolling"};
+  p.options.replicates = 2;
+  const Report r = drive(p, rolling_truth, 30, lose).step.report;
+  ASSERT_EQ(r.state, "done") << r.conclusion;
+  const CandidateOutcome* c = candidate(r, "rolling");
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->state, "failed");
+  EXPECT_FALSE(std::isfinite(c->verified_rms));
+  EXPECT_FALSE(c->explains);
+  EXPECT_TRUE(r.named_cause.empty()) << r.conclusion;
+  // The truth is inside the extended box: the surrogate predicts it closely.
+  EXPECT_LT(c->predicted_rms, 0.01);
+  EXPECT_NEAR(c->proposed.at(kMuR), kTrueMuR, 0.1 * kTrueMuR);
+  // The solid fraction of both seeds is the mean of the truth's at the proposed point.
+  auto at = c->proposed;
+  EXPECT_NEAR(c->simulated.at(kSf), rolling_truth(at, {{"particle_law.rolling", "cdt"}}).at(kSf),
+              1e-12);
+  EXPECT_FALSE(std::isfinite(c->simulated.at(kCn)));
+  EXPECT_NE(c->evidence.find(std::string("not simulated: ") + kCn), std::string::npos)
+      << c->evidence;
+  EXPECT_NE(c->evidence.find(std::string("its finished runs gave ") + kSf), std::string::npos)
+      << c->evidence;
+  EXPECT_NE(c->evidence.find("predicted RMS error"), std::string::npos) << c->evidence;
+}
+
 TEST(Diagnosis, ACutWithinTheSeedsNoiseNamesNothing) {
   // Three lab seeds of every verification put the coordination number at 1 - s, 1 and 1 + s
   // times its value: the mean is the noise-free one, so the rolling candidate's cut of the
