@@ -8,6 +8,7 @@
 #include "core/calib/calibration.hpp"
 #include "core/calib/sequential.hpp"
 #include "core/common/error.hpp"
+#include "core/common/relative_error.hpp"
 #include "core/doe/alias_structure.hpp"
 #include "core/doe/analysis.hpp"
 #include "core/doe/model_fit.hpp"
@@ -620,7 +621,7 @@ void fail_unverified(const Problem& p, const VerifiedPoint& point, CandidateOutc
       continue;
     }
     finished << (finished.tellp() > 0 ? ", " : "") << m.response << " " << number(it->second)
-             << " (" << percent((it->second - m.value) / std::abs(m.value)) << ")";
+             << " (" << percent(relative_error(it->second, m.value)) << ")";
   }
   std::ostringstream e;
   e << "a verification run failed, so nothing is verified (predicted RMS error "

@@ -1028,9 +1028,8 @@ TEST(Diagnosis, AVerificationThatLostARunKeepsItsPredictionAndNamesWhatIsMissing
   EXPECT_LT(c->predicted_rms, 0.01);
   EXPECT_NEAR(c->proposed.at(kMuR), kTrueMuR, 0.1 * kTrueMuR);
   // The solid fraction of both seeds is the mean of the truth's at the proposed point.
-  auto at = c->proposed;
-  EXPECT_NEAR(c->simulated.at(kSf), rolling_truth(at, {{"particle_law.rolling", "cdt"}}).at(kSf),
-              1e-12);
+  EXPECT_NEAR(c->simulated.at(kSf),
+              rolling_truth(c->proposed, {{"particle_law.rolling", "cdt"}}).at(kSf), 1e-12);
   EXPECT_FALSE(std::isfinite(c->simulated.at(kCn)));
   EXPECT_NE(c->evidence.find(std::string("not simulated: ") + kCn), std::string::npos)
       << c->evidence;
